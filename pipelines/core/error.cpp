@@ -1,0 +1,20 @@
+#include "core/error.hpp"
+
+namespace procam {
+
+const char* toString(ErrorCode code) {
+  switch (code) {
+    case ErrorCode::kInvalidInput: return "invalid-input";
+    case ErrorCode::kTooFewPoints: return "too-few-points";
+    case ErrorCode::kDegenerate: return "degenerate";
+    case ErrorCode::kCoplanar: return "coplanar";
+    case ErrorCode::kIllConditioned: return "ill-conditioned";
+    case ErrorCode::kNoConvergence: return "no-convergence";
+    case ErrorCode::kNotFound: return "not-found";
+    case ErrorCode::kParse: return "parse";
+    case ErrorCode::kIo: return "io";
+  }
+  return "unknown";
+}
+
+}  // namespace procam

@@ -1,0 +1,36 @@
+#pragma once
+// Typed errors returned by every pipeline: a code a caller can branch on and a
+// message a user can read. Pipelines never throw across their API.
+#include <string>
+#include <tl/expected.hpp>
+#include <utility>
+
+namespace procam {
+
+enum class ErrorCode {
+  kInvalidInput,     // malformed argument: wrong sizes, NaN/Inf, negative counts
+  kTooFewPoints,     // fewer correspondences than the model needs
+  kDegenerate,       // configuration admits no unique solution (collinear, duplicates)
+  kCoplanar,         // 3D points (near) coplanar: projection matrix undetermined (seed §4.1.1)
+  kIllConditioned,   // system too badly conditioned to trust the result
+  kNoConvergence,    // iterative solver did not reach its tolerance
+  kNotFound,         // requested item absent (no intersection, unknown name)
+  kParse,            // text input could not be parsed (scene files, JSON)
+  kIo,               // used only outside pipelines (tools, drivers)
+};
+
+const char* toString(ErrorCode code);
+
+struct Error {
+  ErrorCode code;
+  std::string message;
+};
+
+template <class T>
+using Result = tl::expected<T, Error>;
+
+inline tl::unexpected<Error> fail(ErrorCode code, std::string message) {
+  return tl::unexpected<Error>(Error{code, std::move(message)});
+}
+
+}  // namespace procam

@@ -1,0 +1,1 @@
+#include "geometry/plane_fit.hpp"

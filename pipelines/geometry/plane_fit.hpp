@@ -1,0 +1,38 @@
+#pragma once
+// Planes: least-squares and RANSAC fits (seed §4.1.1 coplanarity, §7.3 planar
+// display surfaces).
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "core/error.hpp"
+#include "core/types.hpp"
+
+namespace procam::geom {
+
+// n · x + d = 0 with |n| = 1.
+struct Plane {
+  Vec3 n = Vec3::UnitZ();
+  double d = 0;
+  double signedDistance(const Vec3& x) const { return n.dot(x) + d; }
+};
+
+struct PlaneFit {
+  Plane plane;
+  double rms = 0;                 // RMS distance of the inliers
+  std::vector<std::uint32_t> inliers;  // indices (all points for least squares)
+};
+
+Result<PlaneFit> fitPlane(std::span<const Vec3> points);
+
+struct RansacOptions {
+  double threshold = 0.001;  // inlier distance, world units
+  int iterations = 500;
+  double confidence = 0.999;  // early stop
+  std::uint64_t seed = 1;
+};
+
+// RANSAC on 3-point samples, then a least-squares refit on the inliers.
+Result<PlaneFit> fitPlaneRansac(std::span<const Vec3> points, const RansacOptions& options = {});
+
+}  // namespace procam::geom

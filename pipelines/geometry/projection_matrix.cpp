@@ -1,0 +1,1 @@
+#include "geometry/projection_matrix.hpp"

@@ -1,0 +1,1 @@
+// Stress: homography, projection matrix, camera model

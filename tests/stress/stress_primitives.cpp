@@ -1,0 +1,1 @@
+// Stress: rigid transform, triangulation, plane fit, intersections

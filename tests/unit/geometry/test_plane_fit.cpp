@@ -1,0 +1,1 @@
+// Tests for pipelines/geometry/plane_fit
