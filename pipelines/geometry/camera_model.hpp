@@ -22,7 +22,9 @@ struct Distortion {
 
   bool isZero() const { return k1 == 0 && k2 == 0 && p1 == 0 && p2 == 0 && k3 == 0; }
   Vec2 apply(const Vec2& normalized) const;
-  // Inverse of apply() by fixed-point/Newton iteration; kNoConvergence if it fails.
+  // Inverse of apply() on the branch through the centre (Newton with continuation);
+  // kNoConvergence for points beyond the model's fold (no physical preimage),
+  // kInvalidInput for NaN/Inf.
   Result<Vec2> remove(const Vec2& distorted) const;
 };
 
@@ -36,7 +38,9 @@ struct Pose {
   Vec3 toWorld(const Vec3& device) const { return R.transpose() * (device - t); }
   Pose inverse() const;
   // Device at `eye` with its +z axis towards `target` and its -y axis as close to
-  // `up` as possible (image y points down).
+  // `up` as possible (image y points down). Degenerate input never yields NaN: if
+  // eye == target the device looks along world +Y; if up is parallel to the view
+  // direction the world axis least aligned with it is used as up.
   static Pose lookAt(const Vec3& eye, const Vec3& target, const Vec3& up);
 };
 

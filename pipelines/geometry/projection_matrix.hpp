@@ -22,7 +22,7 @@ struct ProjectionOptions {
   // Points whose smallest principal spread is below this fraction of the largest
   // are treated as coplanar (seed §4.1.1: the planar depth-scale ambiguity).
   double coplanar_ratio = 1e-3;
-  double max_condition = 1e12;
+  double max_condition = 1e8;  // of the normalised DLT system; larger -> kIllConditioned
 };
 
 // n >= 6 pairs; kCoplanar for (near-)coplanar 3D points, kTooFewPoints, kDegenerate.
@@ -34,7 +34,10 @@ struct KRt {
   Pose pose;     // det R = +1
 };
 
-// RQ decomposition with signs fixed (positive focal lengths, det R = +1).
+// RQ decomposition with signs fixed (positive focal lengths, det R = +1). The overall
+// sign of P is taken from det of its left 3x3 block (that of a real camera K R is
+// positive), so the result does not depend on the sign P is given in. kDegenerate when
+// that block is singular (camera at infinity).
 Result<KRt> decomposeProjectionMatrix(const Mat34& P);
 
 }  // namespace procam::geom

@@ -1,0 +1,80 @@
+#include "arguments.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+#include <cstdio>
+
+namespace procam::cli {
+
+Result<Arguments> Arguments::parse(int argc, char** argv, int first) {
+  Arguments a;
+  std::string current;
+  for (int i = first; i < argc; ++i) {
+    const std::string word = argv[i];
+    if (word.rfind("--", 0) == 0 && word.size() > 2) {
+      current = word.substr(2);
+      if (a.values_.count(current)) return fail(ErrorCode::kInvalidInput, "option --" + current + " given twice");
+      a.values_[current];
+    } else if (current.empty()) {
+      return fail(ErrorCode::kInvalidInput, "unexpected argument '" + word + "'");
+    } else {
+      a.values_[current].push_back(word);
+    }
+  }
+  return a;
+}
+
+Result<std::string> Arguments::one(const std::string& name) const {
+  auto it = values_.find(name);
+  if (it == values_.end()) return fail(ErrorCode::kInvalidInput, "missing --" + name);
+  if (it->second.size() != 1) return fail(ErrorCode::kInvalidInput, "--" + name + " takes one value");
+  return it->second[0];
+}
+
+std::optional<std::string> Arguments::optional(const std::string& name) const {
+  auto it = values_.find(name);
+  if (it == values_.end() || it->second.size() != 1) return std::nullopt;
+  return it->second[0];
+}
+
+const std::vector<std::string>& Arguments::all(const std::string& name) const {
+  static const std::vector<std::string> kNone;
+  auto it = values_.find(name);
+  return it == values_.end() ? kNone : it->second;
+}
+
+Result<void> Arguments::only(const std::vector<std::string>& known) const {
+  for (const auto& [name, v] : values_) {
+    bool ok = false;
+    for (const auto& k : known) ok |= k == name;
+    if (!ok) return fail(ErrorCode::kInvalidInput, "unknown option --" + name);
+  }
+  return {};
+}
+
+Result<int> toInt(const std::string& text, const std::string& what) {
+  int v = 0;
+  auto [p, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec != std::errc() || p != text.data() + text.size())
+    return fail(ErrorCode::kInvalidInput, what + ": '" + text + "' is not an integer");
+  return v;
+}
+
+Result<double> toDouble(const std::string& text, const std::string& what) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v))
+    return fail(ErrorCode::kInvalidInput, what + ": '" + text + "' is not a number");
+  return v;
+}
+
+Result<std::pair<int, int>> toSize(const std::string& text, const std::string& what) {
+  int w = 0, h = 0, n = 0;
+  if (std::sscanf(text.c_str(), "%dx%d%n", &w, &h, &n) != 2 || n != static_cast<int>(text.size()) ||
+      w < 1 || h < 1)
+    return fail(ErrorCode::kInvalidInput, what + ": expected WIDTHxHEIGHT, got '" + text + "'");
+  return std::pair{w, h};
+}
+
+}  // namespace procam::cli

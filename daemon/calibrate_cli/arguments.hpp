@@ -1,0 +1,34 @@
+#pragma once
+// "--option value [value...]" command-line arguments of procam-calibrate.
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/error.hpp"
+
+namespace procam::cli {
+
+class Arguments {
+ public:
+  // argv[first..argc): every "--name" takes the words up to the next "--name".
+  static Result<Arguments> parse(int argc, char** argv, int first);
+
+  bool has(const std::string& name) const { return values_.count(name) > 0; }
+  // Exactly one value; kInvalidInput names the option when missing.
+  Result<std::string> one(const std::string& name) const;
+  std::optional<std::string> optional(const std::string& name) const;
+  const std::vector<std::string>& all(const std::string& name) const;
+  // Fails on options not in `known`.
+  Result<void> only(const std::vector<std::string>& known) const;
+
+ private:
+  std::map<std::string, std::vector<std::string>> values_;
+};
+
+Result<int> toInt(const std::string& text, const std::string& what);
+Result<double> toDouble(const std::string& text, const std::string& what);
+// "WxH"
+Result<std::pair<int, int>> toSize(const std::string& text, const std::string& what);
+
+}  // namespace procam::cli

@@ -1,0 +1,52 @@
+#pragma once
+// File formats of procam-calibrate: pattern PNGs and sequence.json, capture
+// directories, the correspondence PFM, cameras.json / rig.json (README.md here).
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+
+#include "calibration/projector_calibration.hpp"
+#include "core/error.hpp"
+#include "geometry/camera_model.hpp"
+#include "structured_light/decoder.hpp"
+#include "structured_light/pattern_set.hpp"
+
+namespace procam::cli {
+
+namespace fs = std::filesystem;
+
+// Writes one PNG per frame and DIR/sequence.json.
+Result<void> writePatterns(const sl::PatternSet& set, const fs::path& dir);
+Result<sl::PatternSet> readSequence(const fs::path& dir);
+
+// Loads DIR/<frame name>.png for every frame (8 or 16 bit, as stored).
+Result<std::vector<cv::Mat>> readCaptures(const sl::PatternSet& set, const fs::path& dir);
+
+// 3-channel PFM: u, v, confidence; rows bottom to top, little-endian; -1 undecoded.
+Result<void> writeCorrespondencePfm(const sl::Decoded& decoded, const fs::path& file);
+
+struct NamedCamera {
+  std::string name;
+  geom::CameraModel model;
+  double rms_px = -1;  // written when >= 0
+};
+struct NamedProjector {
+  std::string name;
+  int width = 0, height = 0;
+  calib::ProjectorCalibration calibration;
+};
+
+Result<std::vector<NamedCamera>> readCameras(const fs::path& file);
+nlohmann::json cameraJson(const NamedCamera& c);
+nlohmann::json projectorJson(const NamedProjector& p);
+
+Result<void> writeText(const fs::path& file, const std::string& text);
+Result<nlohmann::json> readJson(const fs::path& file);
+
+// Image files (png, jpg, jpeg, tif, tiff, bmp) of a directory, sorted by name.
+Result<std::vector<fs::path>> listImages(const fs::path& dir);
+
+}  // namespace procam::cli

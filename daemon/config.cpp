@@ -1,0 +1,256 @@
+#include "config.hpp"
+
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <toml++/toml.h>
+
+namespace procam::daemon {
+
+namespace {
+
+class Checker {
+ public:
+  explicit Checker(const std::string& source) : source_(source) {}
+
+  void error(const toml::source_region& where, const std::string& key, const std::string& what) {
+    std::string line = source_ + ":" + std::to_string(where.begin.line) + ": ";
+    if (!key.empty()) line += key + ": ";
+    errors_.push_back(line + what);
+  }
+  bool ok() const { return errors_.empty(); }
+  std::string joined() const {
+    std::string all;
+    for (const auto& e : errors_) all += (all.empty() ? "" : "\n") + e;
+    return all;
+  }
+
+  // Reports every key of `table` not in `known`.
+  void onlyKnown(const toml::table& table, const std::string& prefix,
+                 std::initializer_list<std::string_view> known) {
+    for (auto&& [key, value] : table) {
+      bool found = false;
+      for (auto k : known) found = found || key.str() == k;
+      if (!found) {
+        std::string expected;
+        for (auto k : known) expected += (expected.empty() ? "" : ", ") + std::string(k);
+        error(key.source(), prefix + std::string(key.str()),
+              "unknown key (expected one of: " + expected + ")");
+      }
+    }
+  }
+
+  bool string(const toml::node& node, const std::string& key, std::string& out) {
+    if (auto s = node.value<std::string>(); s && node.is_string()) {
+      out = *s;
+      return true;
+    }
+    error(node.source(), key, "expected a string");
+    return false;
+  }
+
+  bool boolean(const toml::node& node, const std::string& key, bool& out) {
+    if (!node.is_boolean()) {
+      error(node.source(), key, "expected true or false");
+      return false;
+    }
+    out = *node.value<bool>();
+    return true;
+  }
+
+  bool integer(const toml::node& node, const std::string& key, int lo, int hi, int& out) {
+    if (!node.is_integer()) {
+      error(node.source(), key, "expected an integer");
+      return false;
+    }
+    const int64_t v = node.as_integer()->get();
+    if (v < lo || v > hi) {
+      error(node.source(), key,
+            std::to_string(v) + " is out of range [" + std::to_string(lo) + ", " +
+                std::to_string(hi) + "]");
+      return false;
+    }
+    out = static_cast<int>(v);
+    return true;
+  }
+
+  bool number(const toml::node& node, const std::string& key, double lo, double hi,
+              double& out) {
+    if (!node.is_number()) {
+      error(node.source(), key, "expected a number");
+      return false;
+    }
+    const double v = *node.value<double>();
+    if (!(v >= lo && v <= hi)) {  // also rejects nan
+      std::ostringstream msg;
+      msg << v << " is out of range [" << lo << ", " << hi << "]";
+      error(node.source(), key, msg.str());
+      return false;
+    }
+    out = v;
+    return true;
+  }
+
+ private:
+  std::string source_;
+  std::vector<std::string> errors_;
+};
+
+void parseDaemon(Checker& c, const toml::table& t, Config& cfg) {
+  c.onlyKnown(t, "daemon.",
+              {"log_level", "plugin_dir", "group", "max_clients", "client_queue_kib",
+               "client_stall_timeout_s"});
+  if (auto* n = t.get("log_level")) {
+    std::string s;
+    if (c.string(*n, "daemon.log_level", s)) {
+      if (auto level = parseLogLevel(s)) {
+        cfg.log_level = *level;
+      } else {
+        c.error(n->source(), "daemon.log_level", level.error().message);
+      }
+    }
+  }
+  if (auto* n = t.get("plugin_dir")) c.string(*n, "daemon.plugin_dir", cfg.plugin_dir);
+  if (auto* n = t.get("group")) c.string(*n, "daemon.group", cfg.group);
+  if (auto* n = t.get("max_clients")) c.integer(*n, "daemon.max_clients", 1, 4096, cfg.max_clients);
+  if (auto* n = t.get("client_queue_kib")) {
+    c.integer(*n, "daemon.client_queue_kib", 64, 65536, cfg.client_queue_kib);
+  }
+  if (auto* n = t.get("client_stall_timeout_s")) {
+    c.number(*n, "daemon.client_stall_timeout_s", 0.1, 3600.0, cfg.client_stall_timeout_s);
+  }
+}
+
+void parsePolicy(Checker& c, const toml::table& t, Config& cfg) {
+  c.onlyKnown(t, "policy.", {"auto_keystone", "recalibrate"});
+  if (auto* n = t.get("auto_keystone")) c.boolean(*n, "policy.auto_keystone", cfg.auto_keystone);
+  if (auto* n = t.get("recalibrate")) {
+    std::string s;
+    if (c.string(*n, "policy.recalibrate", s)) {
+      if (s == "off") {
+        cfg.recalibrate = RecalibratePolicy::kOff;
+      } else if (s == "on-drift") {
+        cfg.recalibrate = RecalibratePolicy::kOnDrift;
+      } else {
+        c.error(n->source(), "policy.recalibrate", "'" + s + "' is not one of: off, on-drift");
+      }
+    }
+  }
+}
+
+void parseSim(Checker& c, const toml::table& t, Config& cfg) {
+  c.onlyKnown(t, "sim.", {"scene"});
+  if (auto* n = t.get("scene")) c.string(*n, "sim.scene", cfg.sim_scene);
+}
+
+void parseDevices(Checker& c, const toml::node& node, const std::string& section,
+                  procam_family family, Config& cfg, std::set<std::string>& names) {
+  const toml::array* list = node.as_array();
+  if (!list) {
+    c.error(node.source(), section, "expected an array of tables ([[" + section + "]])");
+    return;
+  }
+  for (size_t i = 0; i < list->size(); ++i) {
+    const toml::node& item = *list->get(i);
+    const std::string key = section + "[" + std::to_string(i) + "]";
+    const toml::table* t = item.as_table();
+    if (!t) {
+      c.error(item.source(), key, "expected a table");
+      continue;
+    }
+    c.onlyKnown(*t, key + ".", {"name", "driver", "devnode", "options"});
+    DeviceConfig dev;
+    dev.family = family;
+    dev.line = static_cast<int>(t->source().begin.line);
+    if (auto* n = t->get("name")) {
+      if (c.string(*n, key + ".name", dev.name)) {
+        if (dev.name.empty()) c.error(n->source(), key + ".name", "must not be empty");
+        if (!names.insert(dev.name).second) {
+          c.error(n->source(), key + ".name", "duplicate device name '" + dev.name + "'");
+        }
+      }
+    } else {
+      c.error(t->source(), key + ".name", "missing (every device needs a unique name)");
+    }
+    if (auto* n = t->get("driver")) c.string(*n, key + ".driver", dev.driver);
+    if (auto* n = t->get("devnode")) c.string(*n, key + ".devnode", dev.devnode);
+    if (auto* n = t->get("options")) {
+      if (const toml::table* opts = n->as_table()) {
+        for (auto&& [k, v] : *opts) {
+          const std::string okey = key + ".options." + std::string(k.str());
+          if (v.is_string()) {
+            dev.options.emplace_back(std::string(k.str()), *v.value<std::string>());
+          } else if (v.is_integer()) {
+            dev.options.emplace_back(std::string(k.str()), std::to_string(v.as_integer()->get()));
+          } else if (v.is_floating_point()) {
+            std::ostringstream text;
+            text.precision(17);
+            text << v.as_floating_point()->get();
+            dev.options.emplace_back(std::string(k.str()), text.str());
+          } else if (v.is_boolean()) {
+            dev.options.emplace_back(std::string(k.str()), *v.value<bool>() ? "true" : "false");
+          } else {
+            c.error(v.source(), okey, "expected a string, number or boolean");
+          }
+        }
+      } else {
+        c.error(n->source(), key + ".options", "expected a table");
+      }
+    }
+    cfg.devices.push_back(std::move(dev));
+  }
+}
+
+}  // namespace
+
+const char* recalibratePolicyName(RecalibratePolicy policy) {
+  return policy == RecalibratePolicy::kOnDrift ? "on-drift" : "off";
+}
+
+Result<Config> parseConfig(std::string_view text, const std::string& source) {
+  toml::table root;
+  try {
+    root = toml::parse(text, source);
+  } catch (const toml::parse_error& e) {
+    return fail(ErrorCode::kParse, source + ":" + std::to_string(e.source().begin.line) + ":" +
+                                       std::to_string(e.source().begin.column) + ": " +
+                                       std::string(e.description()));
+  }
+  Config cfg;
+  cfg.source = source;
+  Checker c(source);
+  c.onlyKnown(root, "", {"daemon", "policy", "sim", "projector", "camera", "tilt", "tracker"});
+  auto section = [&](const char* name, void (*parse)(Checker&, const toml::table&, Config&)) {
+    if (auto* n = root.get(name)) {
+      if (const toml::table* t = n->as_table()) {
+        parse(c, *t, cfg);
+      } else {
+        c.error(n->source(), name, "expected a table ([" + std::string(name) + "])");
+      }
+    }
+  };
+  section("daemon", parseDaemon);
+  section("policy", parsePolicy);
+  section("sim", parseSim);
+  std::set<std::string> names;
+  const std::pair<const char*, procam_family> families[] = {{"projector", PROCAM_FAMILY_OUTPUT},
+                                                            {"camera", PROCAM_FAMILY_CAMERA},
+                                                            {"tilt", PROCAM_FAMILY_TILT},
+                                                            {"tracker", PROCAM_FAMILY_TRACKER}};
+  for (const auto& [name, family] : families) {
+    if (auto* n = root.get(name)) parseDevices(c, *n, name, family, cfg, names);
+  }
+  if (!c.ok()) return fail(ErrorCode::kInvalidInput, c.joined());
+  return cfg;
+}
+
+Result<Config> loadConfig(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return fail(ErrorCode::kIo, "cannot open config file " + path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) return fail(ErrorCode::kIo, "cannot read config file " + path);
+  return parseConfig(text.str(), path);
+}
+
+}  // namespace procam::daemon

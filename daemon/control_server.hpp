@@ -1,0 +1,115 @@
+#pragma once
+// Serves the control socket: accepts clients (peer checked with SO_PEERCRED),
+// sends the VERSION banner, frames requests, and queues replies per client.
+// A client whose output queue exceeds its bound, or that stops reading for
+// longer than the stall timeout, is dropped with a logged reason: no client
+// can stall the loop or the others.
+#include <sys/types.h>
+
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "event_loop.hpp"
+#include "protocol.hpp"
+#include "unique_fd.hpp"
+
+namespace procam::daemon {
+
+using ClientId = uint64_t;
+
+struct PeerCred {
+  pid_t pid = 0;
+  uid_t uid = 0;
+  gid_t gid = 0;
+};
+
+struct ServerOptions {
+  std::string release;
+  size_t max_clients = 128;
+  size_t queue_limit_bytes = 1024 * 1024;
+  std::chrono::milliseconds stall_timeout{10000};
+  gid_t group = static_cast<gid_t>(-1);  // the procam group; -1 when it does not exist
+};
+
+struct ServerStats {
+  uint64_t accepted = 0;
+  uint64_t refused = 0;  // peer not allowed, or too many clients
+  uint64_t dropped = 0;  // slow or misbehaving clients
+  uint64_t requests = 0;
+  uint64_t malformed = 0;  // requests answered with a protocol-level ERROR
+};
+
+class ControlServer {
+ public:
+  using RequestHandler = std::function<void(ClientId, const proto::Request&)>;
+  using DisconnectHandler = std::function<void(ClientId)>;
+
+  ControlServer(EventLoop& loop, UniqueFd listen_fd, ServerOptions options,
+                RequestHandler on_request, DisconnectHandler on_disconnect);
+  ControlServer(const ControlServer&) = delete;
+  ControlServer& operator=(const ControlServer&) = delete;
+  ~ControlServer();
+
+  Result<void> start();
+  void setOptions(const ServerOptions& options) { options_ = options; }
+
+  // Queues one line for a client; false when the client is gone or was just
+  // dropped for exceeding its queue bound.
+  bool send(ClientId client, std::string line);
+  // While held, a client that half-closed its side stays connected (an
+  // asynchronous reply is on its way).
+  void hold(ClientId client);
+  void release(ClientId client);
+  // Drops clients that stopped reading; call periodically.
+  void checkStalls();
+
+  bool connected(ClientId client) const;
+  std::optional<PeerCred> peer(ClientId client) const;
+  size_t clientCount() const { return clients_.size(); }
+  const ServerStats& stats() const { return stats_; }
+
+ private:
+  struct Client {
+    UniqueFd fd;
+    PeerCred cred;
+    proto::LineFramer framer;
+    std::deque<std::string> out;
+    size_t out_offset = 0;  // bytes of out.front() already written
+    size_t queued = 0;
+    std::chrono::steady_clock::time_point last_progress;
+    bool want_write = false;
+    bool read_closed = false;
+    bool closing = false;
+    int holds = 0;
+  };
+
+  void onAccept();
+  void onClientEvent(ClientId id, uint32_t events);
+  void readFrom(ClientId id, Client& c);
+  void flush(ClientId id, Client& c);
+  void drop(ClientId id, Client& c, const std::string& reason);
+  void maybeFinish(ClientId id, Client& c);
+  void reap();
+  bool peerAllowed(int fd, const PeerCred& cred) const;
+  std::string describe(const Client& c) const;
+
+  EventLoop& loop_;
+  UniqueFd listen_fd_;
+  ServerOptions options_;
+  RequestHandler on_request_;
+  DisconnectHandler on_disconnect_;
+  std::map<ClientId, std::unique_ptr<Client>> clients_;
+  std::vector<ClientId> to_reap_;
+  bool reap_scheduled_ = false;
+  ClientId next_id_ = 1;
+  ServerStats stats_;
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+};
+
+}  // namespace procam::daemon

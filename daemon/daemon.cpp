@@ -1,0 +1,203 @@
+#include "daemon.hpp"
+
+#include <grp.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <filesystem>
+
+#include "loader.hpp"
+#include "log.hpp"
+#include "systemd_notify.hpp"
+
+namespace procam::daemon {
+
+namespace {
+
+gid_t lookupGroup(const std::string& name) {
+  if (name.empty()) return static_cast<gid_t>(-1);
+  // Called once at start-up, before the loop runs.
+  const group* g = ::getgrnam(name.c_str());
+  return g ? g->gr_gid : static_cast<gid_t>(-1);
+}
+
+}  // namespace
+
+Daemon::Daemon(DaemonOptions options) : options_(std::move(options)) {}
+
+Daemon::~Daemon() {
+  server_.reset();
+  compute_worker_.reset();
+  io_worker_.reset();
+  devices_.closeAll();
+  removeControlSocket(socket_info_);
+}
+
+Result<std::unique_ptr<Daemon>> Daemon::create(DaemonOptions options) {
+  std::unique_ptr<Daemon> d(new Daemon(std::move(options)));
+  if (auto ok = d->setup(); !ok) return tl::unexpected(ok.error());
+  return d;
+}
+
+void Daemon::warn(const std::string& message) {
+  logWarning(message);
+  warnings_.push_back(message);
+  if (warnings_.size() > 32) warnings_.erase(warnings_.begin());
+  if (server_) broadcast("warning", {{"message", message}});
+}
+
+ServerOptions Daemon::serverOptions() const {
+  ServerOptions o;
+  o.release = kRelease;
+  o.max_clients = static_cast<size_t>(config_.max_clients);
+  o.queue_limit_bytes = static_cast<size_t>(config_.client_queue_kib) * 1024;
+  o.stall_timeout = std::chrono::milliseconds(
+      static_cast<int64_t>(config_.client_stall_timeout_s * 1000.0));
+  o.group = lookupGroup(config_.group);
+  return o;
+}
+
+Result<void> Daemon::setup() {
+  started_ = std::chrono::steady_clock::now();
+  if (!options_.config_path.empty()) {
+    auto cfg = loadConfig(options_.config_path);
+    if (!cfg) return tl::unexpected(cfg.error());
+    config_ = std::move(*cfg);
+  }
+  setLogLevel(config_.log_level);
+  if (options_.sim_scene.empty()) options_.sim_scene = config_.sim_scene;
+
+  auto loop = EventLoop::create();
+  if (!loop) return tl::unexpected(loop.error());
+  loop_ = std::move(*loop);
+  // Signals are blocked before any thread exists so that only signalfd sees them.
+  if (auto ok = loop_->watchSignals({SIGTERM, SIGINT, SIGHUP}, [this](int s) { onSignal(s); });
+      !ok) {
+    return ok;
+  }
+  ::signal(SIGPIPE, SIG_IGN);
+
+  std::error_code ec;
+  std::filesystem::create_directories(options_.runtime_dir, ec);
+  if (ec) {
+    return fail(ErrorCode::kIo,
+                "cannot create runtime directory " + options_.runtime_dir + ": " + ec.message());
+  }
+  const ServerOptions server_options = serverOptions();
+  auto sock = openControlSocket(options_.runtime_dir + "/control.sock", server_options.group);
+  if (!sock) return tl::unexpected(sock.error());
+  socket_info_.activated = sock->activated;
+  socket_info_.path = sock->path;
+
+  settings_file_ = std::make_unique<StateFile>(
+      options_.state_dir, "settings.json",
+      [](std::string_view text) -> Result<void> {
+        auto s = settingsFromJson(text);
+        if (!s) return tl::unexpected(s.error());
+        return {};
+      });
+  if (auto ok = settings_file_->ensureDirectory(); !ok) return ok;
+  loadSettings();
+  loadDrivers();
+  openDevices();
+
+  io_worker_ = std::make_unique<WorkerPool>(*loop_, 1);
+  compute_worker_ = std::make_unique<WorkerPool>(*loop_, 1);
+  server_ = std::make_unique<ControlServer>(
+      *loop_, std::move(sock->fd), server_options,
+      [this](ClientId c, const proto::Request& r) { handle(c, r); },
+      [this](ClientId c) { onDisconnect(c); });
+  if (auto ok = server_->start(); !ok) return ok;
+
+  if (auto ok = loop_->addTimer(std::chrono::seconds(1), true, [this] { housekeeping(); }); !ok) {
+    return tl::unexpected(ok.error());
+  }
+  if (auto interval = watchdogPingInterval()) {
+    // Pinged from the loop itself: a stuck loop stops the pings.
+    auto ok = loop_->addTimer(*interval, true, [] { notifyWatchdog(); });
+    if (!ok) return tl::unexpected(ok.error());
+  }
+  return {};
+}
+
+void Daemon::loadSettings() {
+  auto loaded = settings_file_->read();
+  if (!loaded) {
+    if (loaded.error().code != ErrorCode::kNotFound) {
+      warn("settings not restored: " + loaded.error().message + "; using defaults");
+    }
+    return;
+  }
+  if (loaded->from_backup) warn(loaded->warning);
+  // The validator already accepted the text.
+  settings_ = *settingsFromJson(loaded->contents);
+  if (settings_.auto_keystone) {
+    warn("saved setting auto keystone is on, but this build has no keystone pipeline; "
+         "automatic keystone stays off");
+    settings_.auto_keystone = false;
+  }
+}
+
+void Daemon::loadDrivers() {
+  auto statics = plugins::loadStaticPlugins(plugins::staticPlugins());
+  std::vector<std::string> refused;
+  if (statics) {
+    registry_.addAll(*statics, refused);
+  } else {
+    warn("in-tree drivers: " + statics.error().message);
+  }
+  std::string dir = options_.plugin_dir;
+  if (dir.empty()) dir = config_.plugin_dir;
+  if (dir.empty()) dir = PROCAM_DEFAULT_PLUGIN_DIR;
+  std::vector<Error> errors;
+  registry_.addAll(plugins::loadPluginDirectory(dir, errors), refused);
+  for (const auto& e : errors) warn(e.message);
+  for (const auto& r : refused) warn(r);
+  logInfo(std::to_string(registry_.drivers().size()) + " driver(s) available");
+}
+
+void Daemon::openDevices() {
+  for (const DeviceConfig& dc : config_.devices) {
+    plugins::DeviceDescription desc;
+    desc.family = dc.family;
+    desc.name = dc.name;
+    desc.devnode = dc.devnode;
+    desc.subsystem = "config";
+    // The role a udev rule would give such a device (udev/70-procamd.rules).
+    desc.properties = {{"PROCAM_ROLE", plugins::familyName(dc.family)}};
+    const DeviceEntry& e = devices_.open(registry_, desc, dc.driver, dc.options);
+    if (e.usable()) {
+      logInfo("opened " + std::string(plugins::familyName(dc.family)) + " '" + dc.name +
+              "' with driver " + e.driver);
+    } else {
+      warn(config_.source + ":" + std::to_string(dc.line) + ": device '" + dc.name +
+           "': " + e.error);
+    }
+  }
+}
+
+void Daemon::onSignal(int signo) {
+  if (signo == SIGHUP) {
+    if (auto ok = reloadConfig(); !ok) {
+      warn("reload on SIGHUP failed, keeping the previous configuration: " + ok.error().message);
+    }
+    return;
+  }
+  logInfo(std::string("stopping on ") + (signo == SIGINT ? "SIGINT" : "SIGTERM"));
+  notifyStopping();
+  loop_->stop(0);
+}
+
+void Daemon::housekeeping() { server_->checkStalls(); }
+
+int Daemon::run() {
+  const std::string where =
+      socket_info_.activated ? "socket passed by systemd" : socket_info_.path;
+  std::string status = "ready: " + std::to_string(devices_.entries().size()) + " device(s), " +
+                       "control on " + where;
+  logInfo("procamd " + std::string(kRelease) + " " + status);
+  notifyReady(status);
+  return loop_->run();
+}
+
+}  // namespace procam::daemon

@@ -1,0 +1,112 @@
+#pragma once
+// procamd: ties the event loop, the control server, configuration, state,
+// drivers and devices together. All methods run on the loop thread.
+#include <atomic>
+#include <chrono>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "config.hpp"
+#include "control_server.hpp"
+#include "control_socket.hpp"
+#include "device_set.hpp"
+#include "event_loop.hpp"
+#include "registry.hpp"
+#include "settings.hpp"
+#include "state_file.hpp"
+#include "worker_pool.hpp"
+
+namespace procam::daemon {
+
+struct DaemonOptions {
+  std::string config_path;  // empty: built-in defaults
+  std::string runtime_dir = "/run/procamd";
+  std::string state_dir = "/var/lib/procamd";
+  std::string plugin_dir;   // overrides the config and the built-in default
+  std::string sim_scene;    // non-empty: run on the virtual rig
+};
+
+inline constexpr const char* kRelease = PROCAM_RELEASE;
+
+class Daemon {
+ public:
+  static Result<std::unique_ptr<Daemon>> create(DaemonOptions options);
+  Daemon(const Daemon&) = delete;
+  Daemon& operator=(const Daemon&) = delete;
+  ~Daemon();
+
+  int run();
+
+ private:
+  explicit Daemon(DaemonOptions options);
+  Result<void> setup();
+  void loadSettings();
+  void loadDrivers();
+  void openDevices();
+  void onSignal(int signo);
+  void housekeeping();
+  void warn(const std::string& message);
+  ServerOptions serverOptions() const;
+
+  // commands.cpp
+  void handle(ClientId client, const proto::Request& req);
+  void onDisconnect(ClientId client);
+  void broadcast(const std::string& event, nlohmann::json body);
+  // To the watchers and to the client that started the operation.
+  void operationEvent(ClientId owner, const std::string& event, nlohmann::json body);
+  bool replyTo(ClientId client, const proto::Request& req, const std::string& cls,
+               nlohmann::json body = nlohmann::json::object());
+  void errorTo(ClientId client, const proto::Request& req, const char* code,
+               const std::string& message);
+  void cmdVersion(ClientId, const proto::Request&);
+  void cmdStatus(ClientId, const proto::Request&);
+  void cmdDevices(ClientId, const proto::Request&);
+  void cmdWatch(ClientId, const proto::Request&);
+  void cmdCalibrate(ClientId, const proto::Request&);
+  void cmdCancel(ClientId, const proto::Request&);
+  void cmdKeystone(ClientId, const proto::Request&);
+  void cmdPattern(ClientId, const proto::Request&);
+  void cmdContent(ClientId, const proto::Request&);
+  void cmdSave(ClientId, const proto::Request&);
+  void cmdReload(ClientId, const proto::Request&);
+  void cmdLogLevel(ClientId, const proto::Request&);
+  nlohmann::json statusJson() const;
+  nlohmann::json keystoneJson() const;
+  nlohmann::json contentJson() const;
+  bool showPattern();
+  Result<void> reloadConfig();
+
+  struct Operation {
+    std::string kind;
+    ClientId client = 0;
+    nlohmann::json request_id;
+    std::shared_ptr<std::atomic<bool>> cancelled;
+  };
+
+  DaemonOptions options_;
+  Config config_;
+  Settings settings_;
+  std::unique_ptr<StateFile> settings_file_;
+  std::vector<std::string> warnings_;
+  plugins::DriverRegistry registry_;
+  std::chrono::steady_clock::time_point started_;
+  ListeningSocket socket_info_;
+  std::map<ClientId, nlohmann::json> watchers_;  // client -> its watch request id
+  std::map<std::string, Operation> operations_;
+  uint64_t next_operation_ = 1;
+  struct ContentInfo {
+    int width = 0, height = 0;
+  };
+  ContentInfo content_info_;
+  // Destroyed in reverse order: server and workers before the loop they use.
+  std::unique_ptr<EventLoop> loop_;
+  std::unique_ptr<WorkerPool> io_worker_;       // state writes (fsync)
+  std::unique_ptr<WorkerPool> compute_worker_;  // image decoding, pipelines
+  DeviceSet devices_;
+  std::unique_ptr<ControlServer> server_;
+};
+
+}  // namespace procam::daemon

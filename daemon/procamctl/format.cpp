@@ -1,0 +1,152 @@
+#include "format.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace procam::ctl {
+
+using nlohmann::json;
+
+namespace {
+
+std::string scalar(const json& v) {
+  if (v.is_null()) return "-";
+  if (v.is_string()) return v.get<std::string>();
+  if (v.is_number_float()) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.6g", v.get<double>());
+    return buf;
+  }
+  return v.dump();
+}
+
+std::string pairList(const json& v) {
+  if (!v.is_array()) return scalar(v);
+  std::string out;
+  for (const auto& p : v) {
+    if (!out.empty()) out += " ";
+    if (p.is_array() && p.size() == 2) {
+      out += scalar(p[0]) + "," + scalar(p[1]);
+    } else {
+      out += scalar(p);
+    }
+  }
+  return out;
+}
+
+std::string field(const char* name, const std::string& value) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%-14s", (std::string(name) + ":").c_str());
+  return buf + value + "\n";
+}
+
+std::string keystoneText(const json& k) {
+  std::string out = field("auto keystone", k.value("auto", false) ? "on" : "off");
+  const json& corners = k.contains("corners") ? k["corners"] : json(nullptr);
+  out += field("corners", corners.is_null() ? "none (no manual correction)" : pairList(corners));
+  if (k.contains("output_size") && !k["output_size"].is_null()) {
+    out += field("output", scalar(k["output_size"][0]) + "x" + scalar(k["output_size"][1]));
+  }
+  if (k.contains("homography") && k["homography"].is_array()) {
+    for (size_t r = 0; r < k["homography"].size(); ++r) {
+      out += field(r == 0 ? "homography" : "", pairList(k["homography"][r]));
+    }
+  }
+  return out;
+}
+
+std::string contentText(const json& c) {
+  if (c.is_null()) return "none";
+  std::string s = c.value("path", "");
+  if (c.contains("size")) s += " (" + scalar(c["size"][0]) + "x" + scalar(c["size"][1]) + ")";
+  return s;
+}
+
+}  // namespace
+
+std::string progressBar(double fraction, int width, const std::string& stage) {
+  if (!std::isfinite(fraction)) fraction = 0;
+  fraction = std::clamp(fraction, 0.0, 1.0);
+  const int filled = static_cast<int>(std::lround(fraction * width));
+  std::string bar = "[" + std::string(filled, '#') + std::string(width - filled, '.') + "]";
+  char pct[16];
+  std::snprintf(pct, sizeof pct, " %3d%%", static_cast<int>(std::lround(fraction * 100)));
+  return bar + pct + (stage.empty() ? "" : "  " + stage);
+}
+
+std::string formatReply(const json& r) {
+  const std::string cls = r.value("class", "");
+  if (cls == "ERROR") return "error (" + r.value("code", "") + "): " + r.value("message", "") + "\n";
+  if (cls == "VERSION") {
+    return "procamd " + r.value("release", "") + ", protocol " + scalar(r["proto_major"]) + "." +
+           scalar(r["proto_minor"]) + ", plugin ABI " + scalar(r.value("plugin_abi", json())) + "\n";
+  }
+  if (cls == "STATUS") {
+    std::string out = field("release", r.value("release", ""));
+    out += field("pid", scalar(r["pid"]));
+    char up[32];
+    std::snprintf(up, sizeof up, "%.0f s", r.value("uptime_s", 0.0));
+    out += field("uptime", up);
+    out += field("virtual rig", scalar(r["sim"]));
+    out += field("config", scalar(r["config"]));
+    std::string devs;
+    for (const auto& [family, n] : r["devices"].items()) {
+      devs += (devs.empty() ? "" : ", ") + scalar(n) + " " + family;
+    }
+    out += field("devices", devs);
+    out += field("clients", scalar(r["clients"]) + " (" + scalar(r["watchers"]) + " watching)");
+    out += keystoneText(r["keystone"]);
+    out += field("pattern", scalar(r["pattern"]));
+    out += field("content", contentText(r["content"]));
+    out += field("log level", scalar(r["log_level"]));
+    std::string caps;
+    for (const auto& [name, on] : r["capabilities"].items()) {
+      caps += (caps.empty() ? "" : ", ") + name + (on.get<bool>() ? "" : " (not built)");
+    }
+    out += field("capabilities", caps);
+    for (const auto& w : r["warnings"]) out += field("warning", scalar(w));
+    return out;
+  }
+  if (cls == "DEVICES") {
+    std::string out;
+    if (r["devices"].empty()) out += "no devices\n";
+    for (const auto& d : r["devices"]) {
+      char line[256];
+      std::snprintf(line, sizeof line, "%-8s %-16s %-20s %s", scalar(d["family"]).c_str(),
+                    scalar(d["name"]).c_str(), scalar(d["driver"]).c_str(),
+                    scalar(d["state"]).c_str());
+      out += line;
+      if (d.contains("error")) out += ": " + scalar(d["error"]);
+      out += "\n";
+    }
+    out += std::to_string(r["drivers"].size()) + " driver(s) available\n";
+    return out;
+  }
+  if (cls == "KEYSTONE") return keystoneText(r);
+  if (cls == "PATTERN") {
+    return "pattern " + scalar(r["pattern"]) +
+           (r.value("shown", false) ? " (shown)" : " (no output showed it)") + "\n";
+  }
+  if (cls == "CONTENT") return "content: " + contentText(r["content"]) + "\n";
+  if (cls == "SAVE") return "saved " + scalar(r["path"]) + " (" + scalar(r["bytes"]) + " bytes)\n";
+  if (cls == "RELOAD") return "reloaded " + scalar(r["config"]) + "\n";
+  if (cls == "LOG-LEVEL") return "log level " + scalar(r["level"]) + "\n";
+  if (cls == "CANCEL") return "cancelled " + pairList(r["cancelled"]) + "\n";
+  if (cls == "WATCH") {
+    return r.value("enabled", false) ? "watching: " + pairList(r["events"]) + "\n"
+                                     : "not watching\n";
+  }
+  return r.dump() + "\n";
+}
+
+std::string formatEvent(const json& e) {
+  std::string out = e.value("event", "event");
+  for (const auto& [k, v] : e.items()) {
+    if (k == "class" || k == "id" || k == "event") continue;
+    out += " " + k + "=" + (v.is_array() ? pairList(v) : v.is_object() ? v.dump() : scalar(v));
+  }
+  return out + "\n";
+}
+
+}  // namespace procam::ctl

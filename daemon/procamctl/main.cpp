@@ -1,0 +1,213 @@
+// procamctl: command-line client of procamd (daemon/PROTOCOL.md).
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "client.hpp"
+#include "format.hpp"
+
+namespace {
+
+using nlohmann::json;
+using procam::ctl::ExitCode;
+
+constexpr const char* kUsage =
+    "usage: procamctl [--socket PATH] [--json] [--timeout SECONDS] COMMAND [ARGS]\n"
+    "commands:\n"
+    "  version | status | devices | save | reload\n"
+    "  watch                          stream events until interrupted\n"
+    "  calibrate                      run a calibration with a progress bar\n"
+    "  cancel [OPERATION]\n"
+    "  keystone [get]\n"
+    "  keystone set X,Y X,Y X,Y X,Y   corners: top-left top-right bottom-right bottom-left\n"
+    "  keystone clear\n"
+    "  keystone auto on|off\n"
+    "  pattern [off|grid|crosshair|white|black]\n"
+    "  content [get] | content load PATH | content clear\n"
+    "  log-level [error|warning|info|debug]\n"
+    "exit codes: 0 ok, 1 daemon error, 2 usage, 3 cannot connect, 4 protocol, 5 unavailable\n";
+
+struct Options {
+  std::string socket;
+  bool json = false;
+  std::chrono::milliseconds timeout{10000};
+};
+
+[[noreturn]] void usage(const std::string& problem) {
+  std::fprintf(stderr, "procamctl: %s\n%s", problem.c_str(), kUsage);
+  std::exit(procam::ctl::kExitUsage);
+}
+
+bool parsePoint(const std::string& text, json& out) {
+  const size_t comma = text.find(',');
+  if (comma == std::string::npos) return false;
+  char* end = nullptr;
+  const std::string xs = text.substr(0, comma), ys = text.substr(comma + 1);
+  const double x = std::strtod(xs.c_str(), &end);
+  if (xs.empty() || *end) return false;
+  const double y = std::strtod(ys.c_str(), &end);
+  if (ys.empty() || *end) return false;
+  out = json::array({x, y});
+  return true;
+}
+
+// The request for a one-shot command line.
+json buildRequest(const std::string& cmd, const std::vector<std::string>& a) {
+  auto arity = [&](size_t lo, size_t hi) {
+    if (a.size() < lo || a.size() > hi) usage("wrong number of arguments for " + cmd);
+  };
+  json r = {{"cmd", cmd}};
+  if (cmd == "version" || cmd == "status" || cmd == "devices" || cmd == "save" ||
+      cmd == "reload") {
+    arity(0, 0);
+  } else if (cmd == "cancel") {
+    arity(0, 1);
+    if (a.size() == 1) r["operation"] = a[0];
+  } else if (cmd == "keystone") {
+    const std::string action = a.empty() ? "get" : a[0];
+    if (action == "get") {
+      arity(0, 1);
+    } else if (action == "set") {
+      arity(5, 5);
+      json corners = json::array();
+      for (size_t i = 1; i < 5; ++i) {
+        json p;
+        if (!parsePoint(a[i], p)) usage("corner '" + a[i] + "' is not X,Y");
+        corners.push_back(p);
+      }
+      r["action"] = "set";
+      r["corners"] = corners;
+    } else if (action == "clear") {
+      arity(1, 1);
+      r["action"] = "set";
+      r["corners"] = nullptr;
+    } else if (action == "auto") {
+      arity(2, 2);
+      if (a[1] != "on" && a[1] != "off") usage("keystone auto takes on or off");
+      r["action"] = "auto";
+      r["enable"] = a[1] == "on";
+    } else {
+      usage("unknown keystone action '" + action + "'");
+    }
+  } else if (cmd == "pattern" || cmd == "log-level") {
+    arity(0, 1);
+    if (a.size() == 1) r[cmd == "pattern" ? "name" : "level"] = a[0];
+  } else if (cmd == "content") {
+    const std::string action = a.empty() ? "get" : a[0];
+    r["action"] = action;
+    if (action == "load") {
+      arity(2, 2);
+      r["path"] = a[1];
+    } else if (action == "get" || action == "clear") {
+      arity(0, 1);
+    } else {
+      usage("unknown content action '" + action + "'");
+    }
+  } else {
+    usage("unknown command '" + cmd + "'");
+  }
+  return r;
+}
+
+int exitFor(const json& reply) {
+  if (reply.value("class", "") != "ERROR") return procam::ctl::kExitOk;
+  return reply.value("code", "") == "unavailable" ? procam::ctl::kExitUnavailable
+                                                  : procam::ctl::kExitError;
+}
+
+int fail(const procam::ctl::ClientError& e) {
+  std::fprintf(stderr, "procamctl: %s\n", e.message.c_str());
+  return e.exit;
+}
+
+void print(const Options& o, const json& msg, bool event) {
+  if (o.json) {
+    std::printf("%s\n", msg.dump().c_str());
+  } else {
+    std::fputs((event ? procam::ctl::formatEvent(msg) : procam::ctl::formatReply(msg)).c_str(),
+               msg.value("class", "") == "ERROR" ? stderr : stdout);
+  }
+  std::fflush(stdout);
+}
+
+int runWatch(const Options& o, procam::ctl::Client& c) {
+  auto reply = c.call({{"cmd", "watch"}}, o.timeout);
+  if (!reply) return fail(reply.error());
+  print(o, *reply, false);
+  if (exitFor(*reply) != 0) return exitFor(*reply);
+  for (;;) {
+    auto msg = c.next(std::chrono::milliseconds(-1));
+    if (!msg) return fail(msg.error());
+    print(o, *msg, msg->value("class", "") == "EVENT");
+  }
+}
+
+// Sends a request that starts an operation and follows its progress events
+// until the reply (and, for asynchronous starts, the finished event) arrives.
+int runOperation(const Options& o, procam::ctl::Client& c, const json& request) {
+  const bool tty = !o.json && ::isatty(STDERR_FILENO);
+  bool bar_shown = false;
+  auto on_event = [&](const json& e) {
+    if (o.json) return print(o, e, true);
+    if (e.value("event", "") != "progress" || !tty) return;
+    std::fprintf(stderr, "\r%s", procam::ctl::progressBar(e.value("fraction", 0.0), 30,
+                                                          e.value("stage", "")).c_str());
+    bar_shown = true;
+  };
+  // Long operations: no reply timeout, the daemon reports progress.
+  auto reply = c.call(request, std::chrono::milliseconds(-1), on_event);
+  if (bar_shown) std::fputs("\n", stderr);
+  if (!reply) return fail(reply.error());
+  print(o, *reply, false);
+  return exitFor(*reply);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  const char* env = std::getenv("PROCAMD_SOCKET");
+  o.socket = env && *env ? env : "/run/procamd/control.sock";
+  int i = 1;
+  for (; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--socket" && i + 1 < argc) {
+      o.socket = argv[++i];
+    } else if (a == "--json") {
+      o.json = true;
+    } else if (a == "--timeout" && i + 1 < argc) {
+      char* end = nullptr;
+      const double s = std::strtod(argv[++i], &end);
+      if (*end || !(s > 0)) usage("--timeout needs a positive number of seconds");
+      o.timeout = std::chrono::milliseconds(static_cast<int64_t>(s * 1000));
+    } else if (a == "-h" || a == "--help") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    } else if (!a.empty() && a[0] == '-') {
+      usage("unknown option '" + a + "'");
+    } else {
+      break;
+    }
+  }
+  if (i >= argc) usage("no command");
+  const std::string cmd = argv[i++];
+  const std::vector<std::string> args(argv + i, argv + argc);
+  json request;
+  if (cmd != "watch" && cmd != "calibrate") request = buildRequest(cmd, args);
+  if ((cmd == "watch" || cmd == "calibrate") && !args.empty()) usage(cmd + " takes no arguments");
+
+  auto client = procam::ctl::Client::connect(o.socket, o.timeout);
+  if (!client) return fail(client.error());
+  if (cmd == "watch") return runWatch(o, *client);
+  if (cmd == "calibrate") return runOperation(o, *client, {{"cmd", "calibrate"}});
+  if (cmd == "content" && request.value("action", "") == "load") {
+    return runOperation(o, *client, request);
+  }
+  auto reply = client->call(request, o.timeout);
+  if (!reply) return fail(reply.error());
+  print(o, *reply, false);
+  return exitFor(*reply);
+}

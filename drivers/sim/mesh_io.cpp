@@ -1,0 +1,262 @@
+#include "sim/mesh_io.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace procam::sim {
+
+namespace {
+
+tl::unexpected<Error> parseError(const std::string& origin, std::size_t line, const std::string& what) {
+  return fail(ErrorCode::kParse, origin + ":" + std::to_string(line) + ": " + what);
+}
+
+Result<geom::TriangleMesh> checked(geom::TriangleMesh mesh, const std::string& origin) {
+  if (mesh.faces.empty()) return fail(ErrorCode::kParse, origin + ": mesh has no faces");
+  const int n = static_cast<int>(mesh.vertices.size());
+  for (const auto& f : mesh.faces) {
+    if (f.minCoeff() < 0 || f.maxCoeff() >= n)
+      return fail(ErrorCode::kParse, origin + ": face index out of range");
+  }
+  for (const auto& v : mesh.vertices) {
+    if (!v.allFinite()) return fail(ErrorCode::kParse, origin + ": non-finite vertex");
+  }
+  return mesh;
+}
+
+// Resolves an OBJ index token ("7", "7/1/3", "-1//2") to a 0-based vertex index.
+bool objIndex(const std::string& token, int vertex_count, int& out) {
+  const std::string head = token.substr(0, token.find('/'));
+  int value = 0;
+  const auto [ptr, ec] = std::from_chars(head.data(), head.data() + head.size(), value);
+  if (ec != std::errc() || ptr != head.data() + head.size() || value == 0) return false;
+  out = value > 0 ? value - 1 : vertex_count + value;
+  return true;
+}
+
+}  // namespace
+
+Result<geom::TriangleMesh> parseObj(std::string_view text, const std::string& origin) {
+  geom::TriangleMesh mesh;
+  std::istringstream in{std::string(text)};
+  std::string line;
+  std::size_t line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    std::istringstream fields(line);
+    std::string tag;
+    if (!(fields >> tag) || tag[0] == '#') continue;
+    if (tag == "v") {
+      Vec3 v;
+      if (!(fields >> v.x() >> v.y() >> v.z())) return parseError(origin, line_no, "bad vertex");
+      mesh.vertices.push_back(v);
+    } else if (tag == "f") {
+      std::vector<int> idx;
+      std::string token;
+      while (fields >> token) {
+        int i = 0;
+        if (!objIndex(token, static_cast<int>(mesh.vertices.size()), i))
+          return parseError(origin, line_no, "bad face index '" + token + "'");
+        idx.push_back(i);
+      }
+      if (idx.size() < 3) return parseError(origin, line_no, "face with fewer than 3 vertices");
+      for (std::size_t k = 1; k + 1 < idx.size(); ++k)
+        mesh.faces.emplace_back(idx[0], idx[k], idx[k + 1]);
+    }
+    // vt, vn, o, g, s, usemtl, mtllib: not needed for geometry.
+  }
+  return checked(std::move(mesh), origin);
+}
+
+namespace {
+
+enum class PlyType { kI8, kU8, kI16, kU16, kI32, kU32, kF32, kF64, kInvalid };
+
+PlyType plyType(const std::string& name) {
+  if (name == "char" || name == "int8") return PlyType::kI8;
+  if (name == "uchar" || name == "uint8") return PlyType::kU8;
+  if (name == "short" || name == "int16") return PlyType::kI16;
+  if (name == "ushort" || name == "uint16") return PlyType::kU16;
+  if (name == "int" || name == "int32") return PlyType::kI32;
+  if (name == "uint" || name == "uint32") return PlyType::kU32;
+  if (name == "float" || name == "float32") return PlyType::kF32;
+  if (name == "double" || name == "float64") return PlyType::kF64;
+  return PlyType::kInvalid;
+}
+
+std::size_t plySize(PlyType t) {
+  switch (t) {
+    case PlyType::kI8:
+    case PlyType::kU8: return 1;
+    case PlyType::kI16:
+    case PlyType::kU16: return 2;
+    case PlyType::kI32:
+    case PlyType::kU32:
+    case PlyType::kF32: return 4;
+    case PlyType::kF64: return 8;
+    case PlyType::kInvalid: break;
+  }
+  return 0;
+}
+
+struct PlyProperty {
+  std::string name;
+  PlyType type = PlyType::kInvalid;
+  bool is_list = false;
+  PlyType count_type = PlyType::kInvalid;
+};
+
+struct PlyElement {
+  std::string name;
+  std::size_t count = 0;
+  std::vector<PlyProperty> props;
+};
+
+// Reads one scalar of the given type from ascii tokens or little-endian bytes.
+class PlyReader {
+ public:
+  PlyReader(std::string_view body, bool binary) : body_(body), binary_(binary) {
+    if (!binary_) ascii_.str(std::string(body));
+  }
+
+  bool read(PlyType type, double& out) {
+    if (!binary_) return static_cast<bool>(ascii_ >> out);
+    const std::size_t n = plySize(type);
+    if (pos_ + n > body_.size()) return false;
+    const char* p = body_.data() + pos_;
+    pos_ += n;
+    switch (type) {
+      case PlyType::kI8: out = static_cast<std::int8_t>(p[0]); return true;
+      case PlyType::kU8: out = static_cast<std::uint8_t>(p[0]); return true;
+      case PlyType::kI16: return copyAs<std::int16_t>(p, out);
+      case PlyType::kU16: return copyAs<std::uint16_t>(p, out);
+      case PlyType::kI32: return copyAs<std::int32_t>(p, out);
+      case PlyType::kU32: return copyAs<std::uint32_t>(p, out);
+      case PlyType::kF32: return copyAs<float>(p, out);
+      case PlyType::kF64: return copyAs<double>(p, out);
+      case PlyType::kInvalid: break;
+    }
+    return false;
+  }
+
+ private:
+  template <class T>
+  static bool copyAs(const char* p, double& out) {
+    T value;
+    std::memcpy(&value, p, sizeof(T));  // x86/ARM hosts are little-endian, as the file
+    out = static_cast<double>(value);
+    return true;
+  }
+
+  std::string_view body_;
+  bool binary_;
+  std::size_t pos_ = 0;
+  std::istringstream ascii_;
+};
+
+}  // namespace
+
+Result<geom::TriangleMesh> parsePly(std::string_view bytes, const std::string& origin) {
+  const std::size_t end = bytes.find("end_header");
+  if (bytes.substr(0, 3) != "ply" || end == std::string_view::npos)
+    return fail(ErrorCode::kParse, origin + ": not a PLY file");
+  const std::size_t body_start = bytes.find('\n', end);
+  if (body_start == std::string_view::npos) return fail(ErrorCode::kParse, origin + ": truncated");
+
+  std::istringstream header{std::string(bytes.substr(0, end))};
+  std::vector<PlyElement> elements;
+  bool binary = false;
+  std::string line;
+  std::size_t line_no = 0;
+  while (std::getline(header, line)) {
+    ++line_no;
+    std::istringstream f(line);
+    std::string tag;
+    f >> tag;
+    if (tag == "format") {
+      std::string fmt;
+      f >> fmt;
+      if (fmt == "binary_little_endian") binary = true;
+      else if (fmt != "ascii") return parseError(origin, line_no, "unsupported PLY format " + fmt);
+    } else if (tag == "element") {
+      PlyElement e;
+      if (!(f >> e.name >> e.count)) return parseError(origin, line_no, "bad element line");
+      elements.push_back(e);
+    } else if (tag == "property") {
+      if (elements.empty()) return parseError(origin, line_no, "property before element");
+      PlyProperty p;
+      std::string type;
+      f >> type;
+      if (type == "list") {
+        std::string count_type, item_type;
+        f >> count_type >> item_type >> p.name;
+        p.is_list = true;
+        p.count_type = plyType(count_type);
+        p.type = plyType(item_type);
+        if (p.count_type == PlyType::kInvalid) return parseError(origin, line_no, "bad list type");
+      } else {
+        p.type = plyType(type);
+        f >> p.name;
+      }
+      if (p.type == PlyType::kInvalid) return parseError(origin, line_no, "bad property type");
+      elements.back().props.push_back(p);
+    }
+  }
+
+  geom::TriangleMesh mesh;
+  PlyReader reader(bytes.substr(body_start + 1), binary);
+  for (const auto& e : elements) {
+    for (std::size_t i = 0; i < e.count; ++i) {
+      Vec3 v = Vec3::Zero();
+      for (const auto& p : e.props) {
+        if (p.is_list) {
+          double count = 0;
+          if (!reader.read(p.count_type, count) || count < 0)
+            return fail(ErrorCode::kParse, origin + ": truncated " + e.name + " list");
+          std::vector<int> idx(static_cast<std::size_t>(count));
+          for (auto& k : idx) {
+            double value = 0;
+            if (!reader.read(p.type, value))
+              return fail(ErrorCode::kParse, origin + ": truncated " + e.name + " list");
+            k = static_cast<int>(value);
+          }
+          if (e.name == "face" && (p.name == "vertex_indices" || p.name == "vertex_index")) {
+            if (idx.size() < 3) return fail(ErrorCode::kParse, origin + ": face with < 3 vertices");
+            for (std::size_t k = 1; k + 1 < idx.size(); ++k)
+              mesh.faces.emplace_back(idx[0], idx[k], idx[k + 1]);
+          }
+        } else {
+          double value = 0;
+          if (!reader.read(p.type, value))
+            return fail(ErrorCode::kParse, origin + ": truncated " + e.name + " data");
+          if (e.name == "vertex" && p.name.size() == 1 && p.name[0] >= 'x' && p.name[0] <= 'z')
+            v[p.name[0] - 'x'] = value;
+        }
+      }
+      if (e.name == "vertex") mesh.vertices.push_back(v);
+    }
+  }
+  return checked(std::move(mesh), origin);
+}
+
+Result<geom::TriangleMesh> loadMesh(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return fail(ErrorCode::kIo, "cannot open mesh file " + file.string());
+  const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext == ".obj") return parseObj(bytes, file.string());
+  if (ext == ".ply") return parsePly(bytes, file.string());
+  return fail(ErrorCode::kInvalidInput, "unknown mesh format (want .obj or .ply): " + file.string());
+}
+
+}  // namespace procam::sim

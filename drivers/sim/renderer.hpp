@@ -1,0 +1,110 @@
+#pragma once
+// What the rig's cameras (and a viewer) see while the projectors show given
+// framebuffers. Per camera pixel n*n stratified samples (stratum centres):
+// ray -> nearest surface -> every projector lighting that point with a clear line of
+// sight -> its framebuffer (gamma, footprint, bilinear) -> albedo * (ambient +
+// brightness * cos / d^2) -> the camera's signal chain (camera_response.hpp).
+// Rows are rendered in parallel; results do not depend on the number of threads.
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "core/error.hpp"
+#include "sim/projector_image.hpp"
+#include "sim/scene.hpp"
+
+namespace procam::sim {
+
+// Projector name -> framebuffer it shows. A projector without an entry is dark.
+using Framebuffers = std::map<std::string, cv::Mat, std::less<>>;
+
+struct RenderOptions {
+  bool noise = true;
+  std::uint64_t seed = 1;
+  int threads = 0;  // 0: all cores (OpenCV's pool), 1: the calling thread only
+};
+
+// What one camera pixel (its centre ray) sees.
+struct PixelTruth {
+  bool hit = false;
+  int surface = -1;  // index into scene.world().surfaces()
+  Vec3 point = Vec3::Zero();
+  Vec3 normal = Vec3::Zero();  // facing the camera
+  struct Light {
+    bool in_front = false;  // point in front of the projector (pixel below is valid)
+    bool lit = false;       // inside the frame, facing it, no shadow
+    Vec2 pixel = Vec2::Zero();  // framebuffer coordinates of the point
+    double cos_incidence = 0, distance = 0;
+  };
+  std::vector<Light> projectors;  // in SceneState::projectors order
+};
+
+// Per-pixel truth over a whole camera image (centre rays).
+struct TruthMaps {
+  cv::Mat point;    // CV_64FC3 world point; zeros where nothing is hit
+  cv::Mat surface;  // CV_32S surface index, -1 where nothing is hit
+  std::vector<cv::Mat> projector_pixel;  // per projector, CV_32FC2 framebuffer coordinates
+  std::vector<cv::Mat> lit;              // per projector, CV_8U: 255 where lit
+};
+
+class Renderer {
+ public:
+  // The scene must outlive the renderer; `state` is usually scene.at(t).
+  static Result<Renderer> create(const Scene& scene, SceneState state, const Framebuffers& shown);
+
+  // Camera image: CV_8U (<= 8 bits) or CV_16U, 1 or 3 channels (BGR).
+  Result<cv::Mat> renderCamera(std::string_view camera, const RenderOptions& options = {}) const;
+  // Linear radiance the camera's pixels receive (mean over the supersamples), CV_32FC3.
+  Result<cv::Mat> cameraRadiance(std::string_view camera, int threads = 0) const;
+
+  // Noise-free linear radiance (CV_32FC3, BGR) seen through any pinhole, e.g. the
+  // viewer's eye: the image a person there perceives.
+  cv::Mat renderView(const geom::CameraModel& view, int supersamples = 4, int threads = 0) const;
+  cv::Mat renderViewer(int supersamples = 4, int threads = 0) const {
+    return renderView(state_.viewer, supersamples, threads);
+  }
+
+  PixelTruth truthAt(const geom::CameraModel& view, const Vec2& pixel) const;
+  Result<TruthMaps> cameraTruth(std::string_view camera, int threads = 0) const;
+
+  // Radiance leaving along `ray` (BGR, linear); black when nothing is hit.
+  cv::Vec3f radianceAlong(const geom::Ray& ray) const;
+
+  const SceneState& state() const { return state_; }
+  const Scene& scene() const { return *scene_; }
+
+ private:
+  struct Lamp {
+    std::size_t projector = 0;  // index into state_.projectors
+    std::optional<ProjectorImage> image;
+    Mat34 P;  // K [R | t]
+    Vec3 center;
+  };
+
+  Renderer(const Scene& scene, SceneState state) : scene_(&scene), state_(std::move(state)) {}
+  PixelTruth::Light light(const Lamp& lamp, const Vec3& point, const Vec3& normal) const;
+  cv::Mat radianceImage(const geom::CameraModel& view, int supersamples, int threads) const;
+
+  const Scene* scene_;
+  SceneState state_;
+  std::vector<Lamp> lamps_;
+  std::vector<cv::Vec3f> albedo_bgr_;
+  cv::Vec3f ambient_bgr_;
+};
+
+// Pixel -> world ray through a (possibly distorted) pinhole; nullopt if the
+// distortion cannot be inverted there. `warm_start` (optional, in/out) carries the
+// undistorted normalised point of a nearby pixel to speed up the inversion.
+std::optional<geom::Ray> pixelRay(const geom::CameraModel& view, double x, double y,
+                                  Vec2* warm_start = nullptr);
+
+// Runs body(row) for rows [0, rows) on `threads` threads (0: all cores).
+void forEachRow(int rows, int threads, const std::function<void(int)>& body);
+
+}  // namespace procam::sim

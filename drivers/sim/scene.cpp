@@ -1,0 +1,94 @@
+#include "sim/scene.hpp"
+
+#include <fstream>
+#include <iterator>
+
+#include "sim/orientation.hpp"
+
+namespace procam::sim {
+
+namespace {
+template <class T>
+const T* findByName(const std::vector<T>& items, std::string_view name) {
+  for (const auto& item : items) {
+    if (item.spec.name == name) return &item;
+  }
+  return nullptr;
+}
+}  // namespace
+
+const ProjectorState* SceneState::projector(std::string_view name) const {
+  return findByName(projectors, name);
+}
+const CameraState* SceneState::camera(std::string_view name) const {
+  return findByName(cameras, name);
+}
+const TiltSensorState* SceneState::tiltSensor(std::string_view name) const {
+  return findByName(tilt_sensors, name);
+}
+
+const Trajectory* Scene::trajectory(std::string_view name) const {
+  for (const auto& t : trajectories_) {
+    if (t.name() == name) return &t;
+  }
+  return nullptr;
+}
+
+geom::Pose Scene::placementPose(const Placement& p, double time) const {
+  switch (p.kind) {
+    case Placement::Kind::kFixed: return p.fixed;
+    case Placement::Kind::kTrajectory: return trajectory(p.trajectory)->poseAt(time);
+    case Placement::Kind::kAttached:
+      // The parser guarantees the parent exists and is itself not attached.
+      for (const auto& proj : projectors_) {
+        if (proj.name == p.parent) return compose(p.offset, placementPose(proj.placement, time));
+      }
+      break;
+  }
+  return p.fixed;
+}
+
+Vec3 Scene::viewerPosition(double time) const {
+  return placementPose(viewer_.placement, time).center();
+}
+
+SceneState Scene::at(double time) const {
+  SceneState state;
+  state.time = time;
+  for (const auto& spec : projectors_) {
+    geom::CameraModel m;
+    m.K = spec.K;
+    m.pose = placementPose(spec.placement, time);
+    m.width = spec.width;
+    m.height = spec.height;
+    state.projectors.push_back({spec, m});
+  }
+  for (const auto& spec : cameras_) {
+    geom::CameraModel m;
+    m.K = spec.K;
+    m.dist = spec.dist;
+    m.pose = placementPose(spec.placement, time);
+    m.width = spec.width;
+    m.height = spec.height;
+    state.cameras.push_back({spec, m});
+  }
+  for (const auto& spec : tilt_sensors_) {
+    const ProjectorState* proj = state.projector(spec.projector);
+    state.tilt_sensors.push_back({spec, spec.sensor_from_projector * proj->model.pose.R});
+  }
+  state.viewer.K = viewer_.K;
+  state.viewer.pose = placementPose(viewer_.placement, time);
+  state.viewer.width = viewer_.width;
+  state.viewer.height = viewer_.height;
+  return state;
+}
+
+Result<Scene> Scene::load(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return fail(ErrorCode::kIo, "cannot open scene file " + file.string());
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const std::filesystem::path base = file.parent_path().empty() ? "." : file.parent_path();
+  return parse(text, file.string(), base);
+}
+
+}  // namespace procam::sim

@@ -1,0 +1,147 @@
+#pragma once
+// The virtual rig's world: devices, surfaces, light and motion, read from a TOML
+// scene file (schema: SCENE-FORMAT.md beside this file). Scene::at(t) evaluates
+// every trajectory and rigid attachment and gives the true state of the rig.
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/error.hpp"
+#include "core/types.hpp"
+#include "geometry/camera_model.hpp"
+#include "sim/surfaces.hpp"
+#include "sim/trajectory.hpp"
+
+namespace procam::sim {
+
+// Where a device is: a fixed pose, a trajectory, or rigidly attached to a projector.
+struct Placement {
+  enum class Kind { kFixed, kTrajectory, kAttached };
+  Kind kind = Kind::kFixed;
+  geom::Pose fixed;        // kFixed: world -> device
+  std::string trajectory;  // kTrajectory: trajectory name
+  std::string parent;      // kAttached: projector name
+  geom::Pose offset;       // kAttached: parent device -> this device
+};
+
+struct ProjectorSpec {
+  std::string name;
+  int width = 0, height = 0;
+  geom::Intrinsics K;
+  Placement placement;
+  double gamma = 2.2;          // framebuffer value v in [0,1] emits v^gamma
+  double blur_sigma_px = 0.0;  // Gaussian pixel footprint, framebuffer pixels
+  double brightness = 1.0;     // irradiance of a full-white pixel at 1 m, normal incidence
+};
+
+struct CameraSpec {
+  std::string name;
+  int width = 0, height = 0;
+  geom::Intrinsics K;
+  geom::Distortion dist;
+  Placement placement;
+  double exposure = 1.0;        // linear signal = exposure * radiance, 1 = full well at gain 1
+  double gain = 1.0;            // analogue gain after the photodiode (amplifies shot noise)
+  double read_noise_dn = 0.0;   // sigma of the read noise, output DN
+  double full_well_e = 0.0;     // electrons at full scale and gain 1; 0 = no shot noise
+  int bit_depth = 8;            // 8..16; CV_8U up to 8 bits, CV_16U above
+  double response_gamma = 1.0;  // output = linear^(1/response_gamma)
+  int channels = 1;             // 1 (luminance) or 3 (BGR, OpenCV order)
+  int supersamples = 4;         // n*n stratified samples per pixel, n >= 2
+  int maxDn() const { return (1 << bit_depth) - 1; }
+  double electronsPerDn() const { return full_well_e / maxDn(); }  // at gain 1
+};
+
+struct TiltSensorSpec {
+  std::string name;
+  std::string projector;           // the projector it is mounted on
+  Mat3 sensor_from_projector = Mat3::Identity();  // mount rotation; row i = sensor axis i
+  double noise_density_ug = 0.0;   // white noise, micro-g per sqrt(Hz)
+  Vec3 bias_mg = Vec3::Zero();     // constant bias per sensor axis, milli-g
+  double rate_hz = 100.0;          // output data rate
+  double full_scale_g = 0.0;       // clamp of each axis, g; 0 = unlimited
+  bool report_in_g = false;        // units of samples: g, or m/s^2 (default)
+};
+
+struct TrackerSpec {
+  std::string name;
+  std::string trajectory;       // what it tracks; empty = the viewer
+  double noise_sigma_m = 0.0;   // isotropic position noise per sample
+  double rate_hz = 60.0;
+};
+
+struct ViewerSpec {
+  Placement placement;  // kFixed or kTrajectory
+  int width = 640, height = 480;
+  geom::Intrinsics K;   // for renderings of what the viewer perceives
+};
+
+// True state of every device at one time.
+struct ProjectorState {
+  ProjectorSpec spec;
+  geom::CameraModel model;  // K, pose, resolution (no distortion)
+};
+struct CameraState {
+  CameraSpec spec;
+  geom::CameraModel model;
+};
+struct TiltSensorState {
+  TiltSensorSpec spec;
+  Mat3 sensor_from_world = Mat3::Identity();
+};
+
+struct SceneState {
+  double time = 0;
+  std::vector<ProjectorState> projectors;
+  std::vector<CameraState> cameras;
+  std::vector<TiltSensorState> tilt_sensors;
+  geom::CameraModel viewer;  // viewer eye as a pinhole (pose, K, resolution)
+
+  const ProjectorState* projector(std::string_view name) const;
+  const CameraState* camera(std::string_view name) const;
+  const TiltSensorState* tiltSensor(std::string_view name) const;
+};
+
+class Scene {
+ public:
+  // Parses TOML text; mesh files are resolved relative to base_dir (empty: meshes
+  // are refused). `origin` names the text in error messages.
+  static Result<Scene> parse(std::string_view toml_text, const std::string& origin,
+                             const std::filesystem::path& base_dir);
+  static Result<Scene> load(const std::filesystem::path& file);
+
+  SceneState at(double time) const;
+
+  const std::string& name() const { return name_; }
+  const std::string& description() const { return description_; }
+  const std::vector<ProjectorSpec>& projectors() const { return projectors_; }
+  const std::vector<CameraSpec>& cameras() const { return cameras_; }
+  const std::vector<TiltSensorSpec>& tiltSensors() const { return tilt_sensors_; }
+  const std::vector<TrackerSpec>& trackers() const { return trackers_; }
+  const std::vector<Trajectory>& trajectories() const { return trajectories_; }
+  const ViewerSpec& viewer() const { return viewer_; }
+  const World& world() const { return world_; }
+  Vec3 ambientRgb() const { return ambient_rgb_; }  // irradiance-like, added to every point
+
+  const Trajectory* trajectory(std::string_view name) const;
+  Vec3 viewerPosition(double time) const;
+
+ private:
+  friend class SceneBuilder;
+  geom::Pose placementPose(const Placement& p, double time) const;
+
+  std::string name_, description_;
+  std::vector<ProjectorSpec> projectors_;
+  std::vector<CameraSpec> cameras_;
+  std::vector<TiltSensorSpec> tilt_sensors_;
+  std::vector<TrackerSpec> trackers_;
+  std::vector<Trajectory> trajectories_;
+  ViewerSpec viewer_;
+  World world_;
+  Vec3 ambient_rgb_ = Vec3::Zero();
+};
+
+}  // namespace procam::sim

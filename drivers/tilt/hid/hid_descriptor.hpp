@@ -1,0 +1,47 @@
+#pragma once
+// HID report descriptor parsing (HID 1.11 §6.2.2) for sensor accelerometers (HID Sensor
+// Usages: page 0x20, Accelerometer 3D 0x73, Acceleration Axis X/Y/Z 0x453..0x455).
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "core/error.hpp"
+
+namespace procam::tilt {
+
+struct HidField {
+  std::uint8_t report_id = 0;  // 0 when the device uses no report IDs
+  std::uint16_t usage_page = 0;
+  std::uint16_t usage = 0;
+  std::uint32_t bit_offset = 0;  // within the report, after the report ID byte
+  std::uint32_t bit_size = 0;
+  std::int64_t logical_min = 0, logical_max = 0;
+  std::uint32_t unit = 0;
+  int unit_exponent = 0;
+  // Usage of the innermost application/physical collection enclosing the field.
+  std::uint16_t collection_page = 0, collection_usage = 0;
+
+  bool isSigned() const { return logical_min < 0; }
+  // Raw value from a report (without its report ID byte); nullopt if it does not fit.
+  std::optional<std::int64_t> extract(std::span<const std::uint8_t> report) const;
+};
+
+struct HidDescriptor {
+  std::vector<HidField> inputs;
+  bool uses_report_ids = false;
+};
+
+// kParse for truncated items, unbalanced collections or push/pop misuse.
+Result<HidDescriptor> parseHidDescriptor(std::span<const std::uint8_t> bytes);
+
+struct HidAccelFields {
+  HidField axis[3];
+  double scale = 0;  // m/s^2 per logical unit (unit and unit exponent applied)
+};
+
+// The X/Y/Z acceleration input fields of the first Accelerometer 3D collection.
+// kNotFound when absent; kInvalidInput for an unsupported unit.
+Result<HidAccelFields> findAccelerometer(const HidDescriptor& d);
+
+}  // namespace procam::tilt

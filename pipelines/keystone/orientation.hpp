@@ -1,0 +1,60 @@
+#pragma once
+// Projector orientation relative to a vertical wall (seed §3.2.5: P_P = F[R 0], only the
+// rotation matters; §6.2.2: tilt sensors give elevation and roll, the rigid camera gives
+// the azimuth).
+//
+// Wall frame W (right-handed, +Z up as the world frame of DESIGN.md): X runs along the
+// wall to the right, Y is horizontal and points into the wall (away from the viewer), Z
+// points up. Projector frame: x right, y down, z forward (DESIGN.md). R maps W to the
+// projector frame: x_p = R x_w.
+//
+// Angle convention (the one the command line documents): reference pose = optical axis
+// along +Y (square to the wall), image upright. Then, applied in this order about the
+// projector's own axes: yaw (positive turns the optical axis to the right, seen from
+// above), pitch (positive tilts it up), roll (positive turns the image clockwise as seen
+// from behind the projector).
+#include "core/error.hpp"
+#include "core/types.hpp"
+
+namespace procam::keystone {
+
+struct Angles {
+  double pitch = 0, roll = 0, yaw = 0;  // radians
+};
+
+// World (wall frame) -> projector rotation of the angle convention above.
+Mat3 rotationFromAngles(const Angles& a);
+// Inverse of rotationFromAngles for |pitch| < 90°.
+Angles anglesFromRotation(const Mat3& R);
+
+// Direction of gravity in the projector frame from a tilt sensor's specific force
+// reading (gravity's reaction, +1 g "up" at rest) and the sensor -> projector mounting
+// rotation: down = -mount * f.
+Vec3 downFromSpecificForce(const Mat3& mount, const Vec3& specific_force);
+
+// Pitch and roll from the direction of gravity in the projector frame (yaw = 0).
+// Result: down = (sin r cos p, cos r cos p, -sin p). kInvalidInput for zero/NaN.
+Result<Angles> tiltFromDown(const Vec3& down);
+
+// Yaw and pitch from the wall normal in the projector frame, assuming zero roll (the
+// projector's x axis level): the camera-only mode.
+Result<Angles> anglesFromWallNormal(const Vec3& normal);
+
+struct FusedOrientation {
+  Mat3 R = Mat3::Identity();  // wall frame -> projector
+  // Angle between the measured wall normal and the horizontal plane of the measured
+  // gravity (0 for a truly vertical wall and perfect sensors): a consistency check.
+  double wall_tilt = 0;
+};
+
+// Both sensors: gravity fixes pitch and roll exactly, the wall normal's horizontal
+// part fixes yaw (§6.2.2). `normal` may have either sign. kDegenerate when the normal
+// is (nearly) parallel to gravity (the wall is not vertical: no azimuth).
+Result<FusedOrientation> fuseOrientation(const Vec3& down, const Vec3& normal);
+
+// Tilt-only mode (no camera, like consumer projectors): yaw = 0.
+Result<Mat3> rotationFromDown(const Vec3& down);
+// Camera-only mode (no tilt sensor): roll = 0.
+Result<Mat3> rotationFromWallNormal(const Vec3& normal);
+
+}  // namespace procam::keystone

@@ -1,0 +1,42 @@
+#include "render/render_setup.hpp"
+
+namespace procam::render {
+namespace {
+
+bool validSize(cv::Size s) { return s.width > 0 && s.height > 0; }
+
+}  // namespace
+
+Result<void> validateSetup(const RenderSetup& s) {
+  if (!validSize(s.output_size)) return fail(ErrorCode::kInvalidInput, "setup: empty output size");
+  if (s.path != RenderPath::kPlanar3d && (s.content_size.width < 2 || s.content_size.height < 2)) {
+    return fail(ErrorCode::kInvalidInput, "setup: content must be at least 2x2 pixels");
+  }
+  switch (s.path) {
+    case RenderPath::kHomography:
+      if (!s.homography.allFinite()) return fail(ErrorCode::kInvalidInput, "setup: non-finite H");
+      break;
+    case RenderPath::kTwoPassMesh:
+      if (s.surface.triangles.empty() || !s.projector.allFinite() || !s.viewer.allFinite() ||
+          s.projector.isZero() || s.viewer.isZero()) {
+        return fail(ErrorCode::kInvalidInput,
+                    "setup: two-pass path needs a surface mesh, projector and viewer matrices");
+      }
+      break;
+    case RenderPath::kLookupWarp:
+      if (s.lookup.cols < 2 || s.lookup.rows < 2) {
+        return fail(ErrorCode::kInvalidInput, "setup: lookup warp needs a grid of >= 2x2 nodes");
+      }
+      break;
+    case RenderPath::kPlanar3d:
+      if (!s.planar3d.allFinite()) return fail(ErrorCode::kInvalidInput, "setup: non-finite A'P_T");
+      break;
+  }
+  if (!s.final_stage.alpha.empty() && (s.final_stage.alpha.type() != CV_8UC1 ||
+                                       s.final_stage.alpha.size() != s.output_size)) {
+    return fail(ErrorCode::kInvalidInput, "setup: alpha mask must be CV_8UC1 of the output size");
+  }
+  return {};
+}
+
+}  // namespace procam::render

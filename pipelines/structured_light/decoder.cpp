@@ -1,0 +1,238 @@
+#include "structured_light/decoder.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <vector>
+
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "structured_light/gray_code.hpp"
+
+namespace procam::sl {
+namespace {
+
+struct AxisFrames {
+  AxisCode code;
+  std::vector<int> gray, inverse, phase;  // frame indices
+};
+
+AxisFrames axisFrames(const PatternSet& set, Axis axis) {
+  AxisFrames a;
+  a.code = set.code(axis);
+  for (int b = 0; b < a.code.bits; ++b) {
+    a.gray.push_back(findFrame(set, FrameKind::kGray, axis, b));
+    a.inverse.push_back(findFrame(set, FrameKind::kGrayInverse, axis, b));
+  }
+  for (int n = 0; n < set.phaseSteps(); ++n) a.phase.push_back(findFrame(set, FrameKind::kPhase, axis, n));
+  return a;
+}
+
+// Per-row scratch, allocated once per stripe of rows (never per pixel).
+struct Scratch {
+  std::vector<std::uint32_t> code;
+  std::vector<std::uint8_t> weak, bad;
+  std::vector<float> min1, min2, inv_contrast, tolerance, sin_sum, cos_sum;
+  explicit Scratch(int n)
+      : code(n), weak(n), bad(n), min1(n), min2(n), inv_contrast(n), tolerance(n), sin_sum(n),
+        cos_sum(n) {}
+};
+
+template <class T>
+class RowDecoder {
+ public:
+  RowDecoder(const PatternSet& set, const std::vector<cv::Mat>& frames,
+             const DecodeOptions& options, double full_scale, Decoded& out)
+      : set_(set), frames_(frames), o_(options), full_(static_cast<float>(full_scale)), out_(out),
+        white_(findFrame(set, FrameKind::kWhite, Axis::kColumns, 0)),
+        black_(findFrame(set, FrameKind::kBlack, Axis::kColumns, 0)),
+        axes_{axisFrames(set, Axis::kColumns), axisFrames(set, Axis::kRows)} {
+    const int n = set.phaseSteps();
+    for (int i = 0; i < n; ++i) {
+      const double delta = 2 * std::numbers::pi * i / n;
+      sin_.push_back(static_cast<float>(std::sin(delta)));
+      cos_.push_back(static_cast<float>(std::cos(delta)));
+    }
+  }
+
+  void operator()(const cv::Range& rows) const {
+    const int width = frames_[0].cols;
+    Scratch s(width);
+    std::vector<float> confidence(width);
+    for (int y = rows.start; y < rows.end; ++y) {
+      const T* w = frames_[white_].ptr<T>(y);
+      const T* b = frames_[black_].ptr<T>(y);
+      std::uint8_t* flags = out_.flags.ptr<std::uint8_t>(y);
+      const float min_contrast = static_cast<float>(o_.min_contrast) * full_;
+      const float saturated = static_cast<float>(o_.saturation) * full_;
+      const float tol_abs = 0.02f * full_;
+      const bool phase = set_.phaseSteps() > 0;
+      for (int x = 0; x < width; ++x) {
+        const float contrast = static_cast<float>(w[x]) - static_cast<float>(b[x]);
+        std::uint8_t f = 0;
+        if (contrast < min_contrast) f |= kShadow;
+        if (b[x] >= saturated || (phase && w[x] >= saturated)) f |= kSaturated;
+        flags[x] = f;
+        s.inv_contrast[x] = contrast > 0 ? 1.0f / contrast : 0.0f;
+        s.tolerance[x] = static_cast<float>(o_.range_tolerance) * std::max(contrast, 0.0f) + tol_abs;
+        confidence[x] = 1.0f;
+      }
+      decodeAxis(axes_[0], y, w, b, s, flags, confidence.data(), out_.u.ptr<float>(y));
+      decodeAxis(axes_[1], y, w, b, s, flags, confidence.data(), out_.v.ptr<float>(y));
+      float* u = out_.u.ptr<float>(y);
+      float* v = out_.v.ptr<float>(y);
+      float* c = out_.confidence.ptr<float>(y);
+      for (int x = 0; x < width; ++x) {
+        const bool ok = flags[x] == 0;
+        u[x] = ok ? u[x] : -1.0f;
+        v[x] = ok ? v[x] : -1.0f;
+        c[x] = ok ? std::clamp(confidence[x], 0.0f, 1.0f) : 0.0f;
+      }
+    }
+  }
+
+ private:
+  void decodeAxis(const AxisFrames& a, int y, const T* w, const T* b, Scratch& s,
+                  std::uint8_t* flags, float* confidence, float* out) const {
+    const int width = frames_[0].cols;
+    const float firm = static_cast<float>(o_.bit_contrast);
+    constexpr float kInf = std::numeric_limits<float>::infinity();
+    std::fill(s.code.begin(), s.code.end(), 0u);
+    std::fill(s.weak.begin(), s.weak.end(), std::uint8_t{0});
+    std::fill(s.bad.begin(), s.bad.end(), std::uint8_t{0});
+    std::fill(s.min1.begin(), s.min1.end(), kInf);
+    std::fill(s.min2.begin(), s.min2.end(), kInf);
+    for (std::size_t bit = 0; bit < a.gray.size(); ++bit) {
+      const T* p = frames_[a.gray[bit]].ptr<T>(y);
+      const T* q = frames_[a.inverse[bit]].ptr<T>(y);
+      for (int x = 0; x < width; ++x) {
+        const float pv = static_cast<float>(p[x]), qv = static_cast<float>(q[x]);
+        const float d = pv - qv;
+        s.code[x] = (s.code[x] << 1) | static_cast<std::uint32_t>(d > 0);
+        const float r = std::abs(d) * s.inv_contrast[x];
+        s.weak[x] = static_cast<std::uint8_t>(s.weak[x] + (r < firm));
+        s.min2[x] = std::min(s.min2[x], std::max(s.min1[x], r));
+        s.min1[x] = std::min(s.min1[x], r);
+        const float hi = std::max(pv, qv), lo = std::min(pv, qv);
+        const float tol = s.tolerance[x];
+        s.bad[x] |= static_cast<std::uint8_t>((hi > static_cast<float>(w[x]) + tol) |
+                                              (lo < static_cast<float>(b[x]) - tol));
+      }
+    }
+    const AxisCode& code = a.code;
+    const bool phase = !a.phase.empty();
+    if (phase) accumulatePhase(a, y, s);
+    const double period = code.period;
+    const double two_pi = 2 * std::numbers::pi;
+    const float amplitude_scale = phase ? 4.0f / static_cast<float>(a.phase.size()) : 0.0f;
+    for (int x = 0; x < width; ++x) {
+      if (flags[x] != 0) continue;
+      std::uint8_t f = 0;
+      if (s.weak[x] > o_.max_weak_bits) f |= kLowContrast;
+      if (s.bad[x]) f |= kInconsistent;
+      const std::uint32_t cell = fromGray(s.code[x]);
+      if (cell >= static_cast<std::uint32_t>(code.cells)) f |= kInconsistent;
+      float conf = code.bits >= 2 ? s.min2[x] : (code.bits == 1 ? s.min1[x] : 1.0f);
+      const int first = static_cast<int>(cell) * code.cell;
+      const int width_of_cell = std::min(code.cell, code.extent - first);
+      double position = first + (width_of_cell - 1) * 0.5;
+      if (phase && f == 0) {
+        // N-step phase: sum I_n cos(theta - delta_n) sin/cos(delta_n) = N/2 sin/cos(theta).
+        const float sv = s.sin_sum[x], cv = s.cos_sum[x];
+        const float modulation = amplitude_scale * std::sqrt(sv * sv + cv * cv) * s.inv_contrast[x];
+        if (modulation < o_.min_modulation) f |= kLowContrast;
+        double wrapped = std::atan2(static_cast<double>(sv), static_cast<double>(cv)) / two_pi;
+        if (wrapped < 0) wrapped += 1.0;
+        wrapped *= period;
+        const double unwrapped = wrapped + period * std::round((position - wrapped) / period);
+        if (std::abs(unwrapped - position) > 1.75 * code.cell) f |= kInconsistent;
+        position = unwrapped;
+        conf = std::min(conf, modulation);
+      }
+      if (position < -0.5 || position > code.extent - 0.5) f |= kInconsistent;
+      flags[x] |= f;
+      out[x] = static_cast<float>(position);
+      confidence[x] = std::min(confidence[x], conf);
+    }
+  }
+
+  void accumulatePhase(const AxisFrames& a, int y, Scratch& s) const {
+    const int width = frames_[0].cols;
+    std::fill(s.sin_sum.begin(), s.sin_sum.end(), 0.0f);
+    std::fill(s.cos_sum.begin(), s.cos_sum.end(), 0.0f);
+    for (std::size_t n = 0; n < a.phase.size(); ++n) {
+      const T* p = frames_[a.phase[n]].ptr<T>(y);
+      const float sn = sin_[n], cn = cos_[n];
+      for (int x = 0; x < width; ++x) {
+        const float v = static_cast<float>(p[x]);
+        s.sin_sum[x] += v * sn;
+        s.cos_sum[x] += v * cn;
+      }
+    }
+  }
+
+  const PatternSet& set_;
+  const std::vector<cv::Mat>& frames_;
+  const DecodeOptions& o_;
+  float full_;
+  Decoded& out_;
+  int white_, black_;
+  AxisFrames axes_[2];
+  std::vector<float> sin_, cos_;
+};
+
+}  // namespace
+
+Result<Decoded> decode(const PatternSet& set, std::span<const cv::Mat> captures,
+                       const DecodeOptions& options) {
+  if (captures.size() != set.frames.size())
+    return fail(ErrorCode::kInvalidInput, "expected " + std::to_string(set.frames.size()) +
+                                              " captures, got " + std::to_string(captures.size()));
+  if (captures.empty() || captures[0].empty())
+    return fail(ErrorCode::kInvalidInput, "empty capture");
+  const cv::Size size = captures[0].size();
+  std::vector<cv::Mat> frames(captures.size());
+  int depth = -1;
+  for (std::size_t i = 0; i < captures.size(); ++i) {
+    const cv::Mat& c = captures[i];
+    if (c.size() != size)
+      return fail(ErrorCode::kInvalidInput, "capture " + set.frames[i].name + " is " +
+                                                std::to_string(c.cols) + "x" +
+                                                std::to_string(c.rows) + ", expected " +
+                                                std::to_string(size.width) + "x" +
+                                                std::to_string(size.height));
+    if (c.depth() != CV_8U && c.depth() != CV_16U)
+      return fail(ErrorCode::kInvalidInput, "captures must be 8- or 16-bit");
+    if (depth >= 0 && c.depth() != depth)
+      return fail(ErrorCode::kInvalidInput, "captures mix 8- and 16-bit images");
+    depth = c.depth();
+    if (c.channels() == 1) {
+      frames[i] = c;
+    } else if (c.channels() == 3 || c.channels() == 4) {
+      cv::cvtColor(c, frames[i], c.channels() == 3 ? cv::COLOR_BGR2GRAY : cv::COLOR_BGRA2GRAY);
+    } else {
+      return fail(ErrorCode::kInvalidInput, "captures must have 1, 3 or 4 channels");
+    }
+  }
+  const double full = options.full_scale > 0 ? options.full_scale
+                                             : (depth == CV_8U ? 255.0 : 65535.0);
+  Decoded out;
+  out.u.create(size, CV_32F);
+  out.v.create(size, CV_32F);
+  out.confidence.create(size, CV_32F);
+  out.flags.create(size, CV_8U);
+  const int stripes = std::max(1, size.height / 8);
+  if (depth == CV_8U) {
+    cv::parallel_for_(cv::Range(0, size.height),
+                      RowDecoder<std::uint8_t>(set, frames, options, full, out), stripes);
+  } else {
+    cv::parallel_for_(cv::Range(0, size.height),
+                      RowDecoder<std::uint16_t>(set, frames, options, full, out), stripes);
+  }
+  out.decoded = size.area() - cv::countNonZero(out.flags);
+  return out;
+}
+
+}  // namespace procam::sl

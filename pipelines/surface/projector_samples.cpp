@@ -1,0 +1,80 @@
+#include "surface/projector_samples.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
+namespace procam::surface {
+namespace {
+
+// Sufficient statistics of x = c0 + A d, with d = projector offset from the node.
+struct NodeFit {
+  Eigen::Matrix3d dd = Eigen::Matrix3d::Zero();  // sum of [1 dx dy]^T [1 dx dy]
+  Eigen::Matrix<double, 3, 2> dx = Eigen::Matrix<double, 3, 2>::Zero();  // sum of [1 dx dy]^T x^T
+  int count = 0;
+};
+
+}  // namespace
+
+Result<ProjectorSamples> sampleProjectorGrid(const sl::Decoded& d, int width, int height,
+                                             const SampleOptions& o) {
+  if (o.step < 1 || width < 1 || height < 1 || !(o.radius > 0) || o.min_pixels < 3)
+    return fail(ErrorCode::kInvalidInput, "projector sampling: invalid step, size or radius");
+  if (d.u.empty() || d.u.type() != CV_32F || d.v.size() != d.u.size() ||
+      d.flags.size() != d.u.size() || d.confidence.size() != d.u.size())
+    return fail(ErrorCode::kInvalidInput, "projector sampling: malformed decoded map");
+  ProjectorSamples s;
+  s.step = o.step;
+  s.nodes_x = (width - 1) / o.step + 1;
+  s.nodes_y = (height - 1) / o.step + 1;
+  std::vector<NodeFit> fits(static_cast<std::size_t>(s.nodes_x) * s.nodes_y);
+  const double r = std::max(o.radius, 0.5 * o.step);
+  for (int y = 0; y < d.u.rows; ++y) {
+    const float* u = d.u.ptr<float>(y);
+    const float* v = d.v.ptr<float>(y);
+    const float* c = d.confidence.ptr<float>(y);
+    const std::uint8_t* f = d.flags.ptr<std::uint8_t>(y);
+    for (int x = 0; x < d.u.cols; ++x) {
+      if (f[x] != 0 || c[x] < o.min_confidence) continue;
+      const int i0 = std::max(0, static_cast<int>(std::ceil((u[x] - r) / o.step)));
+      const int i1 = std::min(s.nodes_x - 1, static_cast<int>(std::floor((u[x] + r) / o.step)));
+      const int j0 = std::max(0, static_cast<int>(std::ceil((v[x] - r) / o.step)));
+      const int j1 = std::min(s.nodes_y - 1, static_cast<int>(std::floor((v[x] + r) / o.step)));
+      for (int j = j0; j <= j1; ++j)
+        for (int i = i0; i <= i1; ++i) {
+          const Eigen::Vector3d a(1.0, u[x] - i * o.step, v[x] - j * o.step);
+          NodeFit& n = fits[static_cast<std::size_t>(j) * s.nodes_x + i];
+          n.dd.noalias() += a * a.transpose();
+          n.dx.noalias() += a * Eigen::RowVector2d(x, y);
+          ++n.count;
+        }
+    }
+  }
+  s.index.assign(fits.size(), -1);
+  for (int j = 0; j < s.nodes_y; ++j)
+    for (int i = 0; i < s.nodes_x; ++i) {
+      const NodeFit& n = fits[static_cast<std::size_t>(j) * s.nodes_x + i];
+      if (n.count < o.min_pixels) continue;
+      // The node must lie inside the decoded neighbourhood, not at its rim (the
+      // mean offset is then small against the spread), and the system well posed.
+      const Eigen::Vector2d mean = n.dd.block<2, 1>(1, 0) / n.count;
+      const Eigen::Matrix2d cov =
+          n.dd.block<2, 2>(1, 1) / n.count - mean * mean.transpose();
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
+      const double spread = std::sqrt(std::max(eig.eigenvalues()(0), 0.0));
+      if (spread < 0.2 * r || mean.norm() > 0.5 * r) continue;
+      const Eigen::LDLT<Eigen::Matrix3d> ldlt(n.dd);
+      if (ldlt.info() != Eigen::Success) continue;
+      const Eigen::Matrix<double, 3, 2> coef = ldlt.solve(n.dx);
+      const Vec2 cam = coef.row(0).transpose();
+      if (!cam.allFinite()) continue;
+      s.index[static_cast<std::size_t>(j) * s.nodes_x + i] = static_cast<std::int32_t>(s.camera.size());
+      s.camera.push_back(cam);
+      s.projector.emplace_back(i * o.step, j * o.step);
+    }
+  return s;
+}
+
+}  // namespace procam::surface

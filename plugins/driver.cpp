@@ -1,0 +1,123 @@
+#include "driver.hpp"
+
+#include <array>
+
+namespace procam::plugins {
+
+const char* familyName(procam_family family) {
+  switch (family) {
+    case PROCAM_FAMILY_CAMERA: return "camera";
+    case PROCAM_FAMILY_TILT: return "tilt";
+    case PROCAM_FAMILY_TRACKER: return "tracker";
+    case PROCAM_FAMILY_OUTPUT: return "output";
+  }
+  return "unknown";
+}
+
+Result<procam_family> parseFamily(const std::string& text) {
+  for (procam_family f : {PROCAM_FAMILY_CAMERA, PROCAM_FAMILY_TILT, PROCAM_FAMILY_TRACKER,
+                          PROCAM_FAMILY_OUTPUT}) {
+    if (text == familyName(f)) return f;
+  }
+  return fail(ErrorCode::kInvalidInput,
+              "unknown device family '" + text + "' (camera, tilt, tracker, output)");
+}
+
+std::string DeviceDescription::property(const std::string& key) const {
+  for (const auto& [k, v] : properties) {
+    if (k == key) return v;
+  }
+  return {};
+}
+
+const procam_device_desc& DeviceDescription::view() {
+  kv_.clear();
+  for (const auto& [k, v] : properties) kv_.push_back({k.c_str(), v.c_str()});
+  auto cstr = [](const std::string& s) { return s.empty() ? nullptr : s.c_str(); };
+  desc_.family = family;
+  desc_.subsystem = cstr(subsystem);
+  desc_.devnode = cstr(devnode);
+  desc_.syspath = cstr(syspath);
+  desc_.name = cstr(name);
+  desc_.properties = kv_.empty() ? nullptr : kv_.data();
+  desc_.n_properties = kv_.size();
+  return desc_;
+}
+
+Device::Device(procam_device device, std::shared_ptr<void> library, std::string driver_name)
+    : device_(device), library_(std::move(library)), driver_name_(std::move(driver_name)) {}
+
+Device::Device(Device&& other) noexcept
+    : device_(std::exchange(other.device_, procam_device{})),
+      library_(std::move(other.library_)),
+      driver_name_(std::move(other.driver_name_)) {}
+
+Device& Device::operator=(Device&& other) noexcept {
+  if (this != &other) {
+    reset();
+    device_ = std::exchange(other.device_, procam_device{});
+    library_ = std::move(other.library_);
+    driver_name_ = std::move(other.driver_name_);
+  }
+  return *this;
+}
+
+Device::~Device() { reset(); }
+
+void Device::reset() {
+  if (device_.destroy) device_.destroy(device_.self);
+  device_ = procam_device{};
+  library_.reset();  // after destroy: the code of destroy lives in the library
+}
+
+int Device::pollFd() const { return device_.poll_fd ? device_.poll_fd(device_.self) : -1; }
+
+namespace {
+
+bool opsComplete(const procam_device& d) {
+  switch (d.family) {
+    case PROCAM_FAMILY_CAMERA:
+      return d.ops.camera && d.ops.camera->get_format && d.ops.camera->set_exposure &&
+             d.ops.camera->capture;
+    case PROCAM_FAMILY_TILT: return d.ops.tilt && d.ops.tilt->read;
+    case PROCAM_FAMILY_TRACKER: return d.ops.tracker && d.ops.tracker->read;
+    case PROCAM_FAMILY_OUTPUT: return d.ops.output && d.ops.output->get_mode && d.ops.output->show;
+  }
+  return false;
+}
+
+}  // namespace
+
+Result<Device> createDevice(const Driver& driver, DeviceDescription& desc,
+                            const std::vector<std::pair<std::string, std::string>>& options) {
+  std::vector<procam_kv> kv;
+  kv.reserve(options.size());
+  for (const auto& [k, v] : options) kv.push_back({k.c_str(), v.c_str()});
+  procam_config config{kv.empty() ? nullptr : kv.data(), kv.size()};
+  procam_device out{};
+  std::array<char, 512> err{};
+  const int rc =
+      driver.factory->create(&desc.view(), &config, &out, err.data(), err.size() - 1);
+  const std::string who = std::string("driver '") + driver.factory->name + "'";
+  if (rc != PROCAM_OK) {
+    const std::string reason = err[0] ? std::string(err.data()) : "no reason given";
+    return fail(ErrorCode::kIo, who + " could not create the device: " + reason + " (code " +
+                                    std::to_string(rc) + ")");
+  }
+  if (!out.destroy) {
+    return fail(ErrorCode::kInvalidInput, who + " returned a device without destroy()");
+  }
+  Device device(out, driver.library, driver.factory->name);  // owns it from here on
+  if (out.family != driver.factory->family) {
+    return fail(ErrorCode::kInvalidInput, who + " returned a " + familyName(out.family) +
+                                              " device for a " +
+                                              familyName(driver.factory->family) + " factory");
+  }
+  if (!opsComplete(out)) {
+    return fail(ErrorCode::kInvalidInput,
+                who + " returned a device with missing " + familyName(out.family) + " operations");
+  }
+  return device;
+}
+
+}  // namespace procam::plugins

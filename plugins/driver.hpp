@@ -1,0 +1,77 @@
+#pragma once
+// C++ side of the plugin ABI: owning wrappers for drivers, device descriptions
+// and created devices. Nothing here throws; failures are procam::Result.
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/error.hpp"
+#include "procamd/procam_plugin.h"
+
+namespace procam::plugins {
+
+const char* familyName(procam_family family);
+// Parses "camera", "tilt", "tracker", "output".
+Result<procam_family> parseFamily(const std::string& text);
+
+// One driver factory and where it came from. `library` keeps a dlopen()ed
+// plugin loaded for as long as any driver or device of it is alive.
+struct Driver {
+  const procam_driver_factory* factory = nullptr;
+  std::string origin;  // "static" or the path of the shared object
+  std::shared_ptr<void> library;
+
+  procam_family family() const { return factory->family; }
+  std::string name() const { return factory->name; }
+};
+
+// An owning device description; view() yields the C struct for probe/create.
+class DeviceDescription {
+ public:
+  procam_family family = PROCAM_FAMILY_CAMERA;
+  std::string subsystem;
+  std::string devnode;
+  std::string syspath;
+  std::string name;
+  std::vector<std::pair<std::string, std::string>> properties;
+
+  std::string property(const std::string& key) const;
+  // The returned struct points into this object: keep it alive and unchanged.
+  const procam_device_desc& view();
+
+ private:
+  std::vector<procam_kv> kv_;
+  procam_device_desc desc_{};
+};
+
+// A created device; calls the driver's destroy exactly once.
+class Device {
+ public:
+  Device() = default;
+  Device(procam_device device, std::shared_ptr<void> library, std::string driver_name);
+  Device(Device&& other) noexcept;
+  Device& operator=(Device&& other) noexcept;
+  Device(const Device&) = delete;
+  Device& operator=(const Device&) = delete;
+  ~Device();
+
+  bool valid() const { return device_.destroy != nullptr; }
+  procam_family family() const { return device_.family; }
+  const std::string& driverName() const { return driver_name_; }
+  const procam_device& raw() const { return device_; }
+  int pollFd() const;
+
+ private:
+  void reset();
+  procam_device device_{};
+  std::shared_ptr<void> library_;
+  std::string driver_name_;
+};
+
+// Calls the driver's create() and checks what it returned (family, ops,
+// every operation of that family present).
+Result<Device> createDevice(const Driver& driver, DeviceDescription& desc,
+                            const std::vector<std::pair<std::string, std::string>>& options);
+
+}  // namespace procam::plugins

@@ -1,0 +1,189 @@
+/* procamd driver plugin ABI.
+ *
+ * A plugin is a shared object (or, for in-tree drivers, a statically linked
+ * library) that exports two symbols:
+ *
+ *   const uint32_t procam_plugin_abi_version;          (data, read first)
+ *   const procam_plugin_table* procam_plugin_entry(void);
+ *
+ * The loader reads procam_plugin_abi_version before calling anything in the
+ * plugin and refuses the plugin when it differs from PROCAM_PLUGIN_ABI_VERSION.
+ * PROCAM_PLUGIN_DEFINE(entry_function) defines both symbols.
+ *
+ * Rules across this boundary: plain C types only; no exceptions may leave a
+ * plugin function (C++ plugins catch everything); functions that can fail
+ * return PROCAM_OK or a negative PROCAM_E* code and write a NUL-terminated
+ * reason into the caller's buffer. Every string and table returned by a plugin
+ * stays valid until the plugin is unloaded. Units: metres, seconds (as
+ * nanoseconds where integral), radians, m/s^2; image coordinates and frames
+ * follow the project's conventions (x right, y down, z forward).
+ */
+#ifndef PROCAMD_PROCAM_PLUGIN_H
+#define PROCAMD_PROCAM_PLUGIN_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Bumped on every incompatible change of any type or signature below. */
+#define PROCAM_PLUGIN_ABI_VERSION 1u
+
+#define PROCAM_PLUGIN_ABI_SYMBOL "procam_plugin_abi_version"
+#define PROCAM_PLUGIN_ENTRY_SYMBOL "procam_plugin_entry"
+
+/* Status codes. */
+#define PROCAM_OK 0
+#define PROCAM_EINVAL (-1)   /* bad argument or configuration */
+#define PROCAM_ENODEV (-2)   /* device gone or not present */
+#define PROCAM_EIO (-3)      /* device reported an error */
+#define PROCAM_ETIMEDOUT (-4)
+#define PROCAM_EAGAIN (-5)   /* no data yet; poll the device fd */
+#define PROCAM_ENOTSUP (-6)  /* operation not supported by this driver */
+#define PROCAM_EINTERNAL (-7)
+
+typedef enum procam_family {
+  PROCAM_FAMILY_CAMERA = 1,
+  PROCAM_FAMILY_TILT = 2,
+  PROCAM_FAMILY_TRACKER = 3,
+  PROCAM_FAMILY_OUTPUT = 4
+} procam_family;
+
+/* One key/value pair. */
+typedef struct procam_kv {
+  const char* key;
+  const char* value;
+} procam_kv;
+
+/* A device as the daemon found it (udev, configuration or the virtual rig).
+ * Any pointer may be NULL when unknown. */
+typedef struct procam_device_desc {
+  procam_family family;
+  const char* subsystem; /* "video4linux", "iio", "hidraw", "i2c-dev", "gpio", "drm", "sim" */
+  const char* devnode;   /* "/dev/video0" */
+  const char* syspath;   /* "/sys/devices/..." */
+  const char* name;      /* human readable, or the configured name */
+  const procam_kv* properties; /* udev properties (PROCAM_ROLE, ID_VENDOR_ID, ...) */
+  size_t n_properties;
+} procam_device_desc;
+
+/* Driver options from the daemon's configuration, as text. */
+typedef struct procam_config {
+  const procam_kv* options;
+  size_t n_options;
+} procam_config;
+
+/* An 8- or 16-bit image, rows top to bottom, `stride` bytes per row. */
+typedef enum procam_pixel_format {
+  PROCAM_PIXEL_GRAY8 = 1,
+  PROCAM_PIXEL_GRAY16 = 2,
+  PROCAM_PIXEL_RGB8 = 3
+} procam_pixel_format;
+
+typedef struct procam_image {
+  uint32_t width;
+  uint32_t height;
+  uint32_t stride;
+  procam_pixel_format format;
+  uint8_t* data;
+  uint64_t timestamp_ns; /* CLOCK_MONOTONIC */
+} procam_image;
+
+/* Camera. `capture` fills `out` with a buffer owned by the driver that stays
+ * valid until the next capture or destroy. */
+typedef struct procam_camera_ops {
+  int (*get_format)(void* self, uint32_t* out_width, uint32_t* out_height,
+                    procam_pixel_format* out_format);
+  int (*set_exposure)(void* self, double seconds, char* err, size_t err_len);
+  int (*capture)(void* self, int timeout_ms, procam_image* out, char* err, size_t err_len);
+} procam_camera_ops;
+
+/* Tilt sensor: specific force in the sensor frame (m/s^2). At rest it reads
+ * the opposite of gravity, i.e. +9.81 along the sensor's up axis. */
+typedef struct procam_tilt_sample {
+  double specific_force[3];
+  uint64_t timestamp_ns;
+} procam_tilt_sample;
+
+typedef struct procam_tilt_ops {
+  int (*read)(void* self, procam_tilt_sample* out, char* err, size_t err_len);
+} procam_tilt_ops;
+
+/* Head tracker: viewer position in the world frame (metres) and orientation
+ * as a unit quaternion (w, x, y, z). */
+typedef struct procam_pose_sample {
+  double position[3];
+  double orientation[4];
+  uint64_t timestamp_ns;
+} procam_pose_sample;
+
+typedef struct procam_tracker_ops {
+  int (*read)(void* self, procam_pose_sample* out, char* err, size_t err_len);
+} procam_tracker_ops;
+
+/* Projector output: shows one full frame of the mode's size. */
+typedef struct procam_output_ops {
+  int (*get_mode)(void* self, uint32_t* out_width, uint32_t* out_height, double* out_refresh_hz);
+  int (*show)(void* self, const procam_image* frame, char* err, size_t err_len);
+} procam_output_ops;
+
+/* A created device. `poll_fd` returns a file descriptor the daemon may watch
+ * for readability (new data), or -1 when the device is polled by timer.
+ * `destroy` releases everything; the daemon calls it exactly once. */
+typedef struct procam_device {
+  procam_family family;
+  void* self;
+  int (*poll_fd)(void* self);
+  void (*destroy)(void* self);
+  union {
+    const procam_camera_ops* camera;
+    const procam_tilt_ops* tilt;
+    const procam_tracker_ops* tracker;
+    const procam_output_ops* output;
+  } ops;
+} procam_device;
+
+/* One driver. `probe` scores how well the driver handles a device: 0 means
+ * "not mine", higher wins (hardware drivers use 1..99, simulated drivers 100+
+ * so that they outrank hardware when enabled). `create` fills `out`. */
+typedef struct procam_driver_factory {
+  procam_family family;
+  const char* name;
+  const char* description;
+  int (*probe)(const procam_device_desc* device);
+  int (*create)(const procam_device_desc* device, const procam_config* config,
+                procam_device* out, char* err, size_t err_len);
+} procam_driver_factory;
+
+typedef struct procam_plugin_table {
+  uint32_t abi_version; /* PROCAM_PLUGIN_ABI_VERSION again, checked a second time */
+  const char* plugin_name;
+  const char* plugin_version;
+  size_t n_factories;
+  const procam_driver_factory* factories;
+} procam_plugin_table;
+
+typedef const procam_plugin_table* (*procam_plugin_entry_fn)(void);
+
+#ifdef __cplusplus
+#define PROCAM_PLUGIN_EXTERN_C extern "C"
+#else
+#define PROCAM_PLUGIN_EXTERN_C
+#endif
+
+/* Defines the two exported symbols of a shared-object plugin. */
+#define PROCAM_PLUGIN_DEFINE(entry_function)                                          \
+  PROCAM_PLUGIN_EXTERN_C __attribute__((visibility("default")))                       \
+  const uint32_t procam_plugin_abi_version = PROCAM_PLUGIN_ABI_VERSION;               \
+  PROCAM_PLUGIN_EXTERN_C __attribute__((visibility("default"))) const procam_plugin_table* \
+  procam_plugin_entry(void) {                                                          \
+    return entry_function();                                                           \
+  }
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PROCAMD_PROCAM_PLUGIN_H */

@@ -1,0 +1,105 @@
+#include <gtest/gtest.h>
+
+#include "calibration/projector_calibration.hpp"
+#include "synthetic_rig.hpp"
+
+using namespace procam;
+using namespace procam::calib;
+using procam::testing::litPoint;
+using procam::testing::planeThrough;
+
+namespace {
+
+// One orientation of a blank plane: projector pixels every `step` px that land on
+// it and are seen by the camera, with the camera pixel (distorted) that sees them.
+// Decoding noise of sigma projector pixels on the projector side.
+PlaneView planeView(const geom::CameraModel& projector, const geom::CameraModel& camera,
+                    const geom::Plane& plane, int step, double sigma, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0, sigma);
+  PlaneView v;
+  for (int y = 0; y < projector.height; y += step)
+    for (int x = 0; x < projector.width; x += step) {
+      auto p = litPoint(projector, Vec2(x, y), plane);
+      if (!p) continue;
+      auto c = camera.project(*p);
+      if (!c || !camera.inImage(*c)) continue;
+      v.camera.push_back(*c);
+      v.projector.emplace_back(x + noise(rng), y + noise(rng));
+    }
+  return v;
+}
+
+// The wall in front of the projector at two orientations (turned 25 degrees about
+// a vertical and 20 degrees about a horizontal axis).
+std::vector<PlaneView> twoOrientations(double sigma) {
+  const auto projector = procam::testing::squarePixelProjector();
+  const auto camera = procam::testing::camera640();
+  const Vec3 centre(0.0, 0.3, 0.5);
+  const Vec3 n1 = Eigen::AngleAxisd(0.44, Vec3::UnitZ()) * Vec3(0, -1, 0);
+  const Vec3 n2 = Eigen::AngleAxisd(-0.35, Vec3::UnitX()) * Vec3(0, -1, 0);
+  return {planeView(projector, camera, planeThrough(centre, n1), 8, sigma, 1),
+          planeView(projector, camera, planeThrough(centre, n2), 8, sigma, 2)};
+}
+
+}  // namespace
+
+// The intrinsics tolerances for route (b): focal 0.5%, principal point 2 px
+// (c_x is the assumed image centre, exact for this projector).
+TEST(RouteB, TwoPlaneOrientationsGiveTheIntrinsics) {
+  const auto projector = procam::testing::squarePixelProjector();
+  const auto camera = procam::testing::camera640();
+  const auto views = twoOrientations(0.05);
+  ASSERT_GT(views[0].camera.size(), 2000u);
+  ASSERT_GT(views[1].camera.size(), 2000u);
+  // The distance from the camera centre to the first plane fixes the scale.
+  const Vec3 n1 = Eigen::AngleAxisd(0.44, Vec3::UnitZ()) * Vec3(0, -1, 0);
+  const geom::Plane first = planeThrough(Vec3(0.0, 0.3, 0.5), n1);
+  PlaneRouteOptions options;
+  options.projector_width = projector.width;
+  options.projector_height = projector.height;
+  options.first_plane_distance = std::abs(first.signedDistance(camera.pose.center()));
+  auto c = calibrateProjectorFromPlanes(camera, views, options);
+  ASSERT_TRUE(c) << c.error().message;
+  EXPECT_NEAR(c->K.fx, projector.K.fx, 0.005 * projector.K.fx);
+  EXPECT_NEAR(c->K.fy, projector.K.fy, 0.005 * projector.K.fy);
+  EXPECT_NEAR(c->K.cx, projector.K.cx, 2.0);
+  EXPECT_NEAR(c->K.cy, projector.K.cy, 2.0);
+  EXPECT_TRUE(c->scale_known);
+  EXPECT_LT((c->pose.center() - projector.pose.center()).norm(), 0.002);
+  EXPECT_LT(Eigen::AngleAxisd(c->pose.R.transpose() * projector.pose.R).angle() * 180 / M_PI, 0.05);
+  // Noise of 0.05 px per coordinate: the RMS of the 2D residual is about 0.05*sqrt(2).
+  EXPECT_LT(c->rms_px, 0.1);
+}
+
+TEST(RouteB, WithoutADistanceTheTranslationIsADirection) {
+  const auto projector = procam::testing::squarePixelProjector();
+  const auto camera = procam::testing::camera640();
+  PlaneRouteOptions options;
+  options.projector_width = projector.width;
+  options.projector_height = projector.height;
+  auto c = calibrateProjectorFromPlanes(camera, twoOrientations(0.05), options);
+  ASSERT_TRUE(c) << c.error().message;
+  EXPECT_FALSE(c->scale_known);
+  EXPECT_NEAR(c->K.fx, projector.K.fx, 0.005 * projector.K.fx);
+  EXPECT_NEAR(c->K.cy, projector.K.cy, 2.0);
+  const Vec3 true_dir =
+      (projector.pose.R * camera.pose.center() + projector.pose.t).normalized();  // camera in projector frame
+  const Vec3 est_dir = (c->pose.R * camera.pose.center() + c->pose.t).normalized();
+  EXPECT_LT((true_dir - est_dir).norm(), 1e-3);
+}
+
+TEST(RouteB, OneOrientationOrParallelPlanesAreRejected) {
+  const auto camera = procam::testing::camera640();
+  auto views = twoOrientations(0.05);
+  EXPECT_EQ(calibrateProjectorFromPlanes(camera, std::span(views).first(1)).error().code,
+            ErrorCode::kTooFewPoints);
+  const auto projector = procam::testing::squarePixelProjector();
+  const Vec3 n = Eigen::AngleAxisd(0.44, Vec3::UnitZ()) * Vec3(0, -1, 0);
+  std::vector<PlaneView> parallel = {
+      views[0], planeView(projector, camera, planeThrough(Vec3(0.0, 0.45, 0.5), n), 8, 0.05, 5)};
+  auto c = calibrateProjectorFromPlanes(camera, parallel);
+  ASSERT_FALSE(c);
+  EXPECT_TRUE(c.error().code == ErrorCode::kDegenerate || c.error().code == ErrorCode::kNoConvergence)
+      << c.error().message;
+}

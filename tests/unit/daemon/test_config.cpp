@@ -1,0 +1,142 @@
+// procamd.toml parsing: values land in the right fields, and every unknown key
+// or bad value is an error that names the file, the line and the key.
+#include <gtest/gtest.h>
+
+#include "config.hpp"
+
+namespace procam::daemon {
+namespace {
+
+Error parseError(const std::string& text) {
+  auto cfg = parseConfig(text, "rig.toml");
+  EXPECT_FALSE(cfg) << "accepted:\n" << text;
+  return cfg ? Error{} : cfg.error();
+}
+
+bool contains(const std::string& s, const std::string& part) {
+  return s.find(part) != std::string::npos;
+}
+
+TEST(Config, EmptyTextGivesDefaults) {
+  auto cfg = parseConfig("", "rig.toml");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_EQ(cfg->log_level, LogLevel::kInfo);
+  EXPECT_EQ(cfg->max_clients, 128);
+  EXPECT_FALSE(cfg->auto_keystone);
+  EXPECT_TRUE(cfg->devices.empty());
+}
+
+TEST(Config, FullRigIsRead) {
+  const char* text = R"(
+[daemon]
+log_level = "debug"
+max_clients = 12
+client_queue_kib = 256
+client_stall_timeout_s = 2.5
+
+[policy]
+auto_keystone = true
+recalibrate = "on-drift"
+
+[sim]
+scene = "handheld.toml"
+
+[[projector]]
+name = "main"
+driver = "kms"
+devnode = "/dev/dri/card0"
+
+[[camera]]
+name = "cam0"
+[camera.options]
+exposure_ms = 8
+gain = 1.5
+mono = true
+serial = "A1"
+
+[[tilt]]
+name = "imu"
+)";
+  auto cfg = parseConfig(text, "rig.toml");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_EQ(cfg->log_level, LogLevel::kDebug);
+  EXPECT_EQ(cfg->max_clients, 12);
+  EXPECT_EQ(cfg->client_queue_kib, 256);
+  EXPECT_DOUBLE_EQ(cfg->client_stall_timeout_s, 2.5);
+  EXPECT_TRUE(cfg->auto_keystone);
+  EXPECT_EQ(cfg->recalibrate, RecalibratePolicy::kOnDrift);
+  EXPECT_EQ(cfg->sim_scene, "handheld.toml");
+  ASSERT_EQ(cfg->devices.size(), 3u);
+  EXPECT_EQ(cfg->devices[0].family, PROCAM_FAMILY_OUTPUT);
+  EXPECT_EQ(cfg->devices[0].driver, "kms");
+  EXPECT_EQ(cfg->devices[0].devnode, "/dev/dri/card0");
+  EXPECT_EQ(cfg->devices[0].line, 15);
+  EXPECT_EQ(cfg->devices[1].family, PROCAM_FAMILY_CAMERA);
+  using Opt = std::pair<std::string, std::string>;
+  EXPECT_EQ(cfg->devices[1].options,
+            (std::vector<Opt>{{"exposure_ms", "8"}, {"gain", "1.5"}, {"mono", "true"},
+                              {"serial", "A1"}}));
+  EXPECT_EQ(cfg->devices[2].family, PROCAM_FAMILY_TILT);
+}
+
+TEST(Config, UnknownKeyNamesKeyAndLine) {
+  auto e = parseError("[daemon]\nlog_level = \"info\"\nlog_levle = \"debug\"\n");
+  EXPECT_TRUE(contains(e.message, "rig.toml:3: daemon.log_levle: unknown key")) << e.message;
+}
+
+TEST(Config, UnknownSectionNamesIt) {
+  auto e = parseError("\n[deamon]\n");
+  EXPECT_TRUE(contains(e.message, "rig.toml:2: deamon: unknown key")) << e.message;
+}
+
+TEST(Config, BadValuesNameKeyAndLine) {
+  struct Case {
+    const char* text;
+    const char* expected;
+  } cases[] = {
+      {"[daemon]\nlog_level = \"loud\"", "rig.toml:2: daemon.log_level: unknown log level 'loud'"},
+      {"[daemon]\nlog_level = 3", "rig.toml:2: daemon.log_level: expected a string"},
+      {"[daemon]\n\nmax_clients = 0", "rig.toml:3: daemon.max_clients: 0 is out of range [1, 4096]"},
+      {"[daemon]\nmax_clients = 1.5", "rig.toml:2: daemon.max_clients: expected an integer"},
+      {"[daemon]\nclient_stall_timeout_s = nan", "rig.toml:2: daemon.client_stall_timeout_s: nan is out of range"},
+      {"[policy]\nauto_keystone = \"yes\"", "rig.toml:2: policy.auto_keystone: expected true or false"},
+      {"[policy]\nrecalibrate = \"always\"", "rig.toml:2: policy.recalibrate: 'always' is not one of"},
+      {"[[camera]]\ndriver = \"v4l2\"", "rig.toml:1: camera[0].name: missing"},
+      {"[[camera]]\nname = \"a\"\n[[tilt]]\nname = \"a\"", "rig.toml:4: tilt[0].name: duplicate device name 'a'"},
+      {"[[camera]]\nname = \"a\"\nexposure = 3", "rig.toml:3: camera[0].exposure: unknown key"},
+      {"[[camera]]\nname = \"a\"\noptions = { list = [1, 2] }", "rig.toml:3: camera[0].options.list: expected a string, number or boolean"},
+      {"camera = 3", "rig.toml:1: camera: expected an array of tables"},
+      {"daemon = 3", "rig.toml:1: daemon: expected a table"},
+  };
+  for (const auto& c : cases) {
+    auto e = parseError(c.text);
+    EXPECT_TRUE(contains(e.message, c.expected)) << "got: " << e.message << "\nwanted: " << c.expected;
+  }
+}
+
+TEST(Config, AllProblemsAreReportedAtOnce) {
+  auto e = parseError("[daemon]\nfoo = 1\nmax_clients = -1\n[policy]\nbar = 2\n");
+  EXPECT_TRUE(contains(e.message, "rig.toml:2: daemon.foo")) << e.message;
+  EXPECT_TRUE(contains(e.message, "rig.toml:3: daemon.max_clients")) << e.message;
+  EXPECT_TRUE(contains(e.message, "rig.toml:5: policy.bar")) << e.message;
+}
+
+TEST(Config, SyntaxErrorNamesLineAndColumn) {
+  auto e = parseError("[daemon]\nlog_level = \"info\n");
+  EXPECT_EQ(e.code, ErrorCode::kParse);
+  EXPECT_TRUE(contains(e.message, "rig.toml:2:")) << e.message;
+}
+
+TEST(Config, MissingFileIsAnIoError) {
+  auto cfg = loadConfig("/nonexistent/procamd.toml");
+  ASSERT_FALSE(cfg);
+  EXPECT_EQ(cfg.error().code, ErrorCode::kIo);
+}
+
+TEST(Config, ExampleConfigParses) {
+  auto cfg = loadConfig(std::string(std::getenv("PROCAM_SOURCE_DIR")) + "/daemon/procamd.toml.example");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+}
+
+}  // namespace
+}  // namespace procam::daemon

@@ -1,0 +1,141 @@
+// Render-path choice and the CPU renderer's behaviour as one interface.
+#include <gtest/gtest.h>
+
+#include "render/bilinear.hpp"
+#include "render/cpu_renderer.hpp"
+#include "render/render_path.hpp"
+#include "render_test_images.hpp"
+#include "render_test_rig.hpp"
+
+namespace procam::render {
+namespace {
+
+TEST(RenderPath, FollowsTheDesignTable) {
+  auto pick = [](SurfaceKind s, ViewerKind v, ContentKind c, int n) {
+    return *choosePath(SceneTraits{s, v, c, n});
+  };
+  EXPECT_EQ(pick(SurfaceKind::kPlanar, ViewerKind::kUntracked, ContentKind::kImage, 1).path,
+            RenderPath::kHomography);
+  EXPECT_EQ(pick(SurfaceKind::kPlanar, ViewerKind::kTracked, ContentKind::kImage, 1).path,
+            RenderPath::kHomography);
+  EXPECT_EQ(pick(SurfaceKind::kPlanar, ViewerKind::kTracked, ContentKind::kMesh3d, 1).path,
+            RenderPath::kPlanar3d);
+  const auto tiled = pick(SurfaceKind::kPlanar, ViewerKind::kUntracked, ContentKind::kImage, 3);
+  EXPECT_EQ(tiled.path, RenderPath::kHomography);
+  EXPECT_TRUE(tiled.blend);
+  EXPECT_FALSE(tiled.post_warp);
+  const auto dome = pick(SurfaceKind::kNonPlanar, ViewerKind::kTracked, ContentKind::kImage, 3);
+  EXPECT_EQ(dome.path, RenderPath::kTwoPassMesh);
+  EXPECT_TRUE(dome.post_warp && dome.blend);
+  EXPECT_EQ(pick(SurfaceKind::kNonPlanar, ViewerKind::kStatic, ContentKind::kImage, 1).path,
+            RenderPath::kLookupWarp);
+  EXPECT_FALSE(pick(SurfaceKind::kNonPlanar, ViewerKind::kTracked, ContentKind::kImage, 1).post_warp);
+  EXPECT_EQ(choosePath({SurfaceKind::kObject, ViewerKind::kTracked, ContentKind::kMesh3d, 1})
+                .error()
+                .code,
+            ErrorCode::kNotFound);
+  EXPECT_EQ(choosePath({SurfaceKind::kPlanar, ViewerKind::kTracked, ContentKind::kImage, 0})
+                .error()
+                .code,
+            ErrorCode::kInvalidInput);
+}
+
+TEST(CpuRenderer, UnchangedFrameIsNotRenderedAgain) {
+  CpuRenderer r;
+  RenderSetup s;
+  s.output_size = {64, 48};
+  s.content_size = {32, 24};
+  s.homography << 2, 0, 0.5, 0, 2, 0.5, 0, 0, 1;
+  ASSERT_TRUE(r.configure(s));
+  cv::Mat content = test::randomImage(s.content_size, 1);
+  EXPECT_TRUE(*r.render({&content, nullptr, 1}));
+  cv::Mat first;
+  ASSERT_TRUE(r.readFrame(first));
+  content.setTo(cv::Scalar::all(9));  // changed pixels, same version: not re-rendered
+  EXPECT_FALSE(*r.render({&content, nullptr, 1}));
+  cv::Mat second;
+  ASSERT_TRUE(r.readFrame(second));
+  EXPECT_EQ(cv::norm(first, second, cv::NORM_INF), 0.0);
+  EXPECT_TRUE(*r.render({&content, nullptr, 2}));
+  EXPECT_FALSE(*r.render({&content, nullptr, 2}));
+  ASSERT_TRUE(r.configure(s));  // geometry change forces a frame
+  EXPECT_TRUE(*r.render({&content, nullptr, 2}));
+}
+
+TEST(CpuRenderer, HomographyFrameMatchesTheSpecification) {
+  CpuRenderer r;
+  RenderSetup s;
+  s.output_size = {160, 120};
+  s.content_size = {100, 80};
+  s.homography << 1.2, 0.1, 10, -0.05, 1.1, 5, 4e-4, 2e-4, 1;
+  ASSERT_TRUE(r.configure(s));
+  const cv::Mat content = test::smoothImage(s.content_size, 0.05, 0.04);
+  ASSERT_TRUE(r.render({&content, nullptr, 1}));
+  cv::Mat frame;
+  ASSERT_TRUE(r.readFrame(frame));
+  const Mat3 Hinv = s.homography.inverse();
+  for (int y = 0; y < 120; ++y) {
+    for (int x = 0; x < 160; ++x) {
+      const Vec2 p = (Hinv * Vec3(x, y, 1)).hnormalized();
+      const cv::Vec4d e = sampleBilinear(content, p.x(), p.y());
+      // Smooth content (G <= 6.4 per axis): <= 0.5 + 2 * 6.4 / 256 + float map error.
+      for (int c = 0; c < 4; ++c) ASSERT_NEAR(frame.at<cv::Vec4b>(y, x)[c], e[c], 0.56);
+    }
+  }
+}
+
+TEST(CpuRenderer, PlanarMeshTwoPassEqualsTheInducedHomography) {
+  // A planar surface rendered by the two-pass path must give the homography path's image:
+  // the path choice changes cost, never the picture.
+  const SurfaceMesh wall = test::planeMesh(Vec3(0, 3, 1.2), Vec3::UnitX(), Vec3::UnitZ(), 3, 2, 2);
+  const Mat34 P = test::lookAtProjection(300, 159.5, 119.5, Vec3(-0.4, 0, 1.0), Vec3(0, 3, 1.3),
+                                         Vec3::UnitZ());
+  const Mat34 V = test::lookAtProjection(250, 99.5, 79.5, Vec3(0.3, 0.2, 1.4), Vec3(0, 3, 1.2),
+                                         Vec3::UnitZ());
+  RenderSetup mesh;
+  mesh.output_size = {320, 240};
+  mesh.content_size = {200, 160};
+  mesh.path = RenderPath::kTwoPassMesh;
+  mesh.surface = wall;
+  mesh.projector = P;
+  mesh.viewer = V;
+  // Plane y = 3 in world: points (X, 3, Z) -> columns (0, 2, 3) plus 3 * column 1.
+  auto plane = [](const Mat34& M) {
+    Mat3 H;
+    H.col(0) = M.col(0);
+    H.col(1) = M.col(2);
+    H.col(2) = M.col(3) + 3 * M.col(1);
+    return H;
+  };
+  RenderSetup hom = mesh;
+  hom.path = RenderPath::kHomography;
+  hom.homography = plane(P) * plane(V).inverse();
+  CpuRenderer a, b;
+  ASSERT_TRUE(a.configure(mesh));
+  ASSERT_TRUE(b.configure(hom));
+  const cv::Mat content = test::detailedImage(mesh.content_size, 4);
+  ASSERT_TRUE(a.render({&content, nullptr, 1}));
+  ASSERT_TRUE(b.render({&content, nullptr, 1}));
+  cv::Mat fa, fb;
+  ASSERT_TRUE(a.readFrame(fa));
+  ASSERT_TRUE(b.readFrame(fb));
+  // Both maps are the same double mapping rounded to float, then quantised identically.
+  EXPECT_LE(cv::norm(fa, fb, cv::NORM_INF), 1.0);
+  EXPECT_GT(cv::countNonZero(fa.reshape(1) > 0), 1000);
+}
+
+TEST(CpuRenderer, PlanarPath3dNeedsTheGlBackEndAndBadSetupsAreRejected) {
+  CpuRenderer r;
+  RenderSetup s;
+  s.output_size = {8, 8};
+  s.path = RenderPath::kPlanar3d;
+  EXPECT_EQ(r.configure(s).error().code, ErrorCode::kNotFound);
+  s.path = RenderPath::kTwoPassMesh;
+  s.content_size = {8, 8};
+  EXPECT_EQ(r.configure(s).error().code, ErrorCode::kInvalidInput);
+  cv::Mat img(8, 8, CV_8UC4);
+  EXPECT_EQ(r.render({&img, nullptr, 1}).error().code, ErrorCode::kInvalidInput);
+}
+
+}  // namespace
+}  // namespace procam::render

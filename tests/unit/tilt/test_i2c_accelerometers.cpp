@@ -1,0 +1,140 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "fake_i2c.hpp"
+#include "tilt/i2c/i2c_accelerometer.hpp"
+
+namespace procam::tilt {
+namespace {
+
+using testing::FakeChip;
+using testing::FakeI2cBus;
+
+FakeChip adxl345() {
+  FakeChip c;
+  c.address = 0x53;
+  c.regs[0x00] = 0xE5;
+  c.ready_reg = 0x30, c.ready_mask = 0x80, c.data_reg = 0x32;
+  return c;
+}
+FakeChip mpu6050() {
+  FakeChip c;
+  c.address = 0x68;
+  c.regs[0x75] = 0x68;
+  c.ready_reg = 0x3A, c.ready_mask = 0x01, c.data_reg = 0x3B;
+  return c;
+}
+FakeChip lis3dh() {
+  FakeChip c;
+  c.address = 0x18;
+  c.regs[0x0F] = 0x33;
+  c.increment_needs_msb = true;
+  c.ready_reg = 0x27, c.ready_mask = 0x08, c.data_reg = 0x28;
+  return c;
+}
+
+// Datasheet encodings of counts.
+std::array<std::uint8_t, 6> littleEndian(std::array<int, 3> v) {
+  std::array<std::uint8_t, 6> b{};
+  for (int a = 0; a < 3; ++a) {
+    const auto u = std::uint16_t(std::int16_t(v[std::size_t(a)]));
+    b[std::size_t(2 * a)] = std::uint8_t(u & 0xFF);
+    b[std::size_t(2 * a + 1)] = std::uint8_t(u >> 8);
+  }
+  return b;
+}
+std::array<std::uint8_t, 6> bigEndian(std::array<int, 3> v) {
+  auto b = littleEndian(v);
+  for (int a = 0; a < 3; ++a) std::swap(b[std::size_t(2 * a)], b[std::size_t(2 * a + 1)]);
+  return b;
+}
+
+struct Rig {
+  std::shared_ptr<FakeI2cBus> bus = std::make_shared<FakeI2cBus>();
+  FakeChip chip;
+  std::unique_ptr<I2cAccelerometer> sensor;
+  Rig(I2cChip which, FakeChip c, I2cAccelConfig cfg) : chip(c) {
+    cfg.poll_interval = std::chrono::microseconds(0);
+    bus->chips.push_back(&chip);
+    sensor = makeI2cAccelerometer(which, bus, defaultAddress(which), cfg);
+  }
+};
+
+TEST(I2cAccelerometers, Adxl345SetupAndLittleEndianFullResolution) {
+  Rig rig(I2cChip::kAdxl345, adxl345(), {4, 100, 5, {}});
+  ASSERT_TRUE(rig.sensor->open());
+  EXPECT_EQ(rig.chip.lastWrite(0x31), 0x09);  // FULL_RES | ±4 g
+  EXPECT_EQ(rig.chip.lastWrite(0x2C), 0x0A);  // 100 Hz
+  EXPECT_EQ(rig.chip.lastWrite(0x2D), 0x08);  // measure
+  EXPECT_EQ(rig.sensor->rateHz(), 100);
+  rig.chip.produce(littleEndian({128, -64, -256}));  // 0.5, -0.25, -1 g at 256 LSB/g
+  auto s = rig.sensor->read();
+  ASSERT_TRUE(s) << s.error().message;
+  EXPECT_NEAR((s->specific_force - Vec3(0.5, -0.25, -1) * kStandardGravity).norm(), 0, 1e-12);
+  // Data-ready was cleared by the burst read: no second sample.
+  EXPECT_EQ(rig.sensor->read().error().code, ErrorCode::kNotFound);
+  rig.sensor->close();
+  EXPECT_EQ(rig.chip.lastWrite(0x2D), 0x00);  // standby
+}
+
+TEST(I2cAccelerometers, Mpu6050SetupAndBigEndian) {
+  Rig rig(I2cChip::kMpu6050, mpu6050(), {4, 100, 5, {}});
+  ASSERT_TRUE(rig.sensor->open());
+  EXPECT_EQ(rig.chip.lastWrite(0x6B), 0x01);           // awake, PLL
+  EXPECT_EQ(rig.chip.lastWrite(0x1C), 0x08);           // AFS_SEL = 1: ±4 g
+  EXPECT_EQ(rig.chip.lastWrite(0x19), 9);              // 1 kHz / (1 + 9)
+  EXPECT_EQ(rig.chip.lastWrite(0x38), 0x01);           // DATA_RDY_EN
+  rig.chip.produce(bigEndian({8192, -4096, -32768}));  // 8192 LSB/g
+  auto s = rig.sensor->read();
+  ASSERT_TRUE(s);
+  EXPECT_NEAR((s->specific_force - Vec3(1, -0.5, -4) * kStandardGravity).norm(), 0, 1e-12);
+  rig.sensor->close();
+  EXPECT_EQ(rig.chip.lastWrite(0x6B), 0x40);  // sleep
+}
+
+TEST(I2cAccelerometers, Lis3dhLeftJustifiedTwelveBitWithAutoIncrementBit) {
+  Rig rig(I2cChip::kLis3dh, lis3dh(), {2, 100, 5, {}});
+  ASSERT_TRUE(rig.sensor->open());
+  EXPECT_EQ(rig.chip.lastWrite(0x20), 0x57);  // 100 Hz, XYZ on
+  EXPECT_EQ(rig.chip.lastWrite(0x23), 0x88);  // BDU, ±2 g, high resolution
+  // 1 mg/digit, 12 bits left-justified in 16.
+  rig.chip.produce(littleEndian({250 * 16, -1000 * 16, -2048 * 16}));
+  auto s = rig.sensor->read();
+  ASSERT_TRUE(s);
+  EXPECT_NEAR((s->specific_force - Vec3(0.25, -1.0, -2.048) * kStandardGravity).norm(), 0, 1e-12);
+}
+
+TEST(I2cAccelerometers, WrongIdentityNackAndStuckBus) {
+  FakeChip wrong = mpu6050();
+  wrong.regs[0x75] = 0x71;  // an MPU-9250 answers
+  Rig a(I2cChip::kMpu6050, wrong, {});
+  auto r = a.sensor->open();
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, ErrorCode::kNotFound);
+  EXPECT_NE(r.error().message.find("0x71"), std::string::npos);
+
+  Rig b(I2cChip::kAdxl345, adxl345(), {});
+  b.chip.address = 0x1D;  // strapped to the other address: nobody answers at 0x53
+  EXPECT_EQ(b.sensor->open().error().code, ErrorCode::kNotFound);
+
+  Rig c(I2cChip::kLis3dh, lis3dh(), {});
+  c.bus->stuck = true;
+  EXPECT_EQ(c.sensor->open().error().code, ErrorCode::kIo);
+  c.bus->stuck = false;
+  ASSERT_TRUE(c.sensor->open());
+  c.bus->stuck = true;  // bus hangs after setup
+  EXPECT_EQ(c.sensor->read().error().code, ErrorCode::kIo);
+}
+
+TEST(I2cAccelerometers, NoDataReadyTimesOutAfterThePollBudget) {
+  Rig rig(I2cChip::kAdxl345, adxl345(), {2, 100, 7, {}});
+  ASSERT_TRUE(rig.sensor->open());
+  const int before = rig.bus->transfers;
+  EXPECT_EQ(rig.sensor->read().error().code, ErrorCode::kNotFound);
+  EXPECT_EQ(rig.bus->transfers - before, 7);
+  EXPECT_EQ(parseI2cChip("bmi160").error().code, ErrorCode::kNotFound);
+}
+
+}  // namespace
+}  // namespace procam::tilt
