@@ -94,8 +94,8 @@ void Daemon::cmdVersion(ClientId client, const proto::Request& req) {
 json Daemon::statusJson() const {
   const auto uptime = std::chrono::duration<double>(std::chrono::steady_clock::now() - started_);
   json devices = json::object();
-  for (procam_family f : {PROCAM_FAMILY_OUTPUT, PROCAM_FAMILY_CAMERA, PROCAM_FAMILY_TILT,
-                          PROCAM_FAMILY_TRACKER}) {
+  for (procam_family f :
+       {PROCAM_FAMILY_OUTPUT, PROCAM_FAMILY_CAMERA, PROCAM_FAMILY_TILT, PROCAM_FAMILY_TRACKER}) {
     devices[plugins::familyName(f)] = devices_.count(f);
   }
   json ops = json::array();
@@ -150,8 +150,9 @@ void Daemon::cmdWatch(ClientId client, const proto::Request& req) {
   }
   replyTo(client, req, "WATCH",
           {{"enabled", enable},
-           {"events", {"device-added", "device-removed", "progress", "keystone", "pattern",
-                       "content", "config", "warning"}}});
+           {"events",
+            {"device-added", "device-removed", "progress", "finished", "keystone", "pattern",
+             "content", "config", "warning"}}});
 }
 
 void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
@@ -171,9 +172,9 @@ void Daemon::cmdCancel(ClientId client, const proto::Request& req) {
     }
   }
   if (cancelled.empty()) {
-    return errorTo(client, req, code::kNotFound,
-                   which ? "no running operation '" + *which + "'"
-                         : "this client has no running operation");
+    return errorTo(
+        client, req, code::kNotFound,
+        which ? "no running operation '" + *which + "'" : "this client has no running operation");
   }
   replyTo(client, req, "CANCEL", {{"cancelled", cancelled}});
 }
@@ -195,7 +196,8 @@ json Daemon::keystoneJson() const {
         const std::array<Vec2, 4> frame{Vec2(0, 0), Vec2(w - 1.0, 0), Vec2(w - 1.0, h - 1.0),
                                         Vec2(0, h - 1.0)};
         std::array<Vec2, 4> corners;
-        for (int i = 0; i < 4; ++i) corners[i] = Vec2((*settings_.keystone)[i][0], (*settings_.keystone)[i][1]);
+        for (int i = 0; i < 4; ++i)
+          corners[i] = Vec2((*settings_.keystone)[i][0], (*settings_.keystone)[i][1]);
         if (auto H = geom::homographyFrom4(frame, corners)) {
           const Mat3 Hn = *H / (*H)(2, 2);
           j["homography"] = json::array();

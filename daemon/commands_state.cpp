@@ -64,7 +64,8 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
   auto path = args.string("path");
   if (!args.ok()) return errorTo(client, req, code::kBadArgument, args.error());
   if (action == "get" || action == "clear") {
-    if (path) return errorTo(client, req, code::kBadArgument, "content " + action + " takes no path");
+    if (path)
+      return errorTo(client, req, code::kBadArgument, "content " + action + " takes no path");
     if (action == "clear") {
       settings_.content.clear();
       content_info_ = {};
@@ -85,9 +86,9 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
   auto cancelled = std::make_shared<std::atomic<bool>>(false);
   operations_[op_id] = Operation{"content-load", client, req.id, cancelled};
   server_->hold(client);
-  operationEvent(client, "progress",
-                 {{"operation", op_id}, {"kind", "content-load"}, {"fraction", 0.0},
-                  {"stage", "decoding"}});
+  operationEvent(
+      client, "progress",
+      {{"operation", op_id}, {"kind", "content-load"}, {"fraction", 0.0}, {"stage", "decoding"}});
   compute_worker_->submit([this, client, req, op_id, cancelled, file = *path] {
     cv::Mat image;
     std::string failure;
@@ -109,7 +110,9 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
         finished["error"] = failure;
       } else {
         operationEvent(client, "progress",
-                       {{"operation", op_id}, {"kind", "content-load"}, {"fraction", 1.0},
+                       {{"operation", op_id},
+                        {"kind", "content-load"},
+                        {"fraction", 1.0},
                         {"stage", "decoded"}});
       }
       operationEvent(client, "finished", finished);
@@ -186,7 +189,8 @@ void Daemon::cmdReload(ClientId client, const proto::Request& req) {
   if (auto ok = reloadConfig(); !ok) {
     return errorTo(client, req, code::kConfig, ok.error().message);
   }
-  replyTo(client, req, "RELOAD", {{"config", config_.source}, {"devices", devices_.entries().size()}});
+  replyTo(client, req, "RELOAD",
+          {{"config", config_.source}, {"devices", devices_.entries().size()}});
 }
 
 void Daemon::cmdLogLevel(ClientId client, const proto::Request& req) {

@@ -1,9 +1,10 @@
 #include "config.hpp"
 
+#include <toml++/toml.h>
+
 #include <fstream>
 #include <set>
 #include <sstream>
-#include <toml++/toml.h>
 
 namespace procam::daemon {
 
@@ -74,8 +75,7 @@ class Checker {
     return true;
   }
 
-  bool number(const toml::node& node, const std::string& key, double lo, double hi,
-              double& out) {
+  bool number(const toml::node& node, const std::string& key, double lo, double hi, double& out) {
     if (!node.is_number()) {
       error(node.source(), key, "expected a number");
       return false;

@@ -16,8 +16,8 @@ namespace procam::daemon {
 struct DeviceConfig {
   procam_family family = PROCAM_FAMILY_CAMERA;
   std::string name;
-  std::string driver;   // empty: the best-scoring driver
-  std::string devnode;  // empty: any device of the family
+  std::string driver;                                        // empty: the best-scoring driver
+  std::string devnode;                                       // empty: any device of the family
   std::vector<std::pair<std::string, std::string>> options;  // values as text
   int line = 0;
 };

@@ -213,8 +213,8 @@ void ControlServer::flush(ClientId id, Client& c) {
   const bool want = !c.out.empty();
   if (want != c.want_write) {
     c.want_write = want;
-    const uint32_t ev = (c.read_closed ? 0u : uint32_t{EPOLLIN | EPOLLRDHUP}) |
-                       (want ? uint32_t{EPOLLOUT} : 0u);
+    const uint32_t ev =
+        (c.read_closed ? 0u : uint32_t{EPOLLIN | EPOLLRDHUP}) | (want ? uint32_t{EPOLLOUT} : 0u);
     loop_.modify(c.fd.get(), ev);
   }
   maybeFinish(id, c);

@@ -24,7 +24,8 @@ Result<sockaddr_un> unixAddress(const std::string& path) {
   sockaddr_un addr{};
   addr.sun_family = AF_UNIX;
   if (path.empty() || path.size() >= sizeof addr.sun_path) {
-    return fail(ErrorCode::kInvalidInput, "control socket path '" + path + "' is empty or longer than " +
+    return fail(ErrorCode::kInvalidInput, "control socket path '" + path +
+                                              "' is empty or longer than " +
                                               std::to_string(sizeof addr.sun_path - 1) + " bytes");
   }
   std::memcpy(addr.sun_path, path.c_str(), path.size() + 1);
@@ -58,11 +59,13 @@ Result<void> removeIfStale(const std::string& path, const sockaddr_un& addr) {
 Result<ListeningSocket> openControlSocket(const std::string& path, gid_t group) {
   const int n = sd_listen_fds(1);
   if (n < 0) return fail(ErrorCode::kIo, std::string("sd_listen_fds: ") + std::strerror(-n));
-  if (n > 1) return fail(ErrorCode::kIo, "systemd passed " + std::to_string(n) + " sockets, expected 1");
+  if (n > 1)
+    return fail(ErrorCode::kIo, "systemd passed " + std::to_string(n) + " sockets, expected 1");
   if (n == 1) {
     const int fd = SD_LISTEN_FDS_START;
     if (sd_is_socket_unix(fd, SOCK_STREAM, 1, nullptr, 0) <= 0) {
-      return fail(ErrorCode::kIo, "the socket passed by systemd is not a listening Unix stream socket");
+      return fail(ErrorCode::kIo,
+                  "the socket passed by systemd is not a listening Unix stream socket");
     }
     const int flags = ::fcntl(fd, F_GETFL);
     if (flags < 0 || ::fcntl(fd, F_SETFL, flags | O_NONBLOCK) != 0) return sysError("fcntl");
@@ -85,8 +88,10 @@ Result<ListeningSocket> openControlSocket(const std::string& path, gid_t group) 
     errno = bind_errno;
     return sysError("cannot bind " + path);
   }
-  if (group != static_cast<gid_t>(-1) && ::chown(path.c_str(), static_cast<uid_t>(-1), group) != 0) {
-    logDebug("cannot give " + path + " to group " + std::to_string(group) + ": " + std::strerror(errno));
+  if (group != static_cast<gid_t>(-1) &&
+      ::chown(path.c_str(), static_cast<uid_t>(-1), group) != 0) {
+    logDebug("cannot give " + path + " to group " + std::to_string(group) + ": " +
+             std::strerror(errno));
   }
   if (::listen(fd.get(), 128) != 0) return sysError("listen");
   return ListeningSocket{std::move(fd), false, path};

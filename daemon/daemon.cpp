@@ -8,6 +8,7 @@
 
 #include "loader.hpp"
 #include "log.hpp"
+#include "sim_rig.hpp"
 #include "systemd_notify.hpp"
 
 namespace procam::daemon {
@@ -51,8 +52,8 @@ ServerOptions Daemon::serverOptions() const {
   o.release = kRelease;
   o.max_clients = static_cast<size_t>(config_.max_clients);
   o.queue_limit_bytes = static_cast<size_t>(config_.client_queue_kib) * 1024;
-  o.stall_timeout = std::chrono::milliseconds(
-      static_cast<int64_t>(config_.client_stall_timeout_s * 1000.0));
+  o.stall_timeout =
+      std::chrono::milliseconds(static_cast<int64_t>(config_.client_stall_timeout_s * 1000.0));
   o.group = lookupGroup(config_.group);
   return o;
 }
@@ -89,16 +90,30 @@ Result<void> Daemon::setup() {
   socket_info_.activated = sock->activated;
   socket_info_.path = sock->path;
 
-  settings_file_ = std::make_unique<StateFile>(
-      options_.state_dir, "settings.json",
-      [](std::string_view text) -> Result<void> {
-        auto s = settingsFromJson(text);
-        if (!s) return tl::unexpected(s.error());
-        return {};
-      });
+  settings_file_ = std::make_unique<StateFile>(options_.state_dir, "settings.json",
+                                               [](std::string_view text) -> Result<void> {
+                                                 auto s = settingsFromJson(text);
+                                                 if (!s) return tl::unexpected(s.error());
+                                                 return {};
+                                               });
   if (auto ok = settings_file_->ensureDirectory(); !ok) return ok;
   loadSettings();
   loadDrivers();
+  if (!options_.sim_scene.empty()) {
+    auto sim = simDevices(options_.sim_scene);
+    if (!sim) return tl::unexpected(sim.error());
+    for (auto& desc : *sim) {
+      const DeviceEntry& e = devices_.open(registry_, std::move(desc), "", {});
+      if (!e.usable()) {
+        return fail(ErrorCode::kIo, "virtual rig device '" + e.name + "': " + e.error);
+      }
+    }
+    logInfo("virtual rig '" + options_.sim_scene +
+            "': " + std::to_string(devices_.entries().size()) + " device(s)");
+    if (config_.auto_keystone || options_.sim_scene == kDefaultSimScene) {
+      warn("auto keystone requested, but this build has no keystone pipeline; it stays off");
+    }
+  }
   openDevices();
 
   io_worker_ = std::make_unique<WorkerPool>(*loop_, 1);
@@ -132,8 +147,9 @@ void Daemon::loadSettings() {
   // The validator already accepted the text.
   settings_ = *settingsFromJson(loaded->contents);
   if (settings_.auto_keystone) {
-    warn("saved setting auto keystone is on, but this build has no keystone pipeline; "
-         "automatic keystone stays off");
+    warn(
+        "saved setting auto keystone is on, but this build has no keystone pipeline; "
+        "automatic keystone stays off");
     settings_.auto_keystone = false;
   }
 }
@@ -188,11 +204,12 @@ void Daemon::onSignal(int signo) {
   loop_->stop(0);
 }
 
-void Daemon::housekeeping() { server_->checkStalls(); }
+void Daemon::housekeeping() {
+  server_->checkStalls();
+}
 
 int Daemon::run() {
-  const std::string where =
-      socket_info_.activated ? "socket passed by systemd" : socket_info_.path;
+  const std::string where = socket_info_.activated ? "socket passed by systemd" : socket_info_.path;
   std::string status = "ready: " + std::to_string(devices_.entries().size()) + " device(s), " +
                        "control on " + where;
   logInfo("procamd " + std::string(kRelease) + " " + status);

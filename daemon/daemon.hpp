@@ -25,8 +25,8 @@ struct DaemonOptions {
   std::string config_path;  // empty: built-in defaults
   std::string runtime_dir = "/run/procamd";
   std::string state_dir = "/var/lib/procamd";
-  std::string plugin_dir;   // overrides the config and the built-in default
-  std::string sim_scene;    // non-empty: run on the virtual rig
+  std::string plugin_dir;  // overrides the config and the built-in default
+  std::string sim_scene;   // non-empty: run on the virtual rig
 };
 
 inline constexpr const char* kRelease = PROCAM_RELEASE;

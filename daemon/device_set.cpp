@@ -56,7 +56,9 @@ bool DeviceSet::close(const std::string& name) {
   return true;
 }
 
-void DeviceSet::closeAll() { entries_.clear(); }
+void DeviceSet::closeAll() {
+  entries_.clear();
+}
 
 DeviceEntry* DeviceSet::firstUsable(procam_family family) {
   for (auto& e : entries_) {

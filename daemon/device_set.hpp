@@ -17,7 +17,7 @@ struct DeviceEntry {
   std::string driver;  // empty when no driver matched
   std::string origin;  // where the driver came from
   plugins::Device device;
-  std::string error;   // non-empty: not usable
+  std::string error;  // non-empty: not usable
 
   bool usable() const { return device.valid(); }
   nlohmann::json toJson() const;

@@ -13,18 +13,24 @@ constexpr const char* kNames[] = {"error", "warning", "info", "debug"};
 constexpr int kSyslogPriority[] = {3, 4, 6, 7};  // LOG_ERR, LOG_WARNING, LOG_INFO, LOG_DEBUG
 }  // namespace
 
-const char* logLevelName(LogLevel level) { return kNames[static_cast<int>(level)]; }
+const char* logLevelName(LogLevel level) {
+  return kNames[static_cast<int>(level)];
+}
 
 Result<LogLevel> parseLogLevel(std::string_view text) {
   for (int i = 0; i < 4; ++i) {
     if (text == kNames[i]) return static_cast<LogLevel>(i);
   }
-  return fail(ErrorCode::kInvalidInput, "unknown log level '" + std::string(text) +
-                                            "' (error, warning, info, debug)");
+  return fail(ErrorCode::kInvalidInput,
+              "unknown log level '" + std::string(text) + "' (error, warning, info, debug)");
 }
 
-void setLogLevel(LogLevel level) { g_level.store(level); }
-LogLevel logLevel() { return g_level.load(); }
+void setLogLevel(LogLevel level) {
+  g_level.store(level);
+}
+LogLevel logLevel() {
+  return g_level.load();
+}
 
 void log(LogLevel level, std::string_view message) {
   if (level > g_level.load()) return;

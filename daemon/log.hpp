@@ -18,9 +18,17 @@ LogLevel logLevel();
 
 // Thread-safe; messages above the current level are dropped.
 void log(LogLevel level, std::string_view message);
-inline void logError(std::string_view m) { log(LogLevel::kError, m); }
-inline void logWarning(std::string_view m) { log(LogLevel::kWarning, m); }
-inline void logInfo(std::string_view m) { log(LogLevel::kInfo, m); }
-inline void logDebug(std::string_view m) { log(LogLevel::kDebug, m); }
+inline void logError(std::string_view m) {
+  log(LogLevel::kError, m);
+}
+inline void logWarning(std::string_view m) {
+  log(LogLevel::kWarning, m);
+}
+inline void logInfo(std::string_view m) {
+  log(LogLevel::kInfo, m);
+}
+inline void logDebug(std::string_view m) {
+  log(LogLevel::kDebug, m);
+}
 
 }  // namespace procam::daemon

@@ -10,16 +10,19 @@
 #include "loader.hpp"
 #include "log.hpp"
 #include "registry.hpp"
+#include "sim_rig.hpp"
 
 namespace {
 
 constexpr const char* kUsage =
     "usage: procamd [options]\n"
     "  --config PATH       configuration (default /etc/procamd/procamd.toml when it exists)\n"
-    "  --sim SCENE         run on the virtual rig (a scene file)\n"
+    "  --sim [SCENE]       run on the virtual rig: a shipped scene name or a file\n"
+    "                      (default: handheld)\n"
     "  --runtime-dir DIR   control socket directory (default $RUNTIME_DIRECTORY or /run/procamd)\n"
     "  --state-dir DIR     saved settings (default $STATE_DIRECTORY or /var/lib/procamd)\n"
-    "  --plugin-dir DIR    driver plugins (default " PROCAM_DEFAULT_PLUGIN_DIR ")\n"
+    "  --plugin-dir DIR    driver plugins (default " PROCAM_DEFAULT_PLUGIN_DIR
+    ")\n"
     "  --list-drivers      print the available drivers and exit\n"
     "  --version           print the release and exit\n";
 
@@ -69,7 +72,12 @@ int main(int argc, char** argv) {
     if (a == "--config") {
       value(opts.config_path);
     } else if (a == "--sim") {
-      value(opts.sim_scene);
+      // The scene is optional: the shipped handheld rig by default.
+      if (i + 1 < argc && argv[i + 1][0] != '-') {
+        opts.sim_scene = argv[++i];
+      } else {
+        opts.sim_scene = procam::daemon::kDefaultSimScene;
+      }
     } else if (a == "--runtime-dir") {
       value(opts.runtime_dir);
     } else if (a == "--state-dir") {
@@ -79,9 +87,9 @@ int main(int argc, char** argv) {
     } else if (a == "--list-drivers") {
       list = true;
     } else if (a == "--version") {
-      std::printf("procamd %s (control protocol %d.%d, plugin ABI %u)\n",
-                  procam::daemon::kRelease, procam::daemon::proto::kMajor,
-                  procam::daemon::proto::kMinor, PROCAM_PLUGIN_ABI_VERSION);
+      std::printf("procamd %s (control protocol %d.%d, plugin ABI %u)\n", procam::daemon::kRelease,
+                  procam::daemon::proto::kMajor, procam::daemon::proto::kMinor,
+                  PROCAM_PLUGIN_ABI_VERSION);
       return 0;
     } else if (a == "-h" || a == "--help") {
       std::fputs(kUsage, stdout);
@@ -91,7 +99,8 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  if (list) return listDrivers(opts.plugin_dir.empty() ? PROCAM_DEFAULT_PLUGIN_DIR : opts.plugin_dir);
+  if (list)
+    return listDrivers(opts.plugin_dir.empty() ? PROCAM_DEFAULT_PLUGIN_DIR : opts.plugin_dir);
   if (opts.config_path.empty() && opts.sim_scene.empty() &&
       ::access("/etc/procamd/procamd.toml", F_OK) == 0) {
     opts.config_path = "/etc/procamd/procamd.toml";

@@ -18,12 +18,12 @@ inline constexpr size_t kMaxRequestBytes = 64 * 1024;  // newline excluded
 
 // Error codes of ERROR replies.
 namespace code {
-inline constexpr const char* kParse = "parse-error";          // not JSON
-inline constexpr const char* kBadRequest = "bad-request";     // JSON, but not a request
-inline constexpr const char* kTooLarge = "too-large";         // over kMaxRequestBytes
+inline constexpr const char* kParse = "parse-error";       // not JSON
+inline constexpr const char* kBadRequest = "bad-request";  // JSON, but not a request
+inline constexpr const char* kTooLarge = "too-large";      // over kMaxRequestBytes
 inline constexpr const char* kUnknownCommand = "unknown-command";
 inline constexpr const char* kBadArgument = "bad-argument";
-inline constexpr const char* kUnavailable = "unavailable";    // not built / no device
+inline constexpr const char* kUnavailable = "unavailable";  // not built / no device
 inline constexpr const char* kNotFound = "not-found";
 inline constexpr const char* kBusy = "busy";
 inline constexpr const char* kCancelled = "cancelled";
@@ -34,7 +34,7 @@ inline constexpr const char* kInternal = "internal-error";
 }  // namespace code
 
 struct Request {
-  nlohmann::json id;    // string, integer or null
+  nlohmann::json id;  // string, integer or null
   std::string cmd;
   nlohmann::json body;  // the whole request object
 };

@@ -36,9 +36,8 @@ class RequestArgs {
 
 // In a command handler (client, req, errorTo in scope): answers bad-argument
 // and returns when the request has a key outside the listed ones.
-#define PROCAM_CHECK_KEYS(args, ...)                                                   \
-  if (auto bad = (args).unknownKey({__VA_ARGS__})) {                                  \
-    errorTo(client, req, code::kBadArgument, "unknown argument \"" + *bad + "\" for " + \
-                                                 req.cmd);                            \
-    return;                                                                           \
+#define PROCAM_CHECK_KEYS(args, ...)                                                              \
+  if (auto bad = (args).unknownKey({__VA_ARGS__})) {                                              \
+    errorTo(client, req, code::kBadArgument, "unknown argument \"" + *bad + "\" for " + req.cmd); \
+    return;                                                                                       \
   }

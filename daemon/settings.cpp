@@ -16,7 +16,9 @@ bool isPatternName(std::string_view name) {
   return false;
 }
 
-const char* patternNames() { return "off, grid, crosshair, white, black"; }
+const char* patternNames() {
+  return "off, grid, crosshair, white, black";
+}
 
 Result<void> validateQuad(const Quad& q) {
   for (const auto& p : q) {
@@ -31,7 +33,8 @@ Result<void> validateQuad(const Quad& q) {
     const auto& b = q[(i + 1) % 4];
     const auto& c = q[(i + 2) % 4];
     const double cross = (b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0]);
-    const double scale = std::hypot(b[0] - a[0], b[1] - a[1]) * std::hypot(c[0] - b[0], c[1] - b[1]);
+    const double scale =
+        std::hypot(b[0] - a[0], b[1] - a[1]) * std::hypot(c[0] - b[0], c[1] - b[1]);
     if (!(cross > 1e-9 * scale) || scale == 0) {
       return fail(ErrorCode::kInvalidInput,
                   "corners must form a convex quadrilateral listed top-left, top-right, "
@@ -73,7 +76,8 @@ Result<Settings> settingsFromJson(std::string_view text) {
   }
   Settings s;
   const auto* autok = field("auto_keystone");
-  if (!autok || !autok->is_boolean()) return fail(ErrorCode::kParse, "\"auto_keystone\" must be a boolean");
+  if (!autok || !autok->is_boolean())
+    return fail(ErrorCode::kParse, "\"auto_keystone\" must be a boolean");
   s.auto_keystone = autok->get<bool>();
   const auto* ks = field("keystone");
   if (!ks) return fail(ErrorCode::kParse, "missing \"keystone\"");

@@ -78,7 +78,8 @@ StateFile::StateFile(std::string dir, std::string name, Validator validate)
 Result<void> StateFile::ensureDirectory() const {
   std::error_code ec;
   std::filesystem::create_directories(dir_, ec);
-  if (ec) return fail(ErrorCode::kIo, "cannot create state directory " + dir_ + ": " + ec.message());
+  if (ec)
+    return fail(ErrorCode::kIo, "cannot create state directory " + dir_ + ": " + ec.message());
   return {};
 }
 

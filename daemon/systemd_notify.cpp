@@ -8,11 +8,17 @@ void notifyReady(const std::string& status) {
   sd_notify(0, ("READY=1\nSTATUS=" + status).c_str());
 }
 
-void notifyStatus(const std::string& status) { sd_notify(0, ("STATUS=" + status).c_str()); }
+void notifyStatus(const std::string& status) {
+  sd_notify(0, ("STATUS=" + status).c_str());
+}
 
-void notifyStopping() { sd_notify(0, "STOPPING=1\nSTATUS=stopping"); }
+void notifyStopping() {
+  sd_notify(0, "STOPPING=1\nSTATUS=stopping");
+}
 
-void notifyWatchdog() { sd_notify(0, "WATCHDOG=1"); }
+void notifyWatchdog() {
+  sd_notify(0, "WATCHDOG=1");
+}
 
 std::optional<std::chrono::microseconds> watchdogPingInterval() {
   uint64_t usec = 0;

@@ -6,17 +6,21 @@ namespace procam::plugins {
 
 const char* familyName(procam_family family) {
   switch (family) {
-    case PROCAM_FAMILY_CAMERA: return "camera";
-    case PROCAM_FAMILY_TILT: return "tilt";
-    case PROCAM_FAMILY_TRACKER: return "tracker";
-    case PROCAM_FAMILY_OUTPUT: return "output";
+    case PROCAM_FAMILY_CAMERA:
+      return "camera";
+    case PROCAM_FAMILY_TILT:
+      return "tilt";
+    case PROCAM_FAMILY_TRACKER:
+      return "tracker";
+    case PROCAM_FAMILY_OUTPUT:
+      return "output";
   }
   return "unknown";
 }
 
 Result<procam_family> parseFamily(const std::string& text) {
-  for (procam_family f : {PROCAM_FAMILY_CAMERA, PROCAM_FAMILY_TILT, PROCAM_FAMILY_TRACKER,
-                          PROCAM_FAMILY_OUTPUT}) {
+  for (procam_family f :
+       {PROCAM_FAMILY_CAMERA, PROCAM_FAMILY_TILT, PROCAM_FAMILY_TRACKER, PROCAM_FAMILY_OUTPUT}) {
     if (text == familyName(f)) return f;
   }
   return fail(ErrorCode::kInvalidInput,
@@ -62,7 +66,9 @@ Device& Device::operator=(Device&& other) noexcept {
   return *this;
 }
 
-Device::~Device() { reset(); }
+Device::~Device() {
+  reset();
+}
 
 void Device::reset() {
   if (device_.destroy) device_.destroy(device_.self);
@@ -70,7 +76,9 @@ void Device::reset() {
   library_.reset();  // after destroy: the code of destroy lives in the library
 }
 
-int Device::pollFd() const { return device_.poll_fd ? device_.poll_fd(device_.self) : -1; }
+int Device::pollFd() const {
+  return device_.poll_fd ? device_.poll_fd(device_.self) : -1;
+}
 
 namespace {
 
@@ -79,9 +87,12 @@ bool opsComplete(const procam_device& d) {
     case PROCAM_FAMILY_CAMERA:
       return d.ops.camera && d.ops.camera->get_format && d.ops.camera->set_exposure &&
              d.ops.camera->capture;
-    case PROCAM_FAMILY_TILT: return d.ops.tilt && d.ops.tilt->read;
-    case PROCAM_FAMILY_TRACKER: return d.ops.tracker && d.ops.tracker->read;
-    case PROCAM_FAMILY_OUTPUT: return d.ops.output && d.ops.output->get_mode && d.ops.output->show;
+    case PROCAM_FAMILY_TILT:
+      return d.ops.tilt && d.ops.tilt->read;
+    case PROCAM_FAMILY_TRACKER:
+      return d.ops.tracker && d.ops.tracker->read;
+    case PROCAM_FAMILY_OUTPUT:
+      return d.ops.output && d.ops.output->get_mode && d.ops.output->show;
   }
   return false;
 }
@@ -96,8 +107,7 @@ Result<Device> createDevice(const Driver& driver, DeviceDescription& desc,
   procam_config config{kv.empty() ? nullptr : kv.data(), kv.size()};
   procam_device out{};
   std::array<char, 512> err{};
-  const int rc =
-      driver.factory->create(&desc.view(), &config, &out, err.data(), err.size() - 1);
+  const int rc = driver.factory->create(&desc.view(), &config, &out, err.data(), err.size() - 1);
   const std::string who = std::string("driver '") + driver.factory->name + "'";
   if (rc != PROCAM_OK) {
     const std::string reason = err[0] ? std::string(err.data()) : "no reason given";

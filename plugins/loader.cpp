@@ -53,11 +53,11 @@ Result<std::vector<Driver>> loadSharedPlugin(const std::string& path) {
   std::shared_ptr<void> handle(dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL), DlCloser{});
   if (!handle) {
     const char* why = dlerror();
-    return fail(ErrorCode::kIo, "cannot load plugin " + path + ": " + (why ? why : "dlopen failed"));
+    return fail(ErrorCode::kIo,
+                "cannot load plugin " + path + ": " + (why ? why : "dlopen failed"));
   }
   // The version is plain data: reading it runs no plugin code.
-  const auto* abi =
-      static_cast<const uint32_t*>(dlsym(handle.get(), PROCAM_PLUGIN_ABI_SYMBOL));
+  const auto* abi = static_cast<const uint32_t*>(dlsym(handle.get(), PROCAM_PLUGIN_ABI_SYMBOL));
   if (!abi) {
     return fail(ErrorCode::kInvalidInput,
                 path + " is not a procamd plugin: no symbol " PROCAM_PLUGIN_ABI_SYMBOL);
@@ -88,8 +88,8 @@ std::vector<Driver> loadPluginDirectory(const std::string& dir, std::vector<Erro
     if (entry.path().extension() == ".so") paths.push_back(entry.path());
   }
   if (ec && ec != std::errc::no_such_file_or_directory) {
-    out_errors.push_back({ErrorCode::kIo, "cannot list plugin directory " + dir + ": " +
-                                              ec.message()});
+    out_errors.push_back(
+        {ErrorCode::kIo, "cannot list plugin directory " + dir + ": " + ec.message()});
   }
   std::sort(paths.begin(), paths.end());
   for (const auto& p : paths) {

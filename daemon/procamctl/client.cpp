@@ -35,16 +35,17 @@ tl::expected<Client, ClientError> Client::connect(const std::string& path,
   if (!banner) return tl::unexpected(banner.error());
   if (banner->value("class", "") == "ERROR") {
     const std::string code = banner->value("code", "");
-    return tl::unexpected(ClientError{kExitConnect, "procamd refused the connection: " +
-                                                        banner->value("message", code)});
+    return tl::unexpected(ClientError{
+        kExitConnect, "procamd refused the connection: " + banner->value("message", code)});
   }
   if (banner->value("class", "") != "VERSION" || !(*banner)["proto_major"].is_number_integer()) {
     return tl::unexpected(ClientError{kExitProtocol, "no VERSION banner from " + path});
   }
   if ((*banner)["proto_major"].get<int>() != daemon::proto::kMajor) {
     return tl::unexpected(ClientError{
-        kExitProtocol, "procamd speaks protocol " + std::to_string((*banner)["proto_major"].get<int>()) +
-                           ".x, this procamctl speaks " + std::to_string(daemon::proto::kMajor) + ".x"});
+        kExitProtocol,
+        "procamd speaks protocol " + std::to_string((*banner)["proto_major"].get<int>()) +
+            ".x, this procamctl speaks " + std::to_string(daemon::proto::kMajor) + ".x"});
   }
   c.banner_ = *banner;
   return c;
@@ -57,7 +58,8 @@ tl::expected<void, ClientError> Client::send(const json& request) {
     const ssize_t n = ::send(fd_.get(), line.data() + off, line.size() - off, MSG_NOSIGNAL);
     if (n < 0) {
       if (errno == EINTR) continue;
-      return tl::unexpected(ClientError{kExitProtocol, std::string("send: ") + std::strerror(errno)});
+      return tl::unexpected(
+          ClientError{kExitProtocol, std::string("send: ") + std::strerror(errno)});
     }
     off += static_cast<size_t>(n);
   }
@@ -72,7 +74,8 @@ tl::expected<json, ClientError> Client::next(std::chrono::milliseconds timeout) 
       if (item.oversized) continue;
       json j = json::parse(item.line, nullptr, false);
       if (j.is_discarded() || !j.is_object()) {
-        return tl::unexpected(ClientError{kExitProtocol, "procamd sent a line that is not a JSON object"});
+        return tl::unexpected(
+            ClientError{kExitProtocol, "procamd sent a line that is not a JSON object"});
       }
       return j;
     }

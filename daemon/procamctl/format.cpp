@@ -37,7 +37,7 @@ std::string pairList(const json& v) {
 
 std::string field(const char* name, const std::string& value) {
   char buf[48];
-  std::snprintf(buf, sizeof buf, "%-14s", (std::string(name) + ":").c_str());
+  std::snprintf(buf, sizeof buf, "%-15s", *name ? (std::string(name) + ":").c_str() : "");
   return buf + value + "\n";
 }
 
@@ -77,10 +77,12 @@ std::string progressBar(double fraction, int width, const std::string& stage) {
 
 std::string formatReply(const json& r) {
   const std::string cls = r.value("class", "");
-  if (cls == "ERROR") return "error (" + r.value("code", "") + "): " + r.value("message", "") + "\n";
+  if (cls == "ERROR")
+    return "error (" + r.value("code", "") + "): " + r.value("message", "") + "\n";
   if (cls == "VERSION") {
     return "procamd " + r.value("release", "") + ", protocol " + scalar(r["proto_major"]) + "." +
-           scalar(r["proto_minor"]) + ", plugin ABI " + scalar(r.value("plugin_abi", json())) + "\n";
+           scalar(r["proto_minor"]) + ", plugin ABI " + scalar(r.value("plugin_abi", json())) +
+           "\n";
   }
   if (cls == "STATUS") {
     std::string out = field("release", r.value("release", ""));

@@ -60,8 +60,7 @@ json buildRequest(const std::string& cmd, const std::vector<std::string>& a) {
     if (a.size() < lo || a.size() > hi) usage("wrong number of arguments for " + cmd);
   };
   json r = {{"cmd", cmd}};
-  if (cmd == "version" || cmd == "status" || cmd == "devices" || cmd == "save" ||
-      cmd == "reload") {
+  if (cmd == "version" || cmd == "status" || cmd == "devices" || cmd == "save" || cmd == "reload") {
     arity(0, 0);
   } else if (cmd == "cancel") {
     arity(0, 1);
@@ -153,8 +152,9 @@ int runOperation(const Options& o, procam::ctl::Client& c, const json& request) 
   auto on_event = [&](const json& e) {
     if (o.json) return print(o, e, true);
     if (e.value("event", "") != "progress" || !tty) return;
-    std::fprintf(stderr, "\r%s", procam::ctl::progressBar(e.value("fraction", 0.0), 30,
-                                                          e.value("stage", "")).c_str());
+    std::fprintf(
+        stderr, "\r%s",
+        procam::ctl::progressBar(e.value("fraction", 0.0), 30, e.value("stage", "")).c_str());
     bar_shown = true;
   };
   // Long operations: no reply timeout, the daemon reports progress.

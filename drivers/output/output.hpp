@@ -4,7 +4,6 @@
 // mock). Plain C++ interface; every implementation owns its handles (RAII).
 #include <cstdint>
 #include <functional>
-
 #include <opencv2/core.hpp>
 
 #include "core/error.hpp"

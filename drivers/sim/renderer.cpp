@@ -2,7 +2,9 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "sim/camera_response.hpp"
 
@@ -22,6 +24,19 @@ std::uint64_t mixSeed(std::uint64_t seed, std::string_view name) {
 }
 
 }  // namespace
+
+std::vector<Vec2> sampleOffsets(int supersamples) {
+  const int n = std::max(1, static_cast<int>(std::lround(std::sqrt(supersamples))));
+  std::vector<Vec2> offsets;
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      // Stratum (i, j) of the n x n grid, sub-cell (j, n - 1 - i) of its own n x n
+      // grid: every sample has its own column and row of the n^2 x n^2 grid.
+      offsets.emplace_back((i + (j + 0.5) / n) / n - 0.5, (j + (n - 1 - i + 0.5) / n) / n - 0.5);
+    }
+  }
+  return offsets;
+}
 
 void forEachRow(int rows, int threads, const std::function<void(int)>& body) {
   if (threads == 1) {
@@ -61,16 +76,17 @@ std::optional<Vec2> undistortFrom(const geom::Distortion& d, const Vec2& distort
 }  // namespace
 
 std::optional<geom::Ray> pixelRay(const geom::CameraModel& view, double x, double y,
-                                  Vec2* warm_start) {
+                                  Vec2* normalized) {
   const geom::Intrinsics& K = view.K;
   const double yn = (y - K.cy) / K.fy;
   Vec2 n((x - K.cx - K.skew * yn) / K.fx, yn);
   if (!view.dist.isZero()) {
-    const auto undistorted = undistortFrom(view.dist, n, warm_start ? *warm_start : n);
+    const bool warm = normalized && normalized->allFinite();
+    const auto undistorted = undistortFrom(view.dist, n, warm ? *normalized : n);
     if (!undistorted) return std::nullopt;
     n = *undistorted;
-    if (warm_start) *warm_start = n;
   }
+  if (normalized) *normalized = n;
   geom::Ray ray;
   ray.origin = view.pose.center();
   ray.dir = view.pose.R.transpose() * Vec3(n.x(), n.y(), 1.0).normalized();
@@ -102,7 +118,8 @@ Result<Renderer> Renderer::create(const Scene& scene, SceneState state,
   return r;
 }
 
-PixelTruth::Light Renderer::light(const Lamp& lamp, const Vec3& point, const Vec3& normal) const {
+PixelTruth::Light Renderer::light(const Lamp& lamp, const Vec3& point, const Vec3& normal,
+                                  int surface) const {
   PixelTruth::Light out;
   const Vec3 h = lamp.P * point.homogeneous();
   if (!(h.z() > 0)) return out;
@@ -119,7 +136,7 @@ PixelTruth::Light Renderer::light(const Lamp& lamp, const Vec3& point, const Vec
   geom::Ray shadow;
   shadow.origin = lamp.center;
   shadow.dir = -to_lamp / out.distance;
-  out.lit = !scene_->world().occluded(shadow, out.distance * (1.0 - 1e-7));
+  out.lit = !scene_->world().occluded(shadow, out.distance * (1.0 - 1e-7), surface);
   return out;
 }
 
@@ -129,7 +146,7 @@ cv::Vec3f Renderer::radianceAlong(const geom::Ray& ray) const {
   cv::Vec3f irradiance = ambient_bgr_;
   for (const Lamp& lamp : lamps_) {
     if (!lamp.image) continue;
-    const PixelTruth::Light l = light(lamp, hit->hit.point, hit->hit.normal);
+    const PixelTruth::Light l = light(lamp, hit->hit.point, hit->hit.normal, hit->surface);
     if (!l.lit) continue;
     // Irradiance from a point source: I * cos(theta) / d^2 (seed §5.2.4).
     const double scale = state_.projectors[lamp.projector].spec.brightness * l.cos_incidence /
@@ -141,22 +158,23 @@ cv::Vec3f Renderer::radianceAlong(const geom::Ray& ray) const {
 
 cv::Mat Renderer::radianceImage(const geom::CameraModel& view, int supersamples,
                                 int threads) const {
-  const int n = std::max(1, static_cast<int>(std::lround(std::sqrt(supersamples))));
-  const float weight = 1.f / static_cast<float>(n * n);
+  const std::vector<Vec2> offsets = sampleOffsets(supersamples);
+  const float weight = 1.f / static_cast<float>(offsets.size());
   cv::Mat out(view.height, view.width, CV_32FC3);
   forEachRow(view.height, threads, [&](int y) {
     cv::Vec3f* row = out.ptr<cv::Vec3f>(y);
-    Vec2 warm(-view.K.cx / view.K.fx, (y - view.K.cy) / view.K.fy);  // near the first sample
+    // Undistorted positions of each sample in the previous two pixels: their linear
+    // extrapolation starts the inversion for this pixel (one Newton step suffices).
+    const Vec2 none = Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
+    std::vector<Vec2> last(offsets.size(), none), before(offsets.size(), none);
     for (int x = 0; x < view.width; ++x) {
       cv::Vec3f sum(0.f, 0.f, 0.f);
-      // Stratified: one sample at the centre of each of n x n strata of the pixel
-      // [x - 0.5, x + 0.5) x [y - 0.5, y + 0.5).
-      for (int j = 0; j < n; ++j) {
-        for (int i = 0; i < n; ++i) {
-          const double sx = x - 0.5 + (i + 0.5) / n;
-          const double sy = y - 0.5 + (j + 0.5) / n;
-          if (const auto ray = pixelRay(view, sx, sy, &warm)) sum += radianceAlong(*ray);
-        }
+      for (std::size_t k = 0; k < offsets.size(); ++k) {
+        Vec2 n = before[k].allFinite() ? Vec2(2 * last[k] - before[k]) : last[k];
+        const auto ray = pixelRay(view, x + offsets[k].x(), y + offsets[k].y(), &n);
+        before[k] = last[k];
+        last[k] = ray ? n : none;
+        if (ray) sum += radianceAlong(*ray);
       }
       row[x] = sum * weight;
     }
@@ -167,19 +185,26 @@ cv::Mat Renderer::radianceImage(const geom::CameraModel& view, int supersamples,
 Result<cv::Mat> Renderer::cameraRadiance(std::string_view camera, int threads) const {
   const CameraState* cam = state_.camera(camera);
   if (!cam) return fail(ErrorCode::kNotFound, "no camera named '" + std::string(camera) + "'");
-  return radianceImage(cam->model, cam->spec.supersamples, threads);
+  cv::Mat radiance = radianceImage(cam->model, cam->spec.supersamples, threads);
+  if (cam->spec.psf_sigma_px > 0) {
+    // Lens point spread, applied to light (linear) before the sensor.
+    cv::GaussianBlur(radiance, radiance, cv::Size(0, 0), cam->spec.psf_sigma_px,
+                     cam->spec.psf_sigma_px, cv::BORDER_REPLICATE);
+  }
+  return radiance;
 }
 
 Result<cv::Mat> Renderer::renderCamera(std::string_view camera,
                                        const RenderOptions& options) const {
   const CameraState* cam = state_.camera(camera);
   if (!cam) return fail(ErrorCode::kNotFound, "no camera named '" + std::string(camera) + "'");
-  const cv::Mat radiance = radianceImage(cam->model, cam->spec.supersamples, options.threads);
+  auto radiance = cameraRadiance(camera, options.threads);
+  if (!radiance) return tl::unexpected(radiance.error());
   const CameraResponse response(cam->spec, options.noise);
   cv::Mat out(cam->model.height, cam->model.width, response.outputType());
   const std::uint64_t seed = mixSeed(options.seed, cam->spec.name);
   forEachRow(out.rows, options.threads, [&](int y) {
-    response.convertRow(radiance.ptr<cv::Vec3f>(y), y, seed, out);
+    response.convertRow(radiance->ptr<cv::Vec3f>(y), y, seed, out);
   });
   return out;
 }
@@ -198,7 +223,8 @@ PixelTruth Renderer::truthAt(const geom::CameraModel& view, const Vec2& pixel) c
   truth.surface = hit->surface;
   truth.point = hit->hit.point;
   truth.normal = hit->hit.normal;
-  for (const Lamp& lamp : lamps_) truth.projectors.push_back(light(lamp, truth.point, truth.normal));
+  for (const Lamp& lamp : lamps_)
+    truth.projectors.push_back(light(lamp, truth.point, truth.normal, truth.surface));
   return truth;
 }
 

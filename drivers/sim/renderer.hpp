@@ -1,6 +1,6 @@
 #pragma once
 // What the rig's cameras (and a viewer) see while the projectors show given
-// framebuffers. Per camera pixel n*n stratified samples (stratum centres):
+// framebuffers. Per camera pixel n*n stratified samples (sampleOffsets below):
 // ray -> nearest surface -> every projector lighting that point with a clear line of
 // sight -> its framebuffer (gamma, footprint, bilinear) -> albedo * (ambient +
 // brightness * cos / d^2) -> the camera's signal chain (camera_response.hpp).
@@ -88,7 +88,8 @@ class Renderer {
   };
 
   Renderer(const Scene& scene, SceneState state) : scene_(&scene), state_(std::move(state)) {}
-  PixelTruth::Light light(const Lamp& lamp, const Vec3& point, const Vec3& normal) const;
+  PixelTruth::Light light(const Lamp& lamp, const Vec3& point, const Vec3& normal,
+                          int surface) const;
   cv::Mat radianceImage(const geom::CameraModel& view, int supersamples, int threads) const;
 
   const Scene* scene_;
@@ -99,10 +100,17 @@ class Renderer {
 };
 
 // Pixel -> world ray through a (possibly distorted) pinhole; nullopt if the
-// distortion cannot be inverted there. `warm_start` (optional, in/out) carries the
-// undistorted normalised point of a nearby pixel to speed up the inversion.
+// distortion cannot be inverted there. `normalized` (optional, in/out): in, a guess
+// of the undistorted normalised point (ignored unless finite), e.g. extrapolated
+// from neighbouring pixels; out, the undistorted normalised point.
 std::optional<geom::Ray> pixelRay(const geom::CameraModel& view, double x, double y,
-                                  Vec2* warm_start = nullptr);
+                                  Vec2* normalized = nullptr);
+
+// Sample positions inside a pixel, relative to its centre, for n*n supersamples:
+// stratified (one per cell of an n x n grid) and rotated-grid (no two samples share
+// a row or column of the n^2 x n^2 sub-grid), symmetric under a half turn. For n = 2:
+// (-3/8, -1/8), (1/8, -3/8), (-1/8, 3/8), (3/8, 1/8).
+std::vector<Vec2> sampleOffsets(int supersamples);
 
 // Runs body(row) for rows [0, rows) on `threads` threads (0: all cores).
 void forEachRow(int rows, int threads, const std::function<void(int)>& body);

@@ -51,6 +51,7 @@ struct CameraSpec {
   double response_gamma = 1.0;  // output = linear^(1/response_gamma)
   int channels = 1;             // 1 (luminance) or 3 (BGR, OpenCV order)
   int supersamples = 4;         // n*n stratified samples per pixel, n >= 2
+  double psf_sigma_px = 0.0;    // lens blur: Gaussian point spread, camera pixels
   int maxDn() const { return (1 << bit_depth) - 1; }
   double electronsPerDn() const { return full_well_e / maxDn(); }  // at gain 1
 };

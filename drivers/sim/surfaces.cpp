@@ -40,10 +40,14 @@ std::optional<SurfaceHit> World::intersect(const geom::Ray& ray, geom::RayRange 
   return best;
 }
 
-bool World::occluded(const geom::Ray& ray, double t_max) const {
+bool World::occluded(const geom::Ray& ray, double t_max, int on_surface) const {
   const geom::RayRange range{1e-9, t_max};
-  for (const auto& surface : surfaces_) {
-    if (intersectShape(surface.shape, ray, range)) return true;
+  for (std::size_t i = 0; i < surfaces_.size(); ++i) {
+    const Shape& shape = surfaces_[i].shape;
+    if (static_cast<int>(i) == on_surface &&
+        (std::holds_alternative<geom::Plane>(shape) || std::holds_alternative<geom::Rectangle>(shape)))
+      continue;
+    if (intersectShape(shape, ray, range)) return true;
   }
   return false;
 }

@@ -41,8 +41,10 @@ class World {
   explicit World(std::vector<Surface> surfaces) : surfaces_(std::move(surfaces)) {}
 
   std::optional<SurfaceHit> intersect(const geom::Ray& ray, geom::RayRange range = {}) const;
-  // True when anything lies on the ray strictly between t_min and t_max.
-  bool occluded(const geom::Ray& ray, double t_max) const;
+  // True when anything lies on the ray strictly between t_min and t_max. A planar
+  // surface cannot shadow its own points: `on_surface` (the index of the surface the
+  // ray ends on, or -1) is skipped when it is a plane or a rectangle.
+  bool occluded(const geom::Ray& ray, double t_max, int on_surface = -1) const;
 
   const std::vector<Surface>& surfaces() const { return surfaces_; }
 

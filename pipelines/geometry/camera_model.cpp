@@ -6,7 +6,9 @@
 namespace procam::geom {
 namespace {
 
-bool finite(const Vec2& v) { return std::isfinite(v.x()) && std::isfinite(v.y()); }
+bool finite(const Vec2& v) {
+  return std::isfinite(v.x()) && std::isfinite(v.y());
+}
 
 // Jacobian of Distortion::apply at a normalised point (2x2).
 Eigen::Matrix2d distortionJacobian(const Distortion& d, const Vec2& p) {
@@ -24,8 +26,8 @@ Eigen::Matrix2d distortionJacobian(const Distortion& d, const Vec2& p) {
 }
 
 bool validIntrinsics(const Intrinsics& K) {
-  return std::isfinite(K.fx) && std::isfinite(K.fy) && std::isfinite(K.cx) &&
-         std::isfinite(K.cy) && std::isfinite(K.skew) && K.fx != 0 && K.fy != 0;
+  return std::isfinite(K.fx) && std::isfinite(K.fy) && std::isfinite(K.cx) && std::isfinite(K.cy) &&
+         std::isfinite(K.skew) && K.fx != 0 && K.fy != 0;
 }
 
 // Pixel -> distorted normalised coordinates (inverse of the affine K).
@@ -160,7 +162,9 @@ std::optional<Vec2> projectWith(const Mat34& P, const Vec3& world) {
   return p;
 }
 
-Mat34 CameraModel::projectionMatrix() const { return geom::projectionMatrix(K, pose); }
+Mat34 CameraModel::projectionMatrix() const {
+  return geom::projectionMatrix(K, pose);
+}
 
 std::optional<Vec2> CameraModel::project(const Vec3& world) const {
   const Vec3 d = pose.toDevice(world);

@@ -1,15 +1,13 @@
 #include "geometry/homography.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
-#include <Eigen/QR>
-#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
 #include <vector>
 
+#include "geometry/decompositions.hpp"
 #include "geometry/levenberg_marquardt.hpp"
 #include "geometry/normalization.hpp"
 
@@ -61,14 +59,15 @@ Result<void> checkSide(const std::vector<Vec2>& pts, const char* side) {
   }
   if (distinct.size() == 4 &&
       anyThreeCollinear({distinct[0], distinct[1], distinct[2], distinct[3]}, kCollinearShape)) {
-    return fail(ErrorCode::kDegenerate,
-                std::string("homography: three of the four distinct ") + side +
-                    " points are collinear");
+    return fail(ErrorCode::kDegenerate, std::string("homography: three of the four distinct ") +
+                                            side + " points are collinear");
   }
-  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
-  for (const Vec2& p : pts) cov += p * p.transpose();  // centroid is 0 after normalisation
-  const Eigen::Vector2d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cov).eigenvalues();
-  if (!(ev(0) > kCollinearShape * kCollinearShape * ev(1))) {
+  // Principal spreads (singular values of the centred points; the centroid is 0
+  // after normalisation): the smaller one vanishes when all points are on a line.
+  Eigen::MatrixXd centred(pts.size(), 2);
+  for (std::size_t i = 0; i < pts.size(); ++i) centred.row(Eigen::Index(i)) = pts[i].transpose();
+  const Eigen::VectorXd sv = detail::singularValues(centred);
+  if (!(sv(1) > kCollinearShape * sv(0))) {
     return fail(ErrorCode::kDegenerate,
                 std::string("homography: all ") + side + " points are collinear");
   }
@@ -108,32 +107,21 @@ struct Dlt {
   double condition;
 };
 
-// Null vector of the 2n x 9 DLT system. The tall system is first reduced by a
-// Householder QR (same singular values, no squaring of the condition number as
-// with the normal equations), then the 9x9 triangle goes through a Jacobi SVD.
+// Null vector of the 2n x 9 DLT system (HZ Algorithm 4.2); condition is σ1/σ8.
 Dlt solveDlt(const Normalized& n) {
-  const Eigen::Index rows = 2 * Eigen::Index(n.s.size());
-  Eigen::MatrixXd A(std::max<Eigen::Index>(rows, 9), 9);
-  A.setZero();
+  Eigen::MatrixXd A(2 * Eigen::Index(n.s.size()), 9);
   for (std::size_t i = 0; i < n.s.size(); ++i) {
     const double x = n.s[i].x(), y = n.s[i].y(), u = n.d[i].x(), v = n.d[i].y();
     const Eigen::Index r = 2 * Eigen::Index(i);
     A.row(r) << 0, 0, 0, -x, -y, -1, v * x, v * y, v;
     A.row(r + 1) << x, y, 1, 0, 0, 0, -u * x, -u * y, -u;
   }
-  Eigen::MatrixXd R;
-  if (A.rows() > 9) {
-    Eigen::HouseholderQR<Eigen::MatrixXd> qr(A);
-    R = qr.matrixQR().topRows(9).triangularView<Eigen::Upper>();
-  } else {
-    R = A.topRows(9);
-  }
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(R, Eigen::ComputeFullV);
-  const Eigen::VectorXd h = svd.matrixV().col(8);
-  const auto& sv = svd.singularValues();
+  const detail::NullVector nv = detail::smallestRightSingularVector(A);
+  const Eigen::VectorXd& h = nv.v;
   Dlt out;
   out.Hn << h(0), h(1), h(2), h(3), h(4), h(5), h(6), h(7), h(8);
-  out.condition = sv(7) > 0 ? sv(0) / sv(7) : std::numeric_limits<double>::infinity();
+  out.condition = nv.singular(7) > 0 ? nv.singular(0) / nv.singular(7)
+                                     : std::numeric_limits<double>::infinity();
   return out;
 }
 
@@ -165,20 +153,18 @@ std::optional<double> transferRms(const Mat3& H, std::span<const Vec2> src,
 // Dst-side geometric error in the normalised frames (a uniform scaling of the pixel
 // error, so its minimiser is the ML estimate). H = H0 + B·δ with B an orthonormal
 // basis of the tangent space of ||H|| = const at H0: 8 parameters, no gauge freedom.
-struct TransferFunctor : Eigen::DenseFunctor<double> {
+struct TransferError {
   const Normalized& n;
   Vec9 h0;
-  Eigen::Matrix<double, 9, 8> B;
+  Eigen::Matrix<double, 9, 8> B;  // fixed size: the per-point products stay inlined
 
-  TransferFunctor(const Normalized& norm, const Mat3& H0)
-      : DenseFunctor<double>(8, 2 * int(norm.s.size())), n(norm) {
+  TransferError(const Normalized& norm, const Mat3& H0) : n(norm) {
     for (int r = 0; r < 3; ++r) h0.segment<3>(3 * r) = H0.row(r).transpose();
     h0.normalize();
-    const Eigen::MatrixXd Q = Eigen::MatrixXd(h0).householderQr().householderQ();
-    B = Q.rightCols(8);
+    B = detail::orthogonalComplement(h0);
   }
 
-  Mat3 matrixAt(const InputType& delta) const {
+  Mat3 matrixAt(const Eigen::VectorXd& delta) const {
     const Vec9 h = h0 + B * delta;
     Mat3 H;
     H << h(0), h(1), h(2), h(3), h(4), h(5), h(6), h(7), h(8);
@@ -191,7 +177,7 @@ struct TransferFunctor : Eigen::DenseFunctor<double> {
     return std::abs(w) < kTiny ? (w < 0 ? -kTiny : kTiny) : w;
   }
 
-  int operator()(const InputType& delta, ValueType& f) const {
+  void residual(const Eigen::VectorXd& delta, Eigen::VectorXd& f) const {
     const Mat3 H = matrixAt(delta);
     for (std::size_t i = 0; i < n.s.size(); ++i) {
       const Vec3 q = H * n.s[i].homogeneous();
@@ -199,10 +185,9 @@ struct TransferFunctor : Eigen::DenseFunctor<double> {
       f(2 * i) = q.x() / w - n.d[i].x();
       f(2 * i + 1) = q.y() / w - n.d[i].y();
     }
-    return 0;
   }
 
-  int df(const InputType& delta, JacobianType& J) const {
+  void jacobian(const Eigen::VectorXd& delta, Eigen::MatrixXd& J) const {
     const Mat3 H = matrixAt(delta);
     Eigen::Matrix<double, 2, 9> Jh;
     for (std::size_t i = 0; i < n.s.size(); ++i) {
@@ -214,15 +199,13 @@ struct TransferFunctor : Eigen::DenseFunctor<double> {
       Jh.block<1, 3>(0, 6) = -q.x() / (w * w) * p.transpose();
       Jh.block<1, 3>(1, 3) = p.transpose() / w;
       Jh.block<1, 3>(1, 6) = -q.y() / (w * w) * p.transpose();
-      J.middleRows<2>(2 * Eigen::Index(i)) = Jh * B;
+      J.middleRows(2 * Eigen::Index(i), 2) = Jh * B;
     }
-    return 0;
   }
 };
 
-Result<HomographyFit> finish(const Normalized& n, const Mat3& Hn, double condition,
-                             int iterations, std::span<const Vec2> src,
-                             std::span<const Vec2> dst) {
+Result<HomographyFit> finish(const Normalized& n, const Mat3& Hn, double condition, int iterations,
+                             std::span<const Vec2> src, std::span<const Vec2> dst) {
   const Mat3 H = canonical(denormalize(n, Hn));
   if (!H.allFinite()) {
     return fail(ErrorCode::kIllConditioned, "homography: result not representable");
@@ -246,16 +229,21 @@ Result<double> checkedCondition(const Dlt& dlt, const HomographyOptions& options
 
 // LM from Hn0 in the normalised frames; keeps Hn0 if LM does not improve it.
 std::pair<Mat3, int> refineNormalized(const Normalized& n, const Mat3& Hn0, int max_iterations) {
-  TransferFunctor functor(n, Hn0);
+  const TransferError error(n, Hn0);
+  detail::LeastSquaresProblem problem;
+  problem.parameters = 8;
+  problem.residuals = 2 * int(n.s.size());
+  problem.residual = [&](const Eigen::VectorXd& x, Eigen::VectorXd& f) { error.residual(x, f); };
+  problem.jacobian = [&](const Eigen::VectorXd& x, Eigen::MatrixXd& J) { error.jacobian(x, J); };
   Eigen::VectorXd delta = Eigen::VectorXd::Zero(8);
-  Eigen::VectorXd f0(functor.values()), f1(functor.values());
-  functor(delta, f0);
-  const auto outcome = detail::runLevenbergMarquardt(functor, delta, max_iterations);
-  functor(delta, f1);
+  Eigen::VectorXd f0(problem.residuals), f1(problem.residuals);
+  error.residual(delta, f0);
+  const auto outcome = detail::runLevenbergMarquardt(problem, delta, max_iterations);
+  error.residual(delta, f1);
   if (!delta.allFinite() || !(f1.squaredNorm() <= f0.squaredNorm())) {
     return {detail::unitFrobenius(Hn0), outcome.iterations};
   }
-  return {functor.matrixAt(delta), outcome.iterations};
+  return {error.matrixAt(delta), outcome.iterations};
 }
 
 }  // namespace
@@ -277,14 +265,13 @@ Result<Mat3> homographyFrom4(const std::array<Vec2, 4>& src, const std::array<Ve
   // Closed form: the projective basis {e1, e2, e3, (1,1,1)} is mapped to each quad
   // (M = [λ1 p1, λ2 p2, λ3 p3] with M·1 = p4), then H = M_dst · M_src⁻¹. Done in
   // Hartley-normalised coordinates for conditioning.
-  auto basis = [](const std::array<Vec2, 4>& p,
-                  const Similarity<2>& T) -> std::optional<Mat3> {
+  auto basis = [](const std::array<Vec2, 4>& p, const Similarity<2>& T) -> std::optional<Mat3> {
     std::array<Vec2, 4> q;
     for (int i = 0; i < 4; ++i) q[i] = T.apply(p[i]);
     if (anyThreeCollinear(q, kCollinearShape)) return std::nullopt;
     Mat3 M;
     for (int i = 0; i < 3; ++i) M.col(i) = q[i].homogeneous();
-    const Vec3 lambda = M.partialPivLu().solve(q[3].homogeneous());
+    const Vec3 lambda = M.inverse() * q[3].homogeneous();  // M is well conditioned here
     return M * lambda.asDiagonal();
   };
   auto ts = detail::hartley<2>(src);

@@ -17,7 +17,7 @@ struct HomographyFit {
 };
 
 struct HomographyOptions {
-  bool refine = true;           // Levenberg-Marquardt on the dst-side geometric error
+  bool refine = true;  // Levenberg-Marquardt on the dst-side geometric error
   int max_iterations = 50;
   // Larger -> kIllConditioned. Exact data then gives H to ~cond·1e-16 relative; well
   // spread points give cond ~ 1e1..1e3 after normalisation.

@@ -1,33 +1,27 @@
 #pragma once
-// Internal to pipelines/geometry: runs Eigen's Levenberg-Marquardt (MINPACK lmder)
-// for at most `max_iterations` outer iterations on a functor deriving from
-// Eigen::DenseFunctor<double> with operator() and df().
-#include <unsupported/Eigen/LevenbergMarquardt>
+// Internal to pipelines/geometry: one instantiation of Eigen's Levenberg-Marquardt
+// (MINPACK lmder) shared by the estimators, driven through callbacks.
+#include <functional>
+
+#include "core/types.hpp"
 
 namespace procam::geom::detail {
+
+struct LeastSquaresProblem {
+  int parameters = 0;
+  int residuals = 0;
+  // f(x) -> residual vector (size `residuals`), J(x) -> residuals x parameters.
+  std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)> residual;
+  std::function<void(const Eigen::VectorXd&, Eigen::MatrixXd&)> jacobian;
+};
 
 struct LmOutcome {
   int iterations = 0;
   bool converged = false;  // stopped on a tolerance, not on the iteration limit
 };
 
-template <class Functor>
-LmOutcome runLevenbergMarquardt(Functor& functor, Eigen::VectorXd& x, int max_iterations) {
-  Eigen::LevenbergMarquardt<Functor> lm(functor);
-  lm.setXtol(1e-12);
-  lm.setFtol(1e-12);
-  lm.setMaxfev(10 * max_iterations + 10);
-  LmOutcome out;
-  auto status = lm.minimizeInit(x);
-  if (status == Eigen::LevenbergMarquardtSpace::ImproperInputParameters) return out;
-  do {
-    status = lm.minimizeOneStep(x);
-    ++out.iterations;
-  } while (status == Eigen::LevenbergMarquardtSpace::Running && out.iterations < max_iterations);
-  out.converged = status != Eigen::LevenbergMarquardtSpace::Running &&
-                  status != Eigen::LevenbergMarquardtSpace::TooManyFunctionEvaluation &&
-                  status != Eigen::LevenbergMarquardtSpace::UserAsked;
-  return out;
-}
+// Minimises |f(x)|² from x for at most max_iterations outer iterations.
+LmOutcome runLevenbergMarquardt(const LeastSquaresProblem& problem, Eigen::VectorXd& x,
+                                int max_iterations);
 
 }  // namespace procam::geom::detail

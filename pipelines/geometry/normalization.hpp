@@ -61,7 +61,7 @@ Result<Similarity<D>> hartley(std::span<const Eigen::Matrix<double, D, 1>> point
   k = 0;
   for (const auto& p : points) {
     k += 1;
-    mean_dist += ((p - c).stableNorm() - mean_dist) / k;
+    mean_dist += ((p - c).norm() - mean_dist) / k;  // |p - c| <= 2e100: no overflow
   }
   const double scale = std::sqrt(double(D)) / mean_dist;
   // All points (numerically) equal: no frame to normalise into. Relative to the

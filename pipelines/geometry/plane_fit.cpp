@@ -15,6 +15,8 @@ constexpr double kCollinearRatio = 1e-9;
 // Normal ambiguous when the two smallest extents coincide to this fraction of the
 // largest (e.g. points spread isotropically in 3D around a line).
 constexpr double kAmbiguousRatio = 1e-12;
+// Multiple of the coordinate rounding below which an extent counts as zero.
+constexpr double kRoundingFloor = 256;
 
 // Deterministic orientation: the largest-magnitude component of n is positive.
 Plane orient(Vec3 n, const Vec3& point_on_plane) {
@@ -37,10 +39,16 @@ Result<PlaneFit> fitSubset(std::span<const Vec3> points, std::vector<std::uint32
   }
   const Eigen::JacobiSVD<Eigen::MatrixX3d> svd(c, Eigen::ComputeFullV);
   const Vec3 s = svd.singularValues();
-  if (!s.allFinite() || !(s[0] > 0)) {
+  // Extents within the rounding noise of the coordinates (~eps * |x| per point)
+  // carry no shape information.
+  double max_abs = 0;
+  for (const std::uint32_t i : idx) max_abs = std::max(max_abs, points[i].cwiseAbs().maxCoeff());
+  const double noise = kRoundingFloor * std::numeric_limits<double>::epsilon() * max_abs *
+                       std::sqrt(static_cast<double>(idx.size()));
+  if (!s.allFinite() || !(s[0] > noise)) {
     return fail(ErrorCode::kDegenerate, "points coincide");
   }
-  if (!(s[1] > kCollinearRatio * s[0])) {
+  if (!(s[1] > kCollinearRatio * s[0]) || !(s[1] > noise)) {
     return fail(ErrorCode::kDegenerate, "points are collinear");
   }
   if (!(s[1] - s[2] > kAmbiguousRatio * s[0])) {

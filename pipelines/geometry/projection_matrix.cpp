@@ -1,14 +1,12 @@
 #include "geometry/projection_matrix.hpp"
 
-#include <Eigen/Eigenvalues>
-#include <Eigen/QR>
-#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
 #include <vector>
 
+#include "geometry/decompositions.hpp"
 #include "geometry/levenberg_marquardt.hpp"
 #include "geometry/normalization.hpp"
 
@@ -67,10 +65,10 @@ Result<Normalized> prepare(std::span<const Vec3> world, std::span<const Vec2> pi
   }
   // Principal spreads of the 3D points (centroid is 0 after normalisation). Points on
   // one plane leave P undetermined up to a family (seed §4.1.1): the fix is geometric.
-  Mat3 cov = Mat3::Zero();
-  for (const Vec3& X : n.X) cov += X * X.transpose();
-  const Vec3 ev = Eigen::SelfAdjointEigenSolver<Mat3>(cov).eigenvalues().cwiseMax(0.0);
-  const double ratio = std::sqrt(ev(0) / ev(2));
+  Eigen::MatrixXd centred(n.X.size(), 3);
+  for (std::size_t i = 0; i < n.X.size(); ++i) centred.row(Eigen::Index(i)) = n.X[i].transpose();
+  const Eigen::VectorXd spreads = detail::singularValues(centred);
+  const double ratio = spreads(2) / spreads(0);
   if (!(ratio >= options.coplanar_ratio)) {
     return fail(ErrorCode::kCoplanar,
                 "projection matrix: the 3D points are (nearly) coplanar (thickness/extent = " +
@@ -80,10 +78,10 @@ Result<Normalized> prepare(std::span<const Vec3> world, std::span<const Vec2> pi
   }
   // Image points all on one line: the camera centre lies in the points' plane or the
   // points are collinear; either way nothing is determined.
-  Eigen::Matrix2d cov2 = Eigen::Matrix2d::Zero();
-  for (const Vec2& x : n.x) cov2 += x * x.transpose();
-  const Eigen::Vector2d ev2 = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cov2).eigenvalues();
-  if (!(ev2(0) > 1e-18 * ev2(1))) {
+  Eigen::MatrixXd centred2(n.x.size(), 2);
+  for (std::size_t i = 0; i < n.x.size(); ++i) centred2.row(Eigen::Index(i)) = n.x[i].transpose();
+  const Eigen::VectorXd spreads2 = detail::singularValues(centred2);
+  if (!(spreads2(1) > 1e-9 * spreads2(0))) {
     return fail(ErrorCode::kDegenerate, "projection matrix: all image points are collinear");
   }
   return n;
@@ -94,11 +92,9 @@ struct Dlt {
   double condition;
 };
 
-// Null vector of the 2n x 12 DLT system via Householder QR then Jacobi SVD of the
-// 12x12 triangle (no normal equations). Condition is σ1/σ11.
+// Null vector of the 2n x 12 DLT system (HZ §7.1); condition is σ1/σ11.
 Dlt solveDlt(const Normalized& n) {
-  const Eigen::Index rows = 2 * Eigen::Index(n.X.size());
-  Eigen::Matrix<double, Eigen::Dynamic, 12> A(rows, 12);
+  Eigen::MatrixXd A(2 * Eigen::Index(n.X.size()), 12);
   for (std::size_t i = 0; i < n.X.size(); ++i) {
     const Vec4 X = n.X[i].homogeneous();
     const double u = n.x[i].x(), v = n.x[i].y();
@@ -106,38 +102,34 @@ Dlt solveDlt(const Normalized& n) {
     A.row(r) << Eigen::RowVector4d::Zero(), -X.transpose(), v * X.transpose();
     A.row(r + 1) << X.transpose(), Eigen::RowVector4d::Zero(), -u * X.transpose();
   }
-  Eigen::HouseholderQR<Eigen::Matrix<double, Eigen::Dynamic, 12>> qr(A);
-  const Eigen::Matrix<double, 12, 12> R = qr.matrixQR().topRows<12>().triangularView<Eigen::Upper>();
-  Eigen::JacobiSVD<Eigen::Matrix<double, 12, 12>> svd(R, Eigen::ComputeFullV);
-  const auto& sv = svd.singularValues();
+  const detail::NullVector nv = detail::smallestRightSingularVector(A);
   Dlt out;
-  out.Pn = fromVector(svd.matrixV().col(11));
-  out.condition = sv(10) > 0 ? sv(0) / sv(10) : std::numeric_limits<double>::infinity();
+  out.Pn = fromVector(Vec12(nv.v));
+  out.condition = nv.singular(10) > 0 ? nv.singular(0) / nv.singular(10)
+                                      : std::numeric_limits<double>::infinity();
   return out;
 }
 
 // Reprojection error in the normalised image frame (a uniform scaling of the pixel
 // error). P = P0 + B·δ with B spanning the tangent space of ||P|| = const: 11 parameters.
-struct ReprojectionFunctor : Eigen::DenseFunctor<double> {
+struct ReprojectionError {
   const Normalized& n;
   Vec12 p0;
-  Eigen::Matrix<double, 12, 11> B;
+  Eigen::Matrix<double, 12, 11> B;  // fixed size: the per-point products stay inlined
 
-  ReprojectionFunctor(const Normalized& norm, const Mat34& P0)
-      : DenseFunctor<double>(11, 2 * int(norm.X.size())), n(norm) {
+  ReprojectionError(const Normalized& norm, const Mat34& P0) : n(norm) {
     p0 = toVector(P0).normalized();
-    const Eigen::Matrix<double, 12, 12> Q = Vec12(p0).householderQr().householderQ();
-    B = Q.rightCols<11>();
+    B = detail::orthogonalComplement(p0);
   }
 
-  Mat34 matrixAt(const InputType& delta) const { return fromVector(p0 + B * delta); }
+  Mat34 matrixAt(const Eigen::VectorXd& delta) const { return fromVector(p0 + B * delta); }
 
   static double safeW(double w) {
     constexpr double kTiny = 1e-12;
     return std::abs(w) < kTiny ? (w < 0 ? -kTiny : kTiny) : w;
   }
 
-  int operator()(const InputType& delta, ValueType& f) const {
+  void residual(const Eigen::VectorXd& delta, Eigen::VectorXd& f) const {
     const Mat34 P = matrixAt(delta);
     for (std::size_t i = 0; i < n.X.size(); ++i) {
       const Vec3 q = P * n.X[i].homogeneous();
@@ -145,10 +137,9 @@ struct ReprojectionFunctor : Eigen::DenseFunctor<double> {
       f(2 * i) = q.x() / w - n.x[i].x();
       f(2 * i + 1) = q.y() / w - n.x[i].y();
     }
-    return 0;
   }
 
-  int df(const InputType& delta, JacobianType& J) const {
+  void jacobian(const Eigen::VectorXd& delta, Eigen::MatrixXd& J) const {
     const Mat34 P = matrixAt(delta);
     Eigen::Matrix<double, 2, 12> Jp;
     for (std::size_t i = 0; i < n.X.size(); ++i) {
@@ -160,23 +151,27 @@ struct ReprojectionFunctor : Eigen::DenseFunctor<double> {
       Jp.block<1, 4>(0, 8) = -q.x() / (w * w) * X.transpose();
       Jp.block<1, 4>(1, 4) = X.transpose() / w;
       Jp.block<1, 4>(1, 8) = -q.y() / (w * w) * X.transpose();
-      J.middleRows<2>(2 * Eigen::Index(i)) = Jp * B;
+      J.middleRows(2 * Eigen::Index(i), 2) = Jp * B;
     }
-    return 0;
   }
 };
 
 std::pair<Mat34, int> refine(const Normalized& n, const Mat34& Pn0, int max_iterations) {
-  ReprojectionFunctor functor(n, Pn0);
+  const ReprojectionError error(n, Pn0);
+  detail::LeastSquaresProblem problem;
+  problem.parameters = 11;
+  problem.residuals = 2 * int(n.X.size());
+  problem.residual = [&](const Eigen::VectorXd& x, Eigen::VectorXd& f) { error.residual(x, f); };
+  problem.jacobian = [&](const Eigen::VectorXd& x, Eigen::MatrixXd& J) { error.jacobian(x, J); };
   Eigen::VectorXd delta = Eigen::VectorXd::Zero(11);
-  Eigen::VectorXd f0(functor.values()), f1(functor.values());
-  functor(delta, f0);
-  const auto outcome = detail::runLevenbergMarquardt(functor, delta, max_iterations);
-  functor(delta, f1);
+  Eigen::VectorXd f0(problem.residuals), f1(problem.residuals);
+  error.residual(delta, f0);
+  const auto outcome = detail::runLevenbergMarquardt(problem, delta, max_iterations);
+  error.residual(delta, f1);
   if (!delta.allFinite() || !(f1.squaredNorm() <= f0.squaredNorm())) {
     return {detail::unitFrobenius(Pn0), outcome.iterations};
   }
-  return {functor.matrixAt(delta), outcome.iterations};
+  return {error.matrixAt(delta), outcome.iterations};
 }
 
 }  // namespace
@@ -242,9 +237,9 @@ Result<KRt> decomposeProjectionMatrix(const Mat34& P_in) {
   // RQ via QR of the row-reversed transpose: (E M)ᵀ = Q U  =>  M = (E Uᵀ E)(E Qᵀ).
   Mat3 E = Mat3::Zero();
   E(0, 2) = E(1, 1) = E(2, 0) = 1;
-  Eigen::HouseholderQR<Mat3> qr((E * M).transpose());
-  const Mat3 U = qr.matrixQR().triangularView<Eigen::Upper>();
-  const Mat3 Q = qr.householderQ();
+  Eigen::MatrixXd Qd, Ud;
+  detail::householderQr((E * M).transpose(), Qd, Ud);
+  const Mat3 U = Ud, Q = Qd;
   Mat3 K = E * U.transpose() * E;
   Mat3 R = E * Q.transpose();
   // Make the diagonal of K positive: K D, D R with D = diag(±1), D² = I.
@@ -259,8 +254,8 @@ Result<KRt> decomposeProjectionMatrix(const Mat34& P_in) {
   out.K = Intrinsics::fromMatrix(K);
   out.pose.R = R;
   out.pose.t = t;
-  if (!K.allFinite() || !R.allFinite() || !t.allFinite() || !(out.K.fx > 0) ||
-      !(out.K.fy > 0) || !std::isfinite(out.K.cx) || !std::isfinite(out.K.cy)) {
+  if (!K.allFinite() || !R.allFinite() || !t.allFinite() || !(out.K.fx > 0) || !(out.K.fy > 0) ||
+      !std::isfinite(out.K.cx) || !std::isfinite(out.K.cy)) {
     return fail(ErrorCode::kIllConditioned, "decompose: result not representable");
   }
   return out;

@@ -2,6 +2,7 @@
 
 #include <Eigen/SVD>
 #include <cmath>
+#include <limits>
 #include <string>
 
 namespace procam::geom {
@@ -12,6 +13,7 @@ namespace {
 // to ~eps / ratio^2. Sets thinner than this ratio of their two largest principal
 // extents (1e-10 on the covariance, i.e. rotation error <~ 1e-6) count as collinear.
 constexpr double kCollinearRatio = 1e-5;
+constexpr double kRoundingFloor = 256;
 
 Eigen::Matrix3Xd toMatrix(std::span<const Vec3> pts) {
   Eigen::Matrix3Xd m(3, static_cast<Eigen::Index>(pts.size()));
@@ -20,11 +22,14 @@ Eigen::Matrix3Xd toMatrix(std::span<const Vec3> pts) {
 }
 
 // Singular values of the centred set; the set spans a plane or more when the
-// second one is not negligible against the first.
+// second one is neither negligible against the first nor within the rounding noise
+// of the coordinates (~eps * |x| per point: a "width" of that size is no width).
 bool spansPlane(const Eigen::Matrix3Xd& m) {
   const Eigen::Matrix3Xd c = m.colwise() - m.rowwise().mean();
   const Vec3 s = Eigen::JacobiSVD<Eigen::Matrix3Xd>(c).singularValues();
-  return s[0] > 0 && s[1] > kCollinearRatio * s[0];
+  const double noise = kRoundingFloor * std::numeric_limits<double>::epsilon() *
+                       m.cwiseAbs().maxCoeff() * std::sqrt(static_cast<double>(m.cols()));
+  return s[0] > noise && s[1] > kCollinearRatio * s[0] && s[1] > noise;
 }
 
 }  // namespace

@@ -58,7 +58,7 @@ Result<TiltOutput> TiltFilter::update(const Vec3& f, double time) {
     still_start_ = time;
     still_sum_.setZero();
     still_count_ = 0;
-    refined_ = false;
+    next_refinement_ = options_.settle_time;
   }
 
   TiltOutput out;
@@ -74,8 +74,10 @@ Result<TiltOutput> TiltFilter::update(const Vec3& f, double time) {
   }
 
   bool publish = !published_ || angleBetween(*published_, out.filtered) > options_.hysteresis;
-  if (still_ && !refined_ && time - still_start_ >= options_.settle_time) {
-    refined_ = true;
+  // Refinements at settle_time x 1, 2, 4, ...: each halves the noise variance of the
+  // still mean, so a long hold converges with a logarithmic number of updates.
+  if (still_ && time - still_start_ >= next_refinement_) {
+    next_refinement_ *= 2;
     publish = true;
   }
   if (publish) published_ = out.filtered;

@@ -6,8 +6,8 @@
 //  - once still, a fresh mean of the raw samples replaces the low-pass output (white
 //    noise then falls as 1/sqrt(T) instead of staying at the filter's bandwidth);
 //  - hysteresis: the published vector changes only when it turns by more than
-//    `hysteresis` (a smaller change costs nothing downstream), plus one refinement
-//    publication after `settle_time` of stillness.
+//    `hysteresis` (a smaller change costs nothing downstream), plus refinement
+//    publications after 1, 2, 4, ... x `settle_time` of stillness.
 #include <optional>
 
 #include "core/error.hpp"
@@ -19,7 +19,7 @@ struct TiltFilterOptions {
   double cutoff_hz = 10;
   double still_threshold = 0.01;  // g
   double still_time = 0.3;        // s
-  double settle_time = 2.0;       // s of averaging before the refinement publication
+  double settle_time = 2.0;       // s of averaging before the first refinement
   double hysteresis = 0.5e-3;     // rad
 };
 
@@ -54,7 +54,7 @@ class TiltFilter {
   double still_start_ = 0;
   Vec3 still_sum_ = Vec3::Zero();
   long still_count_ = 0;
-  bool refined_ = false;
+  double next_refinement_ = 0;  // still time of the next refinement publication
   std::optional<Vec3> published_;
 };
 

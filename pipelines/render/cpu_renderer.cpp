@@ -8,8 +8,7 @@ Result<WarpMap> mainPathMap(const RenderSetup& setup) {
     case RenderPath::kHomography:
       return homographyMap(setup.homography, setup.output_size);
     case RenderPath::kTwoPassMesh:
-      return projectiveTextureMap(setup.surface, setup.projector, setup.viewer,
-                                  setup.output_size);
+      return projectiveTextureMap(setup.surface, setup.projector, setup.viewer, setup.output_size);
     case RenderPath::kLookupWarp:
       return gridMap(setup.lookup, setup.output_size);
     case RenderPath::kPlanar3d:

@@ -25,8 +25,8 @@ class CpuRenderer final : public Renderer {
   RenderSetup setup_;
   WarpMap map_;
   PackedMap packed_;
-  PackedMap post_;        // empty unless setup.post_warp
-  cv::Mat stage_;         // main-path image when a post-render warp follows
+  PackedMap post_;  // empty unless setup.post_warp
+  cv::Mat stage_;   // main-path image when a post-render warp follows
   cv::Mat frame_;
   FrameGate gate_;
   RemapKernel kernel_ = RemapKernel::kBest;

@@ -9,7 +9,6 @@
 //   out = output_lut[c][v_c]
 #include <array>
 #include <cstdint>
-
 #include <opencv2/core.hpp>
 
 #include "core/error.hpp"
@@ -19,8 +18,8 @@ namespace procam::render {
 using Lut = std::array<uint8_t, 256>;
 
 struct FinalStage {
-  cv::Mat alpha;                    // CV_8UC1 of the output size; empty = all 255
-  Lut weight_lut = identityLut();   // alpha code -> weight code
+  cv::Mat alpha;                   // CV_8UC1 of the output size; empty = all 255
+  Lut weight_lut = identityLut();  // alpha code -> weight code
   std::array<Lut, 3> output_lut = {identityLut(), identityLut(), identityLut()};
 
   static Lut identityLut();

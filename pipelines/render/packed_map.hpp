@@ -3,9 +3,8 @@
 // top-left texel of its 2x2 bilinear footprint and the sub-pixel position in 1/128 px.
 // Compiling moves every branch (footprint test, edge clamping) out of the per-frame loop.
 #include <cstdint>
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "core/error.hpp"
 #include "render/warp_map.hpp"

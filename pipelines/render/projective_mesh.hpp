@@ -4,9 +4,8 @@
 // and the mesh is seen from the projector. For a fixed mesh, projector and viewer this is
 // a fixed map from projector pixels to desired-image pixels, built here in double.
 #include <array>
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "core/error.hpp"
 #include "core/types.hpp"

@@ -66,14 +66,14 @@ void rowSse2(const uint8_t* src, size_t src_step, const PackedMap& m, size_t k0,
     const uint8_t* p1 = p0 + src_step;
     // Interleave the two texels of a row channel by channel (r0 r1 g0 g1 ...), widen to
     // 16 bits and let madd form p0 * w0 + p1 * w1 per channel in 32 bits.
-    const __m128i top = _mm_unpacklo_epi8(
-        _mm_unpacklo_epi8(_mm_cvtsi32_si128(static_cast<int>(loadPixel(p0))),
-                          _mm_cvtsi32_si128(static_cast<int>(loadPixel(p0 + 4)))),
-        zero);
-    const __m128i bottom = _mm_unpacklo_epi8(
-        _mm_unpacklo_epi8(_mm_cvtsi32_si128(static_cast<int>(loadPixel(p1))),
-                          _mm_cvtsi32_si128(static_cast<int>(loadPixel(p1 + 4)))),
-        zero);
+    const __m128i top =
+        _mm_unpacklo_epi8(_mm_unpacklo_epi8(_mm_cvtsi32_si128(static_cast<int>(loadPixel(p0))),
+                                            _mm_cvtsi32_si128(static_cast<int>(loadPixel(p0 + 4)))),
+                          zero);
+    const __m128i bottom =
+        _mm_unpacklo_epi8(_mm_unpacklo_epi8(_mm_cvtsi32_si128(static_cast<int>(loadPixel(p1))),
+                                            _mm_cvtsi32_si128(static_cast<int>(loadPixel(p1 + 4)))),
+                          zero);
     const Weights w = weights(fxs[x], fys[x]);
     const __m128i wt = _mm_set1_epi32(w.w00 | (w.w01 << 16));
     const __m128i wb = _mm_set1_epi32(w.w10 | (w.w11 << 16));
@@ -89,8 +89,7 @@ void rowSse2(const uint8_t* src, size_t src_step, const PackedMap& m, size_t k0,
 
 }  // namespace
 
-Result<void> remapRgba(const cv::Mat& src, const PackedMap& map, cv::Mat& dst,
-                       RemapKernel kernel) {
+Result<void> remapRgba(const cv::Mat& src, const PackedMap& map, cv::Mat& dst, RemapKernel kernel) {
   if (src.type() != CV_8UC4 || src.size() != map.source_size ||
       static_cast<int>(src.step) != map.source_step) {
     return fail(ErrorCode::kInvalidInput,
@@ -110,19 +109,22 @@ Result<void> remapRgba(const cv::Mat& src, const PackedMap& map, cv::Mat& dst,
   (void)kernel;
 #endif
   // Stripes of rows; OpenCV's pool uses every core.
-  cv::parallel_for_(cv::Range(0, map.output_size.height), [&](const cv::Range& rows) {
-    for (int y = rows.start; y < rows.end; ++y) {
-      const size_t k0 = static_cast<size_t>(y) * width;
-      uint8_t* out = dst.ptr<uint8_t>(y);
+  cv::parallel_for_(
+      cv::Range(0, map.output_size.height),
+      [&](const cv::Range& rows) {
+        for (int y = rows.start; y < rows.end; ++y) {
+          const size_t k0 = static_cast<size_t>(y) * width;
+          uint8_t* out = dst.ptr<uint8_t>(y);
 #if defined(__SSE2__)
-      if (simd) {
-        rowSse2(s, step, map, k0, width, out);
-        continue;
-      }
+          if (simd) {
+            rowSse2(s, step, map, k0, width, out);
+            continue;
+          }
 #endif
-      rowScalar(s, step, map, k0, width, out);
-    }
-  }, 16);
+          rowScalar(s, step, map, k0, width, out);
+        }
+      },
+      16);
   return {};
 }
 

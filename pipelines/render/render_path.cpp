@@ -18,8 +18,8 @@ Result<PathChoice> choosePath(const SceneTraits& scene) {
       c.post_warp = false;
       return c;
     case SurfaceKind::kNonPlanar:
-      c.path = scene.viewer == ViewerKind::kTracked ? RenderPath::kTwoPassMesh
-                                                    : RenderPath::kLookupWarp;
+      c.path =
+          scene.viewer == ViewerKind::kTracked ? RenderPath::kTwoPassMesh : RenderPath::kLookupWarp;
       // The measured lookup warp already maps to the exact illuminated pixels (§4.1.5).
       if (c.path == RenderPath::kLookupWarp) c.post_warp = false;
       return c;
@@ -32,10 +32,14 @@ Result<PathChoice> choosePath(const SceneTraits& scene) {
 
 const char* toString(RenderPath path) {
   switch (path) {
-    case RenderPath::kHomography: return "homography";
-    case RenderPath::kPlanar3d: return "planar-3d";
-    case RenderPath::kTwoPassMesh: return "two-pass-mesh";
-    case RenderPath::kLookupWarp: return "lookup-warp";
+    case RenderPath::kHomography:
+      return "homography";
+    case RenderPath::kPlanar3d:
+      return "planar-3d";
+    case RenderPath::kTwoPassMesh:
+      return "two-pass-mesh";
+    case RenderPath::kLookupWarp:
+      return "lookup-warp";
   }
   return "unknown";
 }

@@ -3,7 +3,9 @@
 namespace procam::render {
 namespace {
 
-bool validSize(cv::Size s) { return s.width > 0 && s.height > 0; }
+bool validSize(cv::Size s) {
+  return s.width > 0 && s.height > 0;
+}
 
 }  // namespace
 
@@ -32,8 +34,8 @@ Result<void> validateSetup(const RenderSetup& s) {
       if (!s.planar3d.allFinite()) return fail(ErrorCode::kInvalidInput, "setup: non-finite A'P_T");
       break;
   }
-  if (!s.final_stage.alpha.empty() && (s.final_stage.alpha.type() != CV_8UC1 ||
-                                       s.final_stage.alpha.size() != s.output_size)) {
+  if (!s.final_stage.alpha.empty() &&
+      (s.final_stage.alpha.type() != CV_8UC1 || s.final_stage.alpha.size() != s.output_size)) {
     return fail(ErrorCode::kInvalidInput, "setup: alpha mask must be CV_8UC1 of the output size");
   }
   return {};

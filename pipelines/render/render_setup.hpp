@@ -3,10 +3,9 @@
 // (this struct) changes rarely; content changes every frame.
 #include <array>
 #include <cstdint>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "core/error.hpp"
 #include "core/types.hpp"
@@ -31,28 +30,28 @@ struct RenderSetup {
 
   Mat3 homography = Mat3::Identity();  // kHomography: projector pixel ~ H * content pixel
 
-  SurfaceMesh surface;                 // kTwoPassMesh: display surface (world)
-  Mat34 projector = Mat34::Zero();     // kTwoPassMesh: world -> projector pixels
-  Mat34 viewer = Mat34::Zero();        // kTwoPassMesh: world -> content (desired image) pixels
+  SurfaceMesh surface;              // kTwoPassMesh: display surface (world)
+  Mat34 projector = Mat34::Zero();  // kTwoPassMesh: world -> projector pixels
+  Mat34 viewer = Mat34::Zero();     // kTwoPassMesh: world -> content (desired image) pixels
 
-  WarpGrid lookup;                     // kLookupWarp: projector pixel -> content pixel
+  WarpGrid lookup;  // kLookupWarp: projector pixel -> content pixel
 
   // kPlanar3d: world -> homogeneous projector pixels with depth, (x w, y w, z w, w) and
   // z in [-1, 1] for visible depths: A'4x4 P_T of seed eq. 4.10 in this project's pixel
   // convention (its clip-space form comes from glConventions()).
   Mat4 planar3d = Mat4::Identity();
 
-  std::optional<WarpGrid> post_warp;   // §4.1.3: output pixel -> pixel of the rendered image
-  FinalStage final_stage;              // §4.1.2: alpha mask and LUTs, always last
+  std::optional<WarpGrid> post_warp;  // §4.1.3: output pixel -> pixel of the rendered image
+  FinalStage final_stage;             // §4.1.2: alpha mask and LUTs, always last
 };
 
 // Checks sizes, finiteness and that the path's inputs are present.
 Result<void> validateSetup(const RenderSetup& setup);
 
 struct Content {
-  const cv::Mat* image = nullptr;       // CV_8UC4 of content_size (image paths)
-  const ColoredMesh* mesh = nullptr;    // kPlanar3d
-  uint64_t version = 0;                 // changes whenever the content changes
+  const cv::Mat* image = nullptr;     // CV_8UC4 of content_size (image paths)
+  const ColoredMesh* mesh = nullptr;  // kPlanar3d
+  uint64_t version = 0;               // changes whenever the content changes
 };
 
 // Skips frames that would come out identical: nothing re-renders unless the geometry

@@ -7,11 +7,17 @@
 namespace procam::render {
 namespace {
 
-bool finite(const Mat3& m) { return m.allFinite(); }
+bool finite(const Mat3& m) {
+  return m.allFinite();
+}
 
-cv::Vec2f outside() { return cv::Vec2f(kOutside, kOutside); }
+cv::Vec2f outside() {
+  return cv::Vec2f(kOutside, kOutside);
+}
 
-bool isOutside(const cv::Vec2f& v) { return v[0] == kOutside; }
+bool isOutside(const cv::Vec2f& v) {
+  return v[0] == kOutside;
+}
 
 }  // namespace
 
@@ -61,9 +67,9 @@ Result<WarpMap> homographyMap(const Mat3& H, cv::Size output_size) {
 
 Result<WarpMap> gridMap(const WarpGrid& grid, cv::Size output_size) {
   if (grid.cols < 2 || grid.rows < 2 ||
-      grid.source.size() != static_cast<size_t>(grid.cols) * grid.rows ||
-      !(grid.step.x() > 0) || !(grid.step.y() > 0) || !grid.origin.allFinite() ||
-      output_size.width <= 0 || output_size.height <= 0) {
+      grid.source.size() != static_cast<size_t>(grid.cols) * grid.rows || !(grid.step.x() > 0) ||
+      !(grid.step.y() > 0) || !grid.origin.allFinite() || output_size.width <= 0 ||
+      output_size.height <= 0) {
     return fail(ErrorCode::kInvalidInput, "gridMap: grid needs >= 2x2 nodes, positive steps");
   }
   for (const auto& s : grid.source) {
@@ -107,8 +113,8 @@ Result<WarpMap> composeMaps(const WarpMap& first, const WarpMap& second) {
     auto* row = out.xy.ptr<cv::Vec2f>(y);
     for (int x = 0; x < second.xy.cols; ++x) {
       const cv::Vec2f q = in[x];
-      if (isOutside(q) || !(q[0] >= -0.5f && q[1] >= -0.5f && q[0] < fw - 0.5f &&
-                            q[1] < fh - 0.5f)) {
+      if (isOutside(q) ||
+          !(q[0] >= -0.5f && q[1] >= -0.5f && q[0] < fw - 0.5f && q[1] < fh - 0.5f)) {
         row[x] = outside();
         continue;
       }

@@ -24,10 +24,10 @@ struct WarpMap {
 // (i, j) to (i+1, j+1) — the "multiple textured triangles" of the seed, identical on
 // the CPU and in GL.
 struct WarpGrid {
-  int cols = 0, rows = 0;         // node counts, >= 2 each
-  Vec2 origin = Vec2::Zero();     // output pixel of node (0, 0)
-  Vec2 step = Vec2(8.0, 8.0);     // output pixels between nodes, > 0
-  std::vector<Vec2> source;       // rows * cols source coordinates, row-major
+  int cols = 0, rows = 0;      // node counts, >= 2 each
+  Vec2 origin = Vec2::Zero();  // output pixel of node (0, 0)
+  Vec2 step = Vec2(8.0, 8.0);  // output pixels between nodes, > 0
+  std::vector<Vec2> source;    // rows * cols source coordinates, row-major
   Vec2 node(int i, int j) const { return origin + Vec2(i * step.x(), j * step.y()); }
   const Vec2& at(int i, int j) const { return source[static_cast<size_t>(j) * cols + i]; }
 };

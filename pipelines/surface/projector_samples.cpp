@@ -16,6 +16,24 @@ struct NodeFit {
   int count = 0;
 };
 
+// Median projector pixels per camera pixel (sqrt |det J| of the decoded map).
+double projectorPixelsPerCameraPixel(const sl::Decoded& d) {
+  std::vector<double> scale;
+  for (int y = 0; y + 1 < d.u.rows; y += 3) {
+    const float *u = d.u.ptr<float>(y), *v = d.v.ptr<float>(y);
+    const float *u1 = d.u.ptr<float>(y + 1), *v1 = d.v.ptr<float>(y + 1);
+    const std::uint8_t *f = d.flags.ptr<std::uint8_t>(y), *f1 = d.flags.ptr<std::uint8_t>(y + 1);
+    for (int x = 0; x + 1 < d.u.cols; x += 3) {
+      if (f[x] || f[x + 1] || f1[x]) continue;
+      const double det = (u[x + 1] - u[x]) * (v1[x] - v[x]) - (v[x + 1] - v[x]) * (u1[x] - u[x]);
+      scale.push_back(std::sqrt(std::abs(det)));
+    }
+  }
+  if (scale.empty()) return 1.0;
+  std::nth_element(scale.begin(), scale.begin() + scale.size() / 2, scale.end());
+  return std::clamp(scale[scale.size() / 2], 0.0, 64.0);
+}
+
 }  // namespace
 
 Result<ProjectorSamples> sampleProjectorGrid(const sl::Decoded& d, int width, int height,
@@ -30,7 +48,7 @@ Result<ProjectorSamples> sampleProjectorGrid(const sl::Decoded& d, int width, in
   s.nodes_x = (width - 1) / o.step + 1;
   s.nodes_y = (height - 1) / o.step + 1;
   std::vector<NodeFit> fits(static_cast<std::size_t>(s.nodes_x) * s.nodes_y);
-  const double r = std::max(o.radius, 0.5 * o.step);
+  const double r = std::max({o.radius, 0.5 * o.step, 1.5 * projectorPixelsPerCameraPixel(d)});
   for (int y = 0; y < d.u.rows; ++y) {
     const float* u = d.u.ptr<float>(y);
     const float* v = d.v.ptr<float>(y);

@@ -15,7 +15,10 @@ namespace procam::surface {
 
 struct SampleOptions {
   int step = 8;               // projector pixels between nodes
-  double radius = 2.0;        // neighbourhood half-width in projector pixels (>= step/2 used)
+  // Neighbourhood half-width in projector pixels; at least step/2 and 1.5 times the
+  // projector pixels one camera pixel spans (measured from the map), so that every
+  // neighbourhood holds several camera pixels.
+  double radius = 2.0;
   int min_pixels = 6;         // decoded camera pixels needed in a neighbourhood
   double min_confidence = 0;  // ignore decoded pixels below this confidence
 };

@@ -38,7 +38,8 @@ Timing measure(int runs, const std::function<void()>& fn) {
   for (int i = 0; i < runs; ++i) {
     const auto t0 = std::chrono::steady_clock::now();
     fn();
-    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }
   std::sort(ms.begin(), ms.end());
   return {ms[ms.size() / 2], ms.front()};
@@ -94,7 +95,8 @@ int main(int argc, char** argv) {
     Timing t;
   };
   std::vector<Row> rows;
-  rows.push_back({"memcpy", measure(runs, [&] { std::memcpy(copy.data, src.data, src.total() * 4); })});
+  rows.push_back(
+      {"memcpy", measure(runs, [&] { std::memcpy(copy.data, src.data, src.total() * 4); })});
   rows.push_back({"procam_remap_simd", measure(runs, [&] {
                     (void)render::remapRgba(src, *packed, dst, render::RemapKernel::kBest);
                   })});
@@ -146,8 +148,9 @@ int main(int argc, char** argv) {
   const std::string gl = (*headless)->glRenderer();
   gcsv << "homography_upload_render_readback,\"" << gl << "\"," << g.median_ms << ',' << g.min_ms
        << ',' << 1000.0 / g.median_ms << '\n';
-  std::printf("GLES 1080p homography (upload + render + read-back) on %s: median %.2f ms, %.1f fps\n",
-              gl.c_str(), g.median_ms, 1000.0 / g.median_ms);
+  std::printf(
+      "GLES 1080p homography (upload + render + read-back) on %s: median %.2f ms, %.1f fps\n",
+      gl.c_str(), g.median_ms, 1000.0 / g.median_ms);
 #endif
   return 0;
 }

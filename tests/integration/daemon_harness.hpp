@@ -32,9 +32,9 @@ class TempDir {
 class DaemonProcess {
  public:
   struct Launch {
-    std::vector<std::string> args;                 // after the runtime/state options
-    std::vector<std::string> env;                  // NAME=value added to the environment
-    int listen_fd = -1;                            // passed as fd 3 with LISTEN_FDS=1
+    std::vector<std::string> args;  // after the runtime/state options
+    std::vector<std::string> env;   // NAME=value added to the environment
+    int listen_fd = -1;             // passed as fd 3 with LISTEN_FDS=1
     bool wait_for_socket = true;
   };
 

@@ -31,8 +31,11 @@ struct Rig {
   std::optional<DaemonProcess> daemon;
   explicit Rig(const std::string& config = kRigConfig) {
     dir.write("procamd.toml", config);
-    daemon.emplace(dir, DaemonProcess::Launch{
-                            {"--config", dir.file("procamd.toml"), "--plugin-dir", PROCAM_FIXTURE_DIR}, {}, -1, true});
+    daemon.emplace(dir, DaemonProcess::Launch{{"--config", dir.file("procamd.toml"), "--plugin-dir",
+                                               PROCAM_FIXTURE_DIR},
+                                              {},
+                                              -1,
+                                              true});
   }
   Connection connect() const { return Connection(daemon->socketPath()); }
 };
@@ -131,7 +134,10 @@ TEST(Control, KeystoneSetGetClearAndUnavailableAuto) {
   EXPECT_TRUE((*get)["corners"].is_null());
   EXPECT_EQ((*get)["auto"], false);
 
-  auto bad = c.call({{"cmd", "keystone"}, {"action", "set"}, {"corners", {{0, 0}, {0, 1079}, {1919, 1079}, {1919, 0}}}, {"id", 2}});
+  auto bad = c.call({{"cmd", "keystone"},
+                     {"action", "set"},
+                     {"corners", {{0, 0}, {0, 1079}, {1919, 1079}, {1919, 0}}},
+                     {"id", 2}});
   ASSERT_TRUE(bad);
   EXPECT_EQ((*bad)["class"], "ERROR");
   EXPECT_EQ((*bad)["code"], "bad-argument");
@@ -175,7 +181,8 @@ TEST(Control, ContentLoadDecodesOnAWorkerAndReportsProgress) {
   EXPECT_EQ(lines[3]["id"], "L");
   EXPECT_EQ(lines[3]["content"]["size"], json({64, 48}));
 
-  auto missing = c.call({{"cmd", "content"}, {"action", "load"}, {"path", rig.dir.file("none.png")}, {"id", "M"}});
+  auto missing = c.call(
+      {{"cmd", "content"}, {"action", "load"}, {"path", rig.dir.file("none.png")}, {"id", "M"}});
   ASSERT_TRUE(missing);
   EXPECT_EQ((*missing)["class"], "ERROR");
   EXPECT_EQ((*missing)["code"], "io-error");
@@ -197,7 +204,8 @@ TEST(Control, LogLevelAndReload) {
   auto bad = c.call({{"cmd", "reload"}, {"id", 9}});
   ASSERT_TRUE(bad);
   EXPECT_EQ((*bad)["code"], "config-error");
-  EXPECT_NE((*bad)["message"].get<std::string>().find(":3: daemon.bogus: unknown key"), std::string::npos)
+  EXPECT_NE((*bad)["message"].get<std::string>().find(":3: daemon.bogus: unknown key"),
+            std::string::npos)
       << bad->dump();
   rig.dir.write("procamd.toml", "[daemon]\nlog_level = \"error\"\n");
   auto good = c.call({{"cmd", "reload"}, {"id", 10}});
@@ -215,16 +223,37 @@ TEST(Control, TwoHundredMalformedOrOversizedRequestsEachGetAnError) {
   const std::string big(70 * 1024, 'x');
   for (int i = 0; i < 200; ++i) {
     switch (i % 10) {
-      case 0: bad.push_back("not json " + std::to_string(i)); break;
-      case 1: bad.push_back("{\"cmd\":"); break;
-      case 2: bad.push_back("[1,2,3]"); break;
-      case 3: bad.push_back("{\"id\":" + std::to_string(i) + "}"); break;
-      case 4: bad.push_back("{\"cmd\":\"frobnicate\",\"id\":" + std::to_string(i) + "}"); break;
-      case 5: bad.push_back("{\"cmd\":\"pattern\",\"name\":\"plaid\",\"id\":" + std::to_string(i) + "}"); break;
-      case 6: bad.push_back("{\"cmd\":\"status\",\"extra\":1,\"id\":" + std::to_string(i) + "}"); break;
-      case 7: bad.push_back("{\"cmd\":\"keystone\",\"action\":\"set\",\"corners\":[1,2],\"id\":" + std::to_string(i) + "}"); break;
-      case 8: bad.push_back("{\"cmd\":\"status\",\"pad\":\"" + big + "\"}"); break;
-      case 9: bad.push_back(std::string("{\"cmd\":\"st\xc3\x28tus\"}")); break;
+      case 0:
+        bad.push_back("not json " + std::to_string(i));
+        break;
+      case 1:
+        bad.push_back("{\"cmd\":");
+        break;
+      case 2:
+        bad.push_back("[1,2,3]");
+        break;
+      case 3:
+        bad.push_back("{\"id\":" + std::to_string(i) + "}");
+        break;
+      case 4:
+        bad.push_back("{\"cmd\":\"frobnicate\",\"id\":" + std::to_string(i) + "}");
+        break;
+      case 5:
+        bad.push_back("{\"cmd\":\"pattern\",\"name\":\"plaid\",\"id\":" + std::to_string(i) + "}");
+        break;
+      case 6:
+        bad.push_back("{\"cmd\":\"status\",\"extra\":1,\"id\":" + std::to_string(i) + "}");
+        break;
+      case 7:
+        bad.push_back("{\"cmd\":\"keystone\",\"action\":\"set\",\"corners\":[1,2],\"id\":" +
+                      std::to_string(i) + "}");
+        break;
+      case 8:
+        bad.push_back("{\"cmd\":\"status\",\"pad\":\"" + big + "\"}");
+        break;
+      case 9:
+        bad.push_back(std::string("{\"cmd\":\"st\xc3\x28tus\"}"));
+        break;
     }
   }
   std::string all;
@@ -262,7 +291,7 @@ TEST(Control, HalfClosedClientStillGetsItsReplies) {
   std::vector<json> replies;
   while (auto m = c.next(3s)) replies.push_back(*m);
   ASSERT_EQ(replies.size(), 2u);
-  EXPECT_EQ(replies[0]["id"], 2);  // version is immediate
+  EXPECT_EQ(replies[0]["id"], 2);          // version is immediate
   EXPECT_EQ(replies[1]["class"], "SAVE");  // save comes back from the I/O worker
 }
 

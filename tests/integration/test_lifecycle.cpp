@@ -35,7 +35,8 @@ TEST(Lifecycle, SaveThenKill9ThenRestartKeepsState) {
     DaemonProcess d(dir);
     ASSERT_TRUE(d.started()) << d.log();
     Connection c(d.socketPath());
-    ASSERT_EQ((*c.call({{"cmd", "keystone"}, {"action", "set"}, {"corners", kCorners}}))["class"], "KEYSTONE");
+    ASSERT_EQ((*c.call({{"cmd", "keystone"}, {"action", "set"}, {"corners", kCorners}}))["class"],
+              "KEYSTONE");
     ASSERT_EQ((*c.call({{"cmd", "pattern"}, {"name", "grid"}}))["class"], "PATTERN");
     auto saved = c.call({{"cmd", "save"}, {"id", "s"}});
     ASSERT_TRUE(saved);
@@ -77,7 +78,8 @@ TEST(Lifecycle, CorruptSettingsAreReportedAndBackupUsed) {
   ASSERT_TRUE(s);
   EXPECT_EQ((*s)["pattern"], "crosshair");  // the previous save
   ASSERT_EQ((*s)["warnings"].size(), 1u);
-  EXPECT_NE((*s)["warnings"][0].get<std::string>().find("settings.json is corrupt"), std::string::npos);
+  EXPECT_NE((*s)["warnings"][0].get<std::string>().find("settings.json is corrupt"),
+            std::string::npos);
 }
 
 TEST(Lifecycle, SecondDaemonOnALiveSocketRefusesToStart) {
@@ -132,8 +134,7 @@ TEST(Lifecycle, NotifiesReadyStatusAndWatchdog) {
     char buf[4096];
     const ssize_t n = ::recv(fd, buf, sizeof buf, MSG_DONTWAIT);
     if (n > 0) all.append(buf, static_cast<size_t>(n)).append("\n");
-    return all.find("READY=1") != std::string::npos &&
-           all.find("WATCHDOG=1") != std::string::npos;
+    return all.find("READY=1") != std::string::npos && all.find("WATCHDOG=1") != std::string::npos;
   }));
   EXPECT_NE(all.find("STATUS=ready"), std::string::npos) << all;
   d.signal(SIGTERM);
@@ -189,7 +190,8 @@ TEST(Lifecycle, BadConfigStopsStartupNamingKeyAndLine) {
   dir.write("bad.toml", "[policy]\n\nauto_keystone = 1\n");
   DaemonProcess d(dir, DaemonProcess::Launch{{"--config", dir.file("bad.toml")}, {}, -1, false});
   EXPECT_EQ(d.wait(), 1);
-  EXPECT_NE(d.log().find("bad.toml:3: policy.auto_keystone: expected true or false"), std::string::npos)
+  EXPECT_NE(d.log().find("bad.toml:3: policy.auto_keystone: expected true or false"),
+            std::string::npos)
       << d.log();
 }
 

@@ -33,7 +33,9 @@ TEST(Load, HundredConcurrentClientsAllServed) {
       for (int r = 0; r < kRequestsEach; ++r) {
         const auto t0 = std::chrono::steady_clock::now();
         auto reply = c.call({{"cmd", "status"}, {"id", i * 100 + r}}, 20s);
-        const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        const double ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                .count();
         worst_ms[i] = std::max(worst_ms[i], ms);
         if (reply && (*reply)["class"] == "STATUS" && (*reply)["id"] == i * 100 + r) ++answered[i];
       }
@@ -63,19 +65,23 @@ TEST(Load, ClientOverItsQueueBoundIsDroppedAndOthersKeepGoing) {
   for (int i = 0; i < 50; ++i) {
     const auto t0 = std::chrono::steady_clock::now();
     auto r = fast.call({{"cmd", "version"}, {"id", i}});
-    worst_ms = std::max(worst_ms, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    worst_ms = std::max(
+        worst_ms,
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     served += r && (*r)["id"] == i;
   }
   EXPECT_EQ(served, 50);
-  EXPECT_TRUE(eventually([&] { return d.log().find("output queue over 64 KiB") != std::string::npos; }))
-      << d.log();
+  EXPECT_TRUE(eventually([&] {
+    return d.log().find("output queue over 64 KiB") != std::string::npos;
+  })) << d.log();
   EXPECT_TRUE(slow.closedByPeer());
   ::shutdown(slow.fd(), SHUT_RDWR);
   writer.join();
   auto s = fast.call({{"cmd", "status"}});
   ASSERT_TRUE(s);
   EXPECT_EQ((*s)["clients"], 1);
-  std::printf("[ figures  ] fast client beside a flooding non-reader: worst round trip %.1f ms\n", worst_ms);
+  std::printf("[ figures  ] fast client beside a flooding non-reader: worst round trip %.1f ms\n",
+              worst_ms);
 }
 
 TEST(Load, ClientThatStopsReadingIsDroppedAfterTheStallTimeout) {

@@ -22,7 +22,7 @@ TEST(Procamctl, ReadableStatusAndJsonOutput) {
   ASSERT_TRUE(d.started());
   auto status = ctl(d, {"status"});
   EXPECT_EQ(status.status, 0) << status.err;
-  EXPECT_NE(status.out.find("pattern:      off"), std::string::npos) << status.out;
+  EXPECT_NE(status.out.find("pattern:       off"), std::string::npos) << status.out;
   EXPECT_NE(status.out.find("calibrate (not built)"), std::string::npos) << status.out;
 
   auto js = ctl(d, {"--json", "pattern", "grid"});
@@ -34,7 +34,8 @@ TEST(Procamctl, ReadableStatusAndJsonOutput) {
 
   auto ks = ctl(d, {"keystone", "set", "10,10", "1900,20", "1890,1070", "5,1060"});
   EXPECT_EQ(ks.status, 0) << ks.err;
-  EXPECT_NE(ks.out.find("corners:      10,10 1900,20 1890,1070 5,1060"), std::string::npos) << ks.out;
+  EXPECT_NE(ks.out.find("corners:       10,10 1900,20 1890,1070 5,1060"), std::string::npos)
+      << ks.out;
   auto saved = ctl(d, {"save"});
   EXPECT_EQ(saved.status, 0);
   EXPECT_NE(saved.out.find("settings.json"), std::string::npos);

@@ -79,8 +79,8 @@ struct HomographyCase {
 // Two random cameras viewing the plane z = 0; n points on the plane in [-1,1]².
 HomographyCase randomPlaneCase(Rng& rng, int n, bool uhd) {
   auto view = [&] {
-    const Vec3 eye = rng.uniform(2, 10) * Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1),
-                                               rng.uniform(0.3, 1)).normalized();
+    const Vec3 eye = rng.uniform(2, 10) *
+                     Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(0.3, 1)).normalized();
     return testing::makeCamera(eye, Vec3(rng.uniform(-0.3, 0.3), rng.uniform(-0.3, 0.3), 0),
                                rng.uniform(500, 3000), uhd ? 3840 : 1920, uhd ? 2160 : 1080);
   };
@@ -154,8 +154,10 @@ void checkExact(Tally& t, const HomographyCase& c, bool must_solve, const char* 
   if (four) {
     auto H = homographyFrom4({c.src[0], c.src[1], c.src[2], c.src[3]},
                              {c.dst[0], c.dst[1], c.dst[2], c.dst[3]});
-    if (H) fit = HomographyFit{*H, 1, 0, 0};
-    else fit = tl::unexpected(H.error());
+    if (H)
+      fit = HomographyFit{*H, 1, 0, 0};
+    else
+      fit = tl::unexpected(H.error());
   } else {
     fit = (t.cases % 3 == 0) ? fitHomographyDlt(c.src, c.dst) : fitHomography(c.src, c.dst);
   }
@@ -170,8 +172,8 @@ void checkExact(Tally& t, const HomographyCase& c, bool must_solve, const char* 
   const double err = relativeTransferError(fit->H, c, c.dst);
   if (!(err <= kRelTol)) {
     std::ostringstream os;
-    os << label << ": relative transfer error " << err << " (condition " << fit->condition
-       << ", n " << c.src.size() << ")";
+    os << label << ": relative transfer error " << err << " (condition " << fit->condition << ", n "
+       << c.src.size() << ")";
     t.fail(os.str());
   }
 }
@@ -201,7 +203,8 @@ TEST(StressEstimation, HomographyRandomExact) {
     Frame fs, fd;
     if (rng.chance(0.5)) {
       fs.o = 1e4 * Vec2(rng.uniform(-1, 1), rng.uniform(-1, 1));
-      fd.o = rng.chance(0.5) ? Vec2(1e4 * Vec2(rng.uniform(-1, 1), rng.uniform(-1, 1))) : Vec2::Zero();
+      fd.o =
+          rng.chance(0.5) ? Vec2(1e4 * Vec2(rng.uniform(-1, 1), rng.uniform(-1, 1))) : Vec2::Zero();
     } else if (rng.chance(0.4)) {
       fs.s = rng.logUniform(-8, 8);
       fd.s = rng.logUniform(-8, 8);
@@ -289,7 +292,8 @@ TEST(StressEstimation, HomographyAdversarial) {
       const Vec2 normal(-d.y(), d.x());
       const double lift = 1000 * rng.logUniform(-13, -1);
       for (std::size_t k = 0; k < c.src.size(); ++k) {
-        c.src[k] = a + rng.uniform(-500, 500) * d + (k % 2 ? lift * rng.uniform(0.5, 1) : 0) * normal;
+        c.src[k] =
+            a + rng.uniform(-500, 500) * d + (k % 2 ? lift * rng.uniform(0.5, 1) : 0) * normal;
         c.dst[k] = applyHomography(c.H, c.src[k]).value_or(Vec2(0, 0));
       }
       checkExact(t, c, false, "near-collinear");
@@ -399,8 +403,8 @@ ProjectionCase randomProjectionCase(Rng& rng, int n, double thickness, const Vec
   c.cam = randomCamera(rng, center, rng.chance(0.5));
   const Mat3 R = rng.rotation();
   while (int(c.X.size()) < n) {
-    const Vec3 X = center + R * Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1),
-                                     thickness * rng.uniform(-1, 1));
+    const Vec3 X =
+        center + R * Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), thickness * rng.uniform(-1, 1));
     // Pixels from the 3x4 matrix directly: points behind the camera are valid data too.
     auto p = projectWith(c.cam.projectionMatrix(), X);
     if (!p) continue;
@@ -422,8 +426,8 @@ bool decompositionMatches(const KRt& got, const CameraModel& cam, double tol) {
   return got.K.fx > 0 && got.K.fy > 0 && dK.allFinite() && dK.norm() <= tol * kscale &&
          (got.pose.R - cam.pose.R).norm() <= tol * kscale / std::min(cam.K.fx, cam.K.fy) &&
          std::abs(got.pose.R.determinant() - 1) < 1e-9 &&
-         (got.pose.t - cam.pose.t).norm() <= tol * kscale / std::min(cam.K.fx, cam.K.fy) *
-                                                 (1 + cam.pose.t.norm());
+         (got.pose.t - cam.pose.t).norm() <=
+             tol * kscale / std::min(cam.K.fx, cam.K.fy) * (1 + cam.pose.t.norm());
 }
 
 void checkProjection(Tally& t, const ProjectionCase& c, bool must_solve, const char* label) {
@@ -462,8 +466,7 @@ TEST(StressEstimation, ProjectionMatrix) {
     const int n = rng.integer(6, 60);
     const Vec3 center = rng.chance(0.5) ? rng.inCube(1) : 1e4 * rng.unit();
     // General position (thick): always solved, correct.
-    checkProjection(t, randomProjectionCase(rng, n, rng.uniform(0.2, 1), center), true,
-                    "general");
+    checkProjection(t, randomProjectionCase(rng, n, rng.uniform(0.2, 1), center), true, "general");
     // Thin slabs from 1e-7 to 1e-1: below coplanar_ratio/3 the spread ratio is certain
     // to be under the limit -> kCoplanar required; above, solved correctly or refused.
     const double thickness = rng.logUniform(-7, -1);
@@ -530,7 +533,8 @@ TEST(StressEstimation, Decomposition) {
     // Rank-deficient left block (camera at infinity) and non-finite matrices.
     Mat34 singular = cam.projectionMatrix();
     const int c0 = rng.integer(0, 2), c1 = (c0 + 1) % 3, c2 = (c0 + 2) % 3;
-    singular.col(c0) = rng.uniform(-2, 2) * singular.col(c1) + rng.uniform(-2, 2) * singular.col(c2);
+    singular.col(c0) =
+        rng.uniform(-2, 2) * singular.col(c1) + rng.uniform(-2, 2) * singular.col(c2);
     requireError(t, decomposeProjectionMatrix(singular), {ErrorCode::kDegenerate}, "singular");
     Mat34 nan = cam.projectionMatrix();
     nan(rng.integer(0, 2), rng.integer(0, 3)) = rng.bad();

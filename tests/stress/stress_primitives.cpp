@@ -23,15 +23,32 @@ namespace {
 using stress::kEps;
 using stress::Rng;
 
-// Ratio of the two largest principal extents of a centred set (1 = isotropic).
-double planarity(const Points3& pts) {
+// Singular values of the centred set (sqrt(n) times the rms extent along each
+// principal axis).
+Vec3 extents(const Points3& pts) {
   Eigen::MatrixX3d m(static_cast<Eigen::Index>(pts.size()), 3);
   Vec3 mean = Vec3::Zero();
   for (const Vec3& p : pts) mean += p;
   mean /= static_cast<double>(pts.size());
   for (std::size_t i = 0; i < pts.size(); ++i) m.row(static_cast<Eigen::Index>(i)) = pts[i] - mean;
-  const Vec3 s = Eigen::JacobiSVD<Eigen::MatrixX3d>(m).singularValues();
+  return Eigen::JacobiSVD<Eigen::MatrixX3d>(m).singularValues();
+}
+
+// Ratio of the two largest principal extents (1 = isotropic, 0 = collinear).
+double planarity(const Points3& pts) {
+  const Vec3 s = extents(pts);
   return s[1] / s[0];
+}
+
+// Within a factor 4 of a documented collinearity threshold: the extent ratio of
+// the estimator, or its floor of 256 eps |x| per point (rigid.cpp, plane_fit.cpp).
+// There a typed error and an answer are both acceptable.
+bool nearCollinear(const Points3& pts, double ratio) {
+  const Vec3 s = extents(pts);
+  double max_abs = 0;
+  for (const Vec3& p : pts) max_abs = std::max(max_abs, p.cwiseAbs().maxCoeff());
+  const double floor = 4 * 256 * kEps * max_abs * std::sqrt(static_cast<double>(pts.size()));
+  return s[1] < 4 * ratio * s[0] || s[1] < floor;
 }
 
 Points3 cloud(Rng& rng, int n, const Vec3& center, double spread) {
@@ -88,7 +105,7 @@ TEST(StressPrimitives, RigidTransform) {
       EXPECT_EQ(fit.error().code, ErrorCode::kDegenerate);
       continue;
     }
-    if (!fit && planarity(from) < 2e-5) {  // near the collinearity threshold (rigid.cpp)
+    if (!fit && nearCollinear(from, 1e-5)) {
       EXPECT_EQ(fit.error().code, ErrorCode::kDegenerate);
       continue;
     }
@@ -96,11 +113,12 @@ TEST(StressPrimitives, RigidTransform) {
     expectRotation(fit->R);
     ASSERT_TRUE(fit->t.allFinite() && std::isfinite(fit->scale) && std::isfinite(fit->rms));
     const double mag = offset.norm() + spread + t.norm();
-    // Residual of the data itself: exact correspondences must map onto each other.
-    EXPECT_LE(fit->rms, 1e4 * kEps * (s * mag + t.norm() + 1));
     // Rounding of both point sets relative to their extent, amplified by the
     // squared extent ratio through the cross-covariance (see rigid.cpp).
     const double p = planarity(from);
+    // Residual of the data itself: exact correspondences map onto each other up to
+    // the rotation error about the long axis times the thin extent, ~eps |x| / p.
+    EXPECT_LE(fit->rms, 1e4 * kEps * (s * mag + t.norm() + 1) / p);
     const double cond = (1 + (offset.norm() + t.norm() / s) / spread) / (p * p);
     EXPECT_LE((fit->R - R).norm(), 1e4 * kEps * cond);
     EXPECT_LE(std::abs(fit->scale - s), 1e4 * kEps * cond * s);
@@ -300,27 +318,38 @@ TEST(StressPrimitives, PlaneFitLeastSquares) {
       EXPECT_EQ(fit.error().code, kind == 4 ? ErrorCode::kInvalidInput : ErrorCode::kTooFewPoints);
       continue;
     }
-    if (kind == 2 || (kind == 3 && (pts[1] == pts[0] || planarity(pts) < 1e-9))) {
+    if (kind == 2 || (kind == 3 && pts[1] == pts[0])) {
       ASSERT_FALSE(fit);
       EXPECT_EQ(fit.error().code, ErrorCode::kDegenerate);
       continue;
     }
-    if (kind == 3 && n < 3) continue;
+    if (!fit && nearCollinear(pts, 1e-9)) {  // a thin random sample
+      EXPECT_EQ(fit.error().code, ErrorCode::kDegenerate);
+      continue;
+    }
     ASSERT_TRUE(fit) << fit.error().message;
     ASSERT_TRUE(fit->plane.n.allFinite() && std::isfinite(fit->plane.d) && std::isfinite(fit->rms));
     EXPECT_NEAR(fit->plane.n.norm(), 1, 1e-14);
-    // Conditioning of the sample itself: its second principal extent (a few random
-    // points in a thin strip can be much thinner than the strip).
-    const double extent = su * planarity(pts) / std::sqrt(3.0);
+    // Conditioning of the sample itself: the rms extent along its second principal
+    // axis (a few random points in a strip can be much thinner than the strip).
+    const double extent = extents(pts)[1] / std::sqrt(static_cast<double>(pts.size()));
     const double mag = center.norm() + su;
-    double tol_angle = 1e4 * kEps * mag / extent;
-    // Tilt from noise: sigma / (sqrt(n) * rms extent) per axis; 6 of those.
-    if (kind == 1) tol_angle += 6 * sigma / (std::sqrt(n) * extent);
-    EXPECT_LE(angleBetween(fit->plane.n, normal), tol_angle);
-    EXPECT_LE(std::abs(fit->plane.signedDistance(center)),
-              tol_angle * su + 6 * sigma + 1e4 * kEps * mag);
+    const double tol_angle = 1e4 * kEps * mag / extent;
     if (kind != 1) {
+      EXPECT_LE(angleBetween(fit->plane.n, normal), tol_angle);
+      EXPECT_LE(std::abs(fit->plane.signedDistance(center)), tol_angle * su + 1e4 * kEps * mag);
       EXPECT_LE(fit->rms, 1e4 * kEps * mag);
+      continue;
+    }
+    // Noisy: least squares can never fit worse than the true plane ...
+    double truth_ss = 0;
+    for (const Vec3& p : pts) truth_ss += std::pow(normal.dot(p - center), 2);
+    EXPECT_LE(fit->rms, std::sqrt(truth_ss / n) * (1 + 1e-9) + 1e4 * kEps * mag);
+    // ... and, while the first-order model holds, tilts by sigma / (sqrt(n) rms extent)
+    // per axis: 6 of those (2-axis chi: exceeded with probability ~1e-8).
+    const double tilt = sigma / (std::sqrt(static_cast<double>(n)) * extent);
+    if (tilt < 0.01) {
+      EXPECT_LE(angleBetween(fit->plane.n, normal), tol_angle + 6 * tilt);
     }
   }
   stress::report("plane fit (least squares)", cases);

@@ -27,7 +27,7 @@ class EglContext {
   EglContext& operator=(const EglContext&) = delete;
 
   Result<void> makeCurrent();
-  Result<void> swapBuffers();  // window surfaces only
+  Result<void> swapBuffers();    // window surfaces only
   std::string renderer() const;  // GL_RENDERER string, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
 
  private:

@@ -35,13 +35,27 @@ class GlName {
 };
 
 namespace detail {
-inline void deleteTexture(GLuint id) { glDeleteTextures(1, &id); }
-inline void deleteFramebuffer(GLuint id) { glDeleteFramebuffers(1, &id); }
-inline void deleteRenderbuffer(GLuint id) { glDeleteRenderbuffers(1, &id); }
-inline void deleteBuffer(GLuint id) { glDeleteBuffers(1, &id); }
-inline void deleteVertexArray(GLuint id) { glDeleteVertexArrays(1, &id); }
-inline void deleteProgram(GLuint id) { glDeleteProgram(id); }
-inline void deleteShader(GLuint id) { glDeleteShader(id); }
+inline void deleteTexture(GLuint id) {
+  glDeleteTextures(1, &id);
+}
+inline void deleteFramebuffer(GLuint id) {
+  glDeleteFramebuffers(1, &id);
+}
+inline void deleteRenderbuffer(GLuint id) {
+  glDeleteRenderbuffers(1, &id);
+}
+inline void deleteBuffer(GLuint id) {
+  glDeleteBuffers(1, &id);
+}
+inline void deleteVertexArray(GLuint id) {
+  glDeleteVertexArrays(1, &id);
+}
+inline void deleteProgram(GLuint id) {
+  glDeleteProgram(id);
+}
+inline void deleteShader(GLuint id) {
+  glDeleteShader(id);
+}
 }  // namespace detail
 
 using Texture = GlName<detail::deleteTexture>;

@@ -1,18 +1,17 @@
 #include "gl/gl_renderer.hpp"
 
 #include <array>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "render/projective_mesh.hpp"
 
 namespace procam::output::gl {
 namespace {
 
-using render::GlOrigin;
 using render::glConventions;
+using render::GlOrigin;
 
 Result<void> glCheck(const char* what) {
   const GLenum e = glGetError();
@@ -151,8 +150,8 @@ Result<void> GlRenderer::makeStage(Stage& stage, cv::Size size, bool with_depth)
 Result<void> GlRenderer::configure(const render::RenderSetup& setup) {
   if (auto ok = render::validateSetup(setup); !ok) return ok;
   const cv::Size out = setup.output_size;
-  const bool depth = setup.path == render::RenderPath::kTwoPassMesh ||
-                     setup.path == render::RenderPath::kPlanar3d;
+  const bool depth =
+      setup.path == render::RenderPath::kTwoPassMesh || setup.path == render::RenderPath::kPlanar3d;
   if (auto ok = makeStage(stage_[0], out, depth); !ok) return ok;
   if (setup.post_warp) {
     if (auto ok = makeStage(stage_[1], out, false); !ok) return ok;
@@ -161,9 +160,9 @@ Result<void> GlRenderer::configure(const render::RenderSetup& setup) {
     if (auto ok = makeStage(out_, out, false); !ok) return ok;
   }
   const Mat4 clip = glConventions(out.width, out.height, GlOrigin::kRow0AtGlBottom).clip_from_pixel;
-  const Mat3 tex = glConventions(setup.content_size.width, setup.content_size.height,
-                                 GlOrigin::kRow0AtGlBottom)
-                       .tex_from_pixel;
+  const Mat3 tex =
+      glConventions(setup.content_size.width, setup.content_size.height, GlOrigin::kRow0AtGlBottom)
+          .tex_from_pixel;
   main_.indexed = false;
   main_.mode = GL_TRIANGLES;
   switch (setup.path) {
@@ -171,9 +170,10 @@ Result<void> GlRenderer::configure(const render::RenderSetup& setup) {
       const Mat3 Hinv = setup.homography.inverse();
       if (!Hinv.allFinite()) return fail(ErrorCode::kDegenerate, "gl: singular homography");
       const double scale = 1.0 / Hinv.cwiseAbs().maxCoeff();
-      setVertices(main_.vao.get(), main_.vertices.get(),
-                  quadVertices(out, [&](const Vec2& c) { return Vec3(scale * Hinv * c.homogeneous()); }),
-                  {2, 3});
+      setVertices(
+          main_.vao.get(), main_.vertices.get(),
+          quadVertices(out, [&](const Vec2& c) { return Vec3(scale * Hinv * c.homogeneous()); }),
+          {2, 3});
       main_.mode = GL_TRIANGLE_STRIP;
       main_.count = 4;
       main_clip_ = clip;
@@ -216,7 +216,8 @@ Result<void> GlRenderer::configure(const render::RenderSetup& setup) {
           idx.push_back(static_cast<GLuint>(i));
         }
       }
-      if (idx.empty()) return fail(ErrorCode::kInvalidInput, "gl: no triangle in front of projector");
+      if (idx.empty())
+        return fail(ErrorCode::kInvalidInput, "gl: no triangle in front of projector");
       // Depth-buffer range: a near plane at a tiny depth would squeeze every depth onto
       // 1.0 in float and 24 bits. Surface points closer than far/1000 lie in the
       // projector's own plane, outside any practical field of view, and may be clipped.
@@ -254,10 +255,9 @@ Result<void> GlRenderer::configure(const render::RenderSetup& setup) {
   // Final stage textures: mask (1x1 unused when absent) and LUTs, fetched texel by texel.
   const auto& fs = setup.final_stage;
   const uint8_t one = 255;
-  mask_ = fs.alpha.empty()
-              ? makeTexture2d(GL_R8, GL_RED, {1, 1}, &one, GL_NEAREST)
-              : makeTexture2d(GL_R8, GL_RED, fs.alpha.size(), cv::Mat(fs.alpha.clone()).data,
-                              GL_NEAREST);
+  mask_ = fs.alpha.empty() ? makeTexture2d(GL_R8, GL_RED, {1, 1}, &one, GL_NEAREST)
+                           : makeTexture2d(GL_R8, GL_RED, fs.alpha.size(),
+                                           cv::Mat(fs.alpha.clone()).data, GL_NEAREST);
   weight_lut_ = makeTexture2d(GL_R8, GL_RED, {256, 1}, fs.weight_lut.data(), GL_NEAREST);
   std::vector<uint8_t> lut(256 * 4, 255);
   for (int i = 0; i < 256; ++i)
@@ -340,9 +340,10 @@ void GlRenderer::drawFinal(GLuint frame) {
   const auto& p = programs_.final_stage;
   glUseProgram(p.program.get());
   uniformMat4(p.clip, glConventions(out.width, out.height, origin).clip_from_pixel);
-  const std::array<std::pair<GLint, GLuint>, 4> units = {
-      {{p.frame, frame}, {p.mask, mask_.get()}, {p.weight_lut, weight_lut_.get()},
-       {p.output_lut, output_lut_.get()}}};
+  const std::array<std::pair<GLint, GLuint>, 4> units = {{{p.frame, frame},
+                                                          {p.mask, mask_.get()},
+                                                          {p.weight_lut, weight_lut_.get()},
+                                                          {p.output_lut, output_lut_.get()}}};
   for (size_t k = 0; k < units.size(); ++k) {
     glActiveTexture(GL_TEXTURE0 + static_cast<GLenum>(k));
     glBindTexture(GL_TEXTURE_2D, units[k].second);
@@ -383,9 +384,8 @@ Result<bool> GlRenderer::render(const render::Content& content) {
     glBindVertexArray(main_.vao.get());
     glDrawElements(GL_TRIANGLES, main_.count, GL_UNSIGNED_INT, nullptr);
   } else {
-    const SampleProgram& p = setup_.path == render::RenderPath::kTwoPassMesh
-                                 ? programs_.sample_mesh
-                                 : programs_.sample_2d;
+    const SampleProgram& p = setup_.path == render::RenderPath::kTwoPassMesh ? programs_.sample_mesh
+                                                                             : programs_.sample_2d;
     drawSampled(p, main_, main_clip_, main_tex_, content_.get());
   }
   glDisable(GL_DEPTH_TEST);

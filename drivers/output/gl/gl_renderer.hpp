@@ -21,8 +21,8 @@ namespace procam::output::gl {
 
 // Where the final pass draws.
 struct GlTarget {
-  bool offscreen = true;  // own framebuffer object, read back with image row 0 first
-  GLuint framebuffer = 0; // when !offscreen: the window surface's framebuffer (usually 0)
+  bool offscreen = true;   // own framebuffer object, read back with image row 0 first
+  GLuint framebuffer = 0;  // when !offscreen: the window surface's framebuffer (usually 0)
 };
 
 class GlRenderer final : public render::Renderer {

@@ -12,7 +12,8 @@ Result<std::unique_ptr<HeadlessOutput>> HeadlessOutput::create(cv::Size size) {
   std::unique_ptr<HeadlessOutput> out(new HeadlessOutput());
   auto ctx = egl::EglContext::surfaceless();
   if (!ctx) {
-    return fail(ErrorCode::kNotFound, "headless output: no surfaceless EGL: " + ctx.error().message);
+    return fail(ErrorCode::kNotFound,
+                "headless output: no surfaceless EGL: " + ctx.error().message);
   }
   out->context_ = std::move(*ctx);
   auto r = gl::GlRenderer::create(gl::GlTarget{true, 0});

@@ -20,15 +20,19 @@ struct Freer {
   }
 };
 using Resources = std::unique_ptr<drmModeRes, Freer<drmModeRes, drmModeFreeResources>>;
-using ConnectorPtr = std::unique_ptr<drmModeConnector, Freer<drmModeConnector, drmModeFreeConnector>>;
+using ConnectorPtr =
+    std::unique_ptr<drmModeConnector, Freer<drmModeConnector, drmModeFreeConnector>>;
 using EncoderPtr = std::unique_ptr<drmModeEncoder, Freer<drmModeEncoder, drmModeFreeEncoder>>;
 using Props = std::unique_ptr<drmModeObjectProperties,
                               Freer<drmModeObjectProperties, drmModeFreeObjectProperties>>;
 using Prop = std::unique_ptr<drmModePropertyRes, Freer<drmModePropertyRes, drmModeFreeProperty>>;
-using PlaneRes = std::unique_ptr<drmModePlaneRes, Freer<drmModePlaneRes, drmModeFreePlaneResources>>;
+using PlaneRes =
+    std::unique_ptr<drmModePlaneRes, Freer<drmModePlaneRes, drmModeFreePlaneResources>>;
 using Plane = std::unique_ptr<drmModePlane, Freer<drmModePlane, drmModeFreePlane>>;
 
-std::string errnoText(int e) { return std::string(std::strerror(e)); }
+std::string errnoText(int e) {
+  return std::string(std::strerror(e));
+}
 
 }  // namespace
 
@@ -121,11 +125,11 @@ Result<std::vector<Connector>> DrmDevice::connectors() {
     std::vector<drmModeModeInfo> raw;
     for (int m = 0; m < c->count_modes; ++m) {
       const drmModeModeInfo& mi = c->modes[m];
-      k.modes.push_back(Mode{mi.name, mi.hdisplay, mi.vdisplay,
-                             refreshHz(mi.clock, mi.htotal, mi.vtotal,
-                                       (mi.flags & DRM_MODE_FLAG_INTERLACE) != 0,
-                                       (mi.flags & DRM_MODE_FLAG_DBLSCAN) != 0),
-                             (mi.type & DRM_MODE_TYPE_PREFERRED) != 0});
+      k.modes.push_back(
+          Mode{mi.name, mi.hdisplay, mi.vdisplay,
+               refreshHz(mi.clock, mi.htotal, mi.vtotal, (mi.flags & DRM_MODE_FLAG_INTERLACE) != 0,
+                         (mi.flags & DRM_MODE_FLAG_DBLSCAN) != 0),
+               (mi.type & DRM_MODE_TYPE_PREFERRED) != 0});
       raw.push_back(mi);
     }
     // CRTCs: the one currently driving the connector first, then every possible one.
@@ -185,7 +189,8 @@ uint32_t DrmDevice::primaryPlane(uint32_t crtc) const {
     if (!props) continue;
     for (uint32_t k = 0; k < props->count_props; ++k) {
       Prop p(drmModeGetProperty(fd_, props->props[k]));
-      if (p && std::strcmp(p->name, "type") == 0 && props->prop_values[k] == DRM_PLANE_TYPE_PRIMARY) {
+      if (p && std::strcmp(p->name, "type") == 0 &&
+          props->prop_values[k] == DRM_PLANE_TYPE_PRIMARY) {
         return plane->plane_id;
       }
     }

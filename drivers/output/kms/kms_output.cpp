@@ -50,9 +50,9 @@ Result<std::unique_ptr<KmsOutput>> KmsOutput::create(const KmsConfig& config) {
 
   out->gbm_ = gbm_create_device(out->dev_.fd());
   if (!out->gbm_) return tl::unexpected(drmError("gbm_create_device"));
-  out->surface_ = gbm_surface_create(out->gbm_, out->mode_.hdisplay, out->mode_.vdisplay,
-                                     GBM_FORMAT_XRGB8888,
-                                     GBM_BO_USE_SCANOUT | GBM_BO_USE_RENDERING);
+  out->surface_ =
+      gbm_surface_create(out->gbm_, out->mode_.hdisplay, out->mode_.vdisplay, GBM_FORMAT_XRGB8888,
+                         GBM_BO_USE_SCANOUT | GBM_BO_USE_RENDERING);
   if (!out->surface_) return tl::unexpected(drmError("gbm_surface_create"));
   auto ctx = egl::EglContext::forGbm(out->gbm_, out->surface_, GBM_FORMAT_XRGB8888);
   if (!ctx) return tl::unexpected(ctx.error());
@@ -156,8 +156,8 @@ Result<void> KmsOutput::commit(uint32_t fb, bool modeset) {
     drmModeAtomicFree(req);
     return fail(ErrorCode::kIo, "atomic request: a required KMS property is missing");
   }
-  const uint32_t flags = modeset ? DRM_MODE_ATOMIC_ALLOW_MODESET
-                                 : DRM_MODE_ATOMIC_NONBLOCK | DRM_MODE_PAGE_FLIP_EVENT;
+  const uint32_t flags =
+      modeset ? DRM_MODE_ATOMIC_ALLOW_MODESET : DRM_MODE_ATOMIC_NONBLOCK | DRM_MODE_PAGE_FLIP_EVENT;
   const int rc = drmModeAtomicCommit(fd, req, flags, this);
   drmModeAtomicFree(req);
   if (rc != 0) return tl::unexpected(drmError(modeset ? "atomic modeset" : "atomic page flip"));

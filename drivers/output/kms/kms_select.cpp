@@ -36,11 +36,10 @@ Result<ModeSpec> parseModeSpec(const std::string& text) {
 
 std::string connectorTypeName(uint32_t type) {
   // Names as the kernel prints them (drm_connector_enum_list).
-  static const char* const names[] = {"Unknown", "VGA",     "DVI-I",   "DVI-D",  "DVI-A",
-                                      "Composite", "SVIDEO", "LVDS",    "Component",
-                                      "DIN",     "DP",      "HDMI-A",  "HDMI-B", "TV",
-                                      "eDP",     "Virtual", "DSI",     "DPI",    "Writeback",
-                                      "SPI",     "USB"};
+  static const char* const names[] = {
+      "Unknown", "VGA",       "DVI-I", "DVI-D", "DVI-A",     "Composite", "SVIDEO",
+      "LVDS",    "Component", "DIN",   "DP",    "HDMI-A",    "HDMI-B",    "TV",
+      "eDP",     "Virtual",   "DSI",   "DPI",   "Writeback", "SPI",       "USB"};
   if (type < sizeof(names) / sizeof(names[0])) return names[type];
   return "Unknown";
 }
@@ -49,7 +48,8 @@ namespace {
 
 std::string listNames(const std::vector<Connector>& cs) {
   std::string s;
-  for (const auto& c : cs) s += (s.empty() ? "" : ", ") + c.name + (c.connected ? "" : " (disconnected)");
+  for (const auto& c : cs)
+    s += (s.empty() ? "" : ", ") + c.name + (c.connected ? "" : " (disconnected)");
   return s.empty() ? "none" : s;
 }
 
@@ -80,7 +80,8 @@ std::optional<size_t> pickMode(const Connector& c, const ModeSpec& spec) {
     if (m.width != spec.width || m.height != spec.height) continue;
     if (spec.refresh_hz) {
       const double d = std::abs(m.refresh_hz - *spec.refresh_hz);
-      if (d <= 0.5 && (!best || d < std::abs(c.modes[*best].refresh_hz - *spec.refresh_hz))) best = i;
+      if (d <= 0.5 && (!best || d < std::abs(c.modes[*best].refresh_hz - *spec.refresh_hz)))
+        best = i;
     } else if (!best || m.refresh_hz > c.modes[*best].refresh_hz) {
       best = i;
     }
@@ -90,23 +91,26 @@ std::optional<size_t> pickMode(const Connector& c, const ModeSpec& spec) {
 
 }  // namespace
 
-Result<Choice> chooseOutput(const std::vector<Connector>& connectors, const OutputRequest& request) {
+Result<Choice> chooseOutput(const std::vector<Connector>& connectors,
+                            const OutputRequest& request) {
   auto spec = parseModeSpec(request.mode);
   if (!spec) return tl::unexpected(spec.error());
   std::optional<size_t> ci;
   for (size_t i = 0; i < connectors.size(); ++i) {
-    if (request.connector.empty() ? connectors[i].connected : connectors[i].name == request.connector) {
+    if (request.connector.empty() ? connectors[i].connected
+                                  : connectors[i].name == request.connector) {
       ci = i;
       break;
     }
   }
   if (!ci) {
     if (request.connector.empty()) {
-      return fail(ErrorCode::kNotFound, "no connected display connector (connectors: " +
-                                            listNames(connectors) + ")");
+      return fail(ErrorCode::kNotFound,
+                  "no connected display connector (connectors: " + listNames(connectors) + ")");
     }
     return fail(ErrorCode::kNotFound, "connector '" + request.connector +
-                                          "' not found (connectors: " + listNames(connectors) + ")");
+                                          "' not found (connectors: " + listNames(connectors) +
+                                          ")");
   }
   const Connector& c = connectors[*ci];
   if (!c.connected) {
@@ -143,8 +147,9 @@ ApiChoice chooseModesetApi(bool atomic_cap_accepted, const PropertyTable& presen
     }
     return "";
   };
-  for (auto r : {missing(need.connector, present.connector, "connector"),
-                 missing(need.crtc, present.crtc, "CRTC"), missing(need.plane, present.plane, "plane")}) {
+  for (auto r :
+       {missing(need.connector, present.connector, "connector"),
+        missing(need.crtc, present.crtc, "CRTC"), missing(need.plane, present.plane, "plane")}) {
     if (!r.empty()) return {false, r};
   }
   return {true, "atomic"};

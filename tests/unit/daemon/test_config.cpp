@@ -74,8 +74,8 @@ name = "imu"
   EXPECT_EQ(cfg->devices[1].family, PROCAM_FAMILY_CAMERA);
   using Opt = std::pair<std::string, std::string>;
   EXPECT_EQ(cfg->devices[1].options,
-            (std::vector<Opt>{{"exposure_ms", "8"}, {"gain", "1.5"}, {"mono", "true"},
-                              {"serial", "A1"}}));
+            (std::vector<Opt>{
+                {"exposure_ms", "8"}, {"gain", "1.5"}, {"mono", "true"}, {"serial", "A1"}}));
   EXPECT_EQ(cfg->devices[2].family, PROCAM_FAMILY_TILT);
 }
 
@@ -96,21 +96,28 @@ TEST(Config, BadValuesNameKeyAndLine) {
   } cases[] = {
       {"[daemon]\nlog_level = \"loud\"", "rig.toml:2: daemon.log_level: unknown log level 'loud'"},
       {"[daemon]\nlog_level = 3", "rig.toml:2: daemon.log_level: expected a string"},
-      {"[daemon]\n\nmax_clients = 0", "rig.toml:3: daemon.max_clients: 0 is out of range [1, 4096]"},
+      {"[daemon]\n\nmax_clients = 0",
+       "rig.toml:3: daemon.max_clients: 0 is out of range [1, 4096]"},
       {"[daemon]\nmax_clients = 1.5", "rig.toml:2: daemon.max_clients: expected an integer"},
-      {"[daemon]\nclient_stall_timeout_s = nan", "rig.toml:2: daemon.client_stall_timeout_s: nan is out of range"},
-      {"[policy]\nauto_keystone = \"yes\"", "rig.toml:2: policy.auto_keystone: expected true or false"},
-      {"[policy]\nrecalibrate = \"always\"", "rig.toml:2: policy.recalibrate: 'always' is not one of"},
+      {"[daemon]\nclient_stall_timeout_s = nan",
+       "rig.toml:2: daemon.client_stall_timeout_s: nan is out of range"},
+      {"[policy]\nauto_keystone = \"yes\"",
+       "rig.toml:2: policy.auto_keystone: expected true or false"},
+      {"[policy]\nrecalibrate = \"always\"",
+       "rig.toml:2: policy.recalibrate: 'always' is not one of"},
       {"[[camera]]\ndriver = \"v4l2\"", "rig.toml:1: camera[0].name: missing"},
-      {"[[camera]]\nname = \"a\"\n[[tilt]]\nname = \"a\"", "rig.toml:4: tilt[0].name: duplicate device name 'a'"},
+      {"[[camera]]\nname = \"a\"\n[[tilt]]\nname = \"a\"",
+       "rig.toml:4: tilt[0].name: duplicate device name 'a'"},
       {"[[camera]]\nname = \"a\"\nexposure = 3", "rig.toml:3: camera[0].exposure: unknown key"},
-      {"[[camera]]\nname = \"a\"\noptions = { list = [1, 2] }", "rig.toml:3: camera[0].options.list: expected a string, number or boolean"},
+      {"[[camera]]\nname = \"a\"\noptions = { list = [1, 2] }",
+       "rig.toml:3: camera[0].options.list: expected a string, number or boolean"},
       {"camera = 3", "rig.toml:1: camera: expected an array of tables"},
       {"daemon = 3", "rig.toml:1: daemon: expected a table"},
   };
   for (const auto& c : cases) {
     auto e = parseError(c.text);
-    EXPECT_TRUE(contains(e.message, c.expected)) << "got: " << e.message << "\nwanted: " << c.expected;
+    EXPECT_TRUE(contains(e.message, c.expected))
+        << "got: " << e.message << "\nwanted: " << c.expected;
   }
 }
 
@@ -134,7 +141,8 @@ TEST(Config, MissingFileIsAnIoError) {
 }
 
 TEST(Config, ExampleConfigParses) {
-  auto cfg = loadConfig(std::string(std::getenv("PROCAM_SOURCE_DIR")) + "/daemon/procamd.toml.example");
+  auto cfg =
+      loadConfig(std::string(std::getenv("PROCAM_SOURCE_DIR")) + "/daemon/procamd.toml.example");
   ASSERT_TRUE(cfg) << cfg.error().message;
 }
 

@@ -10,7 +10,9 @@
 namespace procam::plugins {
 namespace {
 
-std::string fixture(const char* name) { return std::string(PROCAM_FIXTURE_DIR) + "/" + name; }
+std::string fixture(const char* name) {
+  return std::string(PROCAM_FIXTURE_DIR) + "/" + name;
+}
 
 DeviceDescription tiltDescription(const char* role) {
   DeviceDescription d;
@@ -96,9 +98,15 @@ TEST(PluginLoader, DirectoryLoadsGoodPluginsAndReportsBadOnes) {
   EXPECT_EQ(errors.size(), 2u);  // wrong ABI, not a plugin
 }
 
-int neverProbe(const procam_device_desc*) { return 0; }
-int scoreFive(const procam_device_desc*) { return 5; }
-int scoreFifty(const procam_device_desc*) { return 50; }
+int neverProbe(const procam_device_desc*) {
+  return 0;
+}
+int scoreFive(const procam_device_desc*) {
+  return 5;
+}
+int scoreFifty(const procam_device_desc*) {
+  return 50;
+}
 int noCreate(const procam_device_desc*, const procam_config*, procam_device*, char* err,
              size_t len) {
   std::strncpy(err, "unused", len);
@@ -162,8 +170,8 @@ TEST(DriverRegistry, SharedPluginProbeSeesProperties) {
 }
 
 TEST(Family, NamesRoundTrip) {
-  for (procam_family f : {PROCAM_FAMILY_CAMERA, PROCAM_FAMILY_TILT, PROCAM_FAMILY_TRACKER,
-                          PROCAM_FAMILY_OUTPUT}) {
+  for (procam_family f :
+       {PROCAM_FAMILY_CAMERA, PROCAM_FAMILY_TILT, PROCAM_FAMILY_TRACKER, PROCAM_FAMILY_OUTPUT}) {
     auto parsed = parseFamily(familyName(f));
     ASSERT_TRUE(parsed);
     EXPECT_EQ(*parsed, f);

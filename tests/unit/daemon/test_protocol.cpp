@@ -63,8 +63,9 @@ TEST(Replies, CarryClassAndIdAndEndWithNewline) {
   EXPECT_EQ(e["code"], "too-large");
 
   const json b = json::parse(versionBanner("1.2.3"));
-  EXPECT_EQ(b, (json{{"class", "VERSION"}, {"release", "1.2.3"}, {"proto_major", 1},
-                     {"proto_minor", 0}}));
+  EXPECT_EQ(
+      b,
+      (json{{"class", "VERSION"}, {"release", "1.2.3"}, {"proto_major", 1}, {"proto_minor", 0}}));
 }
 
 std::vector<LineFramer::Item> drain(LineFramer& f) {

@@ -26,14 +26,18 @@ TEST(Settings, RoundTrip) {
 }
 
 TEST(Settings, RejectsCorruptOrForeignFiles) {
-  for (const char* text : {
-           "", "{", "[]", R"({"schema":2,"auto_keystone":false,"keystone":null,"pattern":"off","content":null})",
-           R"({"schema":1,"auto_keystone":0,"keystone":null,"pattern":"off","content":null})",
-           R"({"schema":1,"auto_keystone":false,"keystone":{"corners":[[0,0]]},"pattern":"off","content":null})",
-           R"({"schema":1,"auto_keystone":false,"keystone":null,"pattern":"plaid","content":null})",
-           R"({"schema":1,"auto_keystone":false,"keystone":null,"pattern":"off","content":5})",
-           R"({"schema":1,"auto_keystone":false,"keystone":{"corners":[[0,0],[0,0],[1,1],[0,1]]},"pattern":"off","content":null})",
-       }) {
+  for (
+      const char* text : {
+          "",
+          "{",
+          "[]",
+          R"({"schema":2,"auto_keystone":false,"keystone":null,"pattern":"off","content":null})",
+          R"({"schema":1,"auto_keystone":0,"keystone":null,"pattern":"off","content":null})",
+          R"({"schema":1,"auto_keystone":false,"keystone":{"corners":[[0,0]]},"pattern":"off","content":null})",
+          R"({"schema":1,"auto_keystone":false,"keystone":null,"pattern":"plaid","content":null})",
+          R"({"schema":1,"auto_keystone":false,"keystone":null,"pattern":"off","content":5})",
+          R"({"schema":1,"auto_keystone":false,"keystone":{"corners":[[0,0],[0,0],[1,1],[0,1]]},"pattern":"off","content":null})",
+      }) {
     EXPECT_FALSE(settingsFromJson(text)) << text;
   }
 }
@@ -57,7 +61,8 @@ TEST(Quad, RejectsDegenerateReversedNonConvexOrNonFinite) {
 }
 
 TEST(Pattern, Names) {
-  for (const char* n : {"off", "grid", "crosshair", "white", "black"}) EXPECT_TRUE(isPatternName(n));
+  for (const char* n : {"off", "grid", "crosshair", "white", "black"})
+    EXPECT_TRUE(isPatternName(n));
   EXPECT_FALSE(isPatternName("Grid"));
   EXPECT_FALSE(isPatternName(""));
 }

@@ -69,7 +69,8 @@ TEST_F(StateFileTest, CorruptFileIsReportedAndBackupUsed) {
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_TRUE(r->from_backup);
   EXPECT_EQ(r->contents, "ok:old");
-  EXPECT_NE(r->warning.find("is corrupt: does not start with ok:"), std::string::npos) << r->warning;
+  EXPECT_NE(r->warning.find("is corrupt: does not start with ok:"), std::string::npos)
+      << r->warning;
 }
 
 TEST_F(StateFileTest, CorruptFileNeverReplacesGoodBackup) {

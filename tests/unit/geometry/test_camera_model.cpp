@@ -140,8 +140,8 @@ TEST(CameraModel, ProjectMatchesClosedForm) {
 
 TEST(CameraModel, ProjectRejectsPointsBehind) {
   const CameraModel cam = testing::makeCamera({0, -5, 1}, {0, 0, 1});
-  EXPECT_FALSE(cam.project({0, -10, 1}).has_value());            // behind
-  EXPECT_FALSE(cam.project(cam.pose.center()).has_value());      // at the centre
+  EXPECT_FALSE(cam.project({0, -10, 1}).has_value());           // behind
+  EXPECT_FALSE(cam.project(cam.pose.center()).has_value());     // at the centre
   EXPECT_FALSE(cam.project({std::nan(""), 0, 0}).has_value());  // NaN
   // On the principal plane the 3x4 projection has w = 0.
   EXPECT_FALSE(projectWith(cam.projectionMatrix(), {3, -5, 1}).has_value());

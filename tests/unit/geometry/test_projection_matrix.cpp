@@ -14,7 +14,8 @@ namespace {
 Points3 boxPoints(int n, const Vec3& center, const Vec3& half, std::mt19937_64& rng) {
   std::uniform_real_distribution<double> u(-1, 1);
   Points3 pts;
-  for (int i = 0; i < n; ++i) pts.push_back(center + Vec3(u(rng), u(rng), u(rng)).cwiseProduct(half));
+  for (int i = 0; i < n; ++i)
+    pts.push_back(center + Vec3(u(rng), u(rng), u(rng)).cwiseProduct(half));
   return pts;
 }
 

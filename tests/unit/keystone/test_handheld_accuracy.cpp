@@ -1,12 +1,14 @@
 // Accuracy on the virtual rig's `handheld` scene (issue: self-correcting handheld
 // projector). The projector is rescaled to 1920x1080 (same field of view) because the
 // tolerances are stated in pixels at that resolution. The hand trajectory is played
-// as holds at each keyframe pose, since the tolerances apply "once settled". The
+// as 10 s holds at each keyframe pose, since the tolerances apply "once settled"
+// (the filter's still mean then spans 8 s: white noise of 400 ug/sqrt(Hz) averages to
+// ~0.1 mg, i.e. ~0.1 mrad, ~0.3 px at the corners of this 2100 px lens). The
 // accelerometer is the scene's MPU-6050-like model (400 ug/sqrt(Hz), 50 mg bias),
 // calibrated by six still positions; the filter is the 10 Hz TiltFilter. The camera
 // part uses the rig's attached camera model (pose, intrinsics, distortion) to observe
-// a sparse dot grid; dot centroids carry 0.05 px Gaussian noise instead of being
-// detected in rendered images.
+// a 32 x 18 dot grid in four frames of each still pose; dot centroids carry 0.05 px Gaussian noise
+// instead of being detected in rendered images.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -34,7 +36,7 @@ struct Pose {
 // The keyframe poses of tests/scenes/handheld.toml.
 const Pose kHandPoses[] = {{0, 0, 0},  {0, 45, 0},  {0, -45, 0},   {30, 0, 0}, {-30, 0, 0},
                            {0, 0, 20}, {0, 0, -20}, {20, 25, -10}, {0, 0, 0}};
-constexpr double kHold = 3.0;  // s per pose: 0.5 s to move, 2.5 s still
+constexpr double kHold = 10.0;  // s per pose: 0.5 s to move, 9.5 s still
 
 std::string sceneText() {
   const char* root = std::getenv("PROCAM_SOURCE_DIR");
@@ -67,7 +69,7 @@ Result<sim::Scene> scene(const std::vector<Pose>& poses) {
   return sim::Scene::parse(withHolds(sceneText(), poses), "handheld-holds", ".");
 }
 
-// Six-position calibration on the rig: the mean of 2 s of still samples per pose.
+// Six-position calibration on the rig: the mean of 8 s of still samples per pose.
 AccelCalibration calibrate() {
   // chip z up / down, x up / down (roll), y up / down (pitch) for this mount.
   const std::vector<Pose> six = {{0, 0, 0},  {0, 0, 180}, {0, 0, -85},
@@ -77,7 +79,7 @@ AccelCalibration calibrate() {
   std::vector<Vec3> means;
   for (std::size_t i = 0; i < six.size(); ++i) {
     auto series =
-        sim::sampleTiltSeries(*sc, "accel", kHold * double(i) + 0.3, kHold * double(i) + 2.3, 11);
+        sim::sampleTiltSeries(*sc, "accel", kHold * double(i) + 0.3, kHold * double(i) + 8.3, 11);
     EXPECT_TRUE(series);
     Vec3 sum = Vec3::Zero();
     for (const auto& s : *series) sum += s.value / sim::kStandardGravity;
@@ -122,18 +124,20 @@ Outcome run(const std::vector<Pose>& poses, bool use_camera) {
       cam_from_proj.R = cam.pose.R * proj.pose.R.transpose();
       cam_from_proj.t = cam.pose.t - cam_from_proj.R * proj.pose.t;
       std::vector<Vec2> xp, xc;
-      for (int gx = 0; gx < 9; ++gx)
-        for (int gy = 0; gy < 6; ++gy) {
-          const Vec2 p(100 + 215 * gx, 90 + 180 * gy);
-          auto ray = proj.backproject(p);
-          const double t = (2.5 - ray->origin.y()) / ray->dir.y();
-          auto c = cam.project(ray->at(t));
-          if (!c || !cam.inImage(*c)) continue;
-          auto ideal = cam.undistortPixel(*c + Vec2(centroid(rng), centroid(rng)));
-          if (!ideal) continue;
-          xp.push_back(p);
-          xc.push_back(*ideal);
-        }
+      // Four camera frames of the still pose (independent centroid noise).
+      for (int frame = 0; frame < 4; ++frame)
+        for (int gx = 0; gx < 32; ++gx)
+          for (int gy = 0; gy < 18; ++gy) {
+            const Vec2 p(30 + 60 * gx, 30 + 60 * gy);
+            auto ray = proj.backproject(p);
+            const double t = (2.5 - ray->origin.y()) / ray->dir.y();
+            auto c = cam.project(ray->at(t));
+            if (!c || !cam.inImage(*c)) continue;
+            auto ideal = cam.undistortPixel(*c + Vec2(centroid(rng), centroid(rng)));
+            if (!ideal) continue;
+            xp.push_back(p);
+            xc.push_back(*ideal);
+          }
       auto wall = wallFromCorrespondences(proj.K, cam.K, cam_from_proj, xp, xc);
       EXPECT_TRUE(wall) << wall.error().message;
       auto fused = fuseOrientation(down, wall->normal);

@@ -25,11 +25,13 @@ cv::Mat interior(const RenderSetup& s, const render::WarpMap& map, int margin) {
     for (int x = 0; x < valid.cols; ++x) {
       const cv::Vec2f p = map.xy.at<cv::Vec2f>(y, x);
       valid.at<uint8_t>(y, x) =
-          render::insideFootprint(p[0], p[1], s.content_size.width, s.content_size.height) ? 255 : 0;
+          render::insideFootprint(p[0], p[1], s.content_size.width, s.content_size.height) ? 255
+                                                                                           : 0;
     }
   }
   cv::Mat framed(valid.size(), CV_8UC1, cv::Scalar(0));
-  valid(cv::Rect(1, 1, valid.cols - 2, valid.rows - 2)).copyTo(framed(cv::Rect(1, 1, valid.cols - 2, valid.rows - 2)));
+  valid(cv::Rect(1, 1, valid.cols - 2, valid.rows - 2))
+      .copyTo(framed(cv::Rect(1, 1, valid.cols - 2, valid.rows - 2)));
   cv::Mat out;
   cv::erode(framed, out, cv::Mat::ones(2 * margin + 1, 2 * margin + 1, CV_8UC1));
   return out;
@@ -145,12 +147,14 @@ TEST_F(GlVsCpu, BlendedOverlapOfTwoProjectors) {
       for (int x = 0; x < out.width; ++x) {
         const double cx = x0 + x * 520.0 / 640;  // approximate content column
         const double t = std::clamp((cx - 380) / 140.0, 0.0, 1.0);
-        s.final_stage.alpha.at<uint8_t>(y, x) = static_cast<uint8_t>(std::lround(255 * (k ? t : 1 - t)));
+        s.final_stage.alpha.at<uint8_t>(y, x) =
+            static_cast<uint8_t>(std::lround(255 * (k ? t : 1 - t)));
       }
     }
     s.final_stage.weight_lut = *weight;
     for (int i = 0; i < 256; ++i) {
-      s.final_stage.output_lut[0][i] = static_cast<uint8_t>(std::lround(255 * std::pow(i / 255.0, 0.9)));
+      s.final_stage.output_lut[0][i] =
+          static_cast<uint8_t>(std::lround(255 * std::pow(i / 255.0, 0.9)));
       s.final_stage.output_lut[2][i] = static_cast<uint8_t>(std::min(255, i + 3));
     }
     auto o = HeadlessOutput::create(out);

@@ -78,7 +78,9 @@ TEST(KmsSelect, ConnectorNamesAndRefreshRatesFollowTheKernel) {
 TEST(KmsSelect, ChoosesConnectorAndModeFromConfiguration) {
   const Table t = load("kms_laptop_with_projector.json");
   ASSERT_EQ(t.connectors[1].name, "HDMI-A-1");
-  auto pick = [&](const std::string& c, const std::string& m) { return chooseOutput(t.connectors, {c, m}); };
+  auto pick = [&](const std::string& c, const std::string& m) {
+    return chooseOutput(t.connectors, {c, m});
+  };
   // Nothing configured: first connected connector, its preferred mode, its first CRTC.
   auto def = pick("", "");
   ASSERT_TRUE(def);
@@ -113,9 +115,11 @@ TEST(KmsSelect, ErrorsNameTheCauseAndTheAlternatives) {
   auto mode = chooseOutput(t.connectors, {"HDMI-A-1", "800x600"});
   ASSERT_FALSE(mode);
   EXPECT_NE(mode.error().message.find("1024x768@60.00"), std::string::npos);
-  EXPECT_EQ(chooseOutput(t.connectors, {"HDMI-A-1", "1920x1080@75"}).error().code, ErrorCode::kNotFound);
+  EXPECT_EQ(chooseOutput(t.connectors, {"HDMI-A-1", "1920x1080@75"}).error().code,
+            ErrorCode::kNotFound);
   std::vector<Connector> none = {t.connectors[2]};
-  EXPECT_NE(chooseOutput(none, {"", ""}).error().message.find("no connected display"), std::string::npos);
+  EXPECT_NE(chooseOutput(none, {"", ""}).error().message.find("no connected display"),
+            std::string::npos);
 }
 
 TEST(KmsSelect, LegacyDriverTableFallsBackAndPicksTheLargestMode) {

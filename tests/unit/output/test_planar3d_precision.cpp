@@ -16,10 +16,10 @@ namespace {
 constexpr int kW = 1920, kH = 1080;
 
 struct Scene {
-  Mat34 P;        // projector, world -> pixels
-  Vec3 eye;       // tracked viewer
+  Mat34 P;   // projector, world -> pixels
+  Vec3 eye;  // tracked viewer
   keystone::DisplayRect S;
-  Mat4 pixel3d;   // A'4x4 P_T in this project's pixel convention
+  Mat4 pixel3d;  // A'4x4 P_T in this project's pixel convention
 };
 
 // Wall: plane y = 3 (world +Z up), viewer side y < 3; u = +X, v = +Z.
@@ -215,8 +215,10 @@ TEST(Planar3d, RenderedNearerSurfaceHidesFartherAndLandsWhereExpected) {
   const cv::Rect frame(0, 0, kW, kH);
   ASSERT_TRUE(frame.contains(cv::Point(int(overlap.x()), int(overlap.y()))));
   ASSERT_TRUE(frame.contains(cv::Point(int(red_only.x()), int(red_only.y()))));
-  const cv::Vec4b at_overlap = f.at<cv::Vec4b>(int(std::lround(overlap.y())), int(std::lround(overlap.x())));
-  const cv::Vec4b at_red = f.at<cv::Vec4b>(int(std::lround(red_only.y())), int(std::lround(red_only.x())));
+  const cv::Vec4b at_overlap =
+      f.at<cv::Vec4b>(int(std::lround(overlap.y())), int(std::lround(overlap.x())));
+  const cv::Vec4b at_red =
+      f.at<cv::Vec4b>(int(std::lround(red_only.y())), int(std::lround(red_only.x())));
   EXPECT_EQ(at_overlap, cv::Vec4b(0, 255, 0, 255));
   EXPECT_EQ(at_red, cv::Vec4b(255, 0, 0, 255));
   // The green quad's rendered area centroid against the centroid of its projected outline
@@ -227,7 +229,8 @@ TEST(Planar3d, RenderedNearerSurfaceHidesFartherAndLandsWhereExpected) {
     for (int x = 0; x < kW; ++x)
       if (f.at<cv::Vec4b>(y, x)[1] == 255) sx += x, sy += y, n += 1;
   ASSERT_GT(n, 1000);
-  std::array<Vec2, 4> q = {pixelOf(0.45, 0.45), pixelOf(0.6, 0.45), pixelOf(0.6, 0.6), pixelOf(0.45, 0.6)};
+  std::array<Vec2, 4> q = {pixelOf(0.45, 0.45), pixelOf(0.6, 0.45), pixelOf(0.6, 0.6),
+                           pixelOf(0.45, 0.6)};
   double A = 0, cx = 0, cy = 0, L = 0;
   for (int i = 0; i < 4; ++i) {
     const Vec2 &p = q[i], &r = q[(i + 1) % 4];
@@ -242,7 +245,8 @@ TEST(Planar3d, RenderedNearerSurfaceHidesFartherAndLandsWhereExpected) {
   const double tol = std::max(0.05, L / (2 * std::abs(A)));
   EXPECT_NEAR(sx / n, cx, tol);
   EXPECT_NEAR(sy / n, cy, tol);
-  std::printf("green centroid error (%.4f, %.4f) px, tolerance %.4f\n", sx / n - cx, sy / n - cy, tol);
+  std::printf("green centroid error (%.4f, %.4f) px, tolerance %.4f\n", sx / n - cx, sy / n - cy,
+              tol);
 }
 
 }  // namespace

@@ -3,9 +3,8 @@
 // image-difference measures.
 #include <cmath>
 #include <cstdint>
-#include <random>
-
 #include <opencv2/core.hpp>
+#include <random>
 
 namespace procam::test {
 
@@ -17,7 +16,8 @@ inline cv::Mat smoothImage(cv::Size size, double kx, double ky) {
     for (int x = 0; x < size.width; ++x) {
       cv::Vec4b& p = img.at<cv::Vec4b>(y, x);
       for (int c = 0; c < 3; ++c) {
-        p[c] = static_cast<uint8_t>(std::lround(127.5 + 127.5 * std::sin(kx * x + ky * y + 2.0 * c)));
+        p[c] =
+            static_cast<uint8_t>(std::lround(127.5 + 127.5 * std::sin(kx * x + ky * y + 2.0 * c)));
       }
       p[3] = 255;
     }
@@ -51,7 +51,7 @@ inline cv::Mat randomImage(cv::Size size, uint32_t seed) {
 struct Difference {
   double mean_abs = 0;  // in code values, over compared pixels and channels
   double max_abs = 0;
-  double psnr = 0;      // dB, peak 255; infinity when identical
+  double psnr = 0;  // dB, peak 255; infinity when identical
   long pixels = 0;
 };
 

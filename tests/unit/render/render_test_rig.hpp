@@ -33,7 +33,8 @@ inline void pixelRay(const Mat34& P, double x, double y, Vec3& origin, Vec3& dir
 }
 
 // Nearest ray-mesh hit (Moller-Trumbore), t > 0.
-inline std::optional<Vec3> intersect(const render::SurfaceMesh& mesh, const Vec3& o, const Vec3& d) {
+inline std::optional<Vec3> intersect(const render::SurfaceMesh& mesh, const Vec3& o,
+                                     const Vec3& d) {
   double best = INFINITY;
   for (const auto& tri : mesh.triangles) {
     const Vec3 &a = mesh.vertices[tri[0]], &b = mesh.vertices[tri[1]], &c = mesh.vertices[tri[2]];

@@ -29,15 +29,15 @@ TEST(RenderPath, FollowsTheDesignTable) {
   EXPECT_TRUE(dome.post_warp && dome.blend);
   EXPECT_EQ(pick(SurfaceKind::kNonPlanar, ViewerKind::kStatic, ContentKind::kImage, 1).path,
             RenderPath::kLookupWarp);
-  EXPECT_FALSE(pick(SurfaceKind::kNonPlanar, ViewerKind::kTracked, ContentKind::kImage, 1).post_warp);
+  EXPECT_FALSE(
+      pick(SurfaceKind::kNonPlanar, ViewerKind::kTracked, ContentKind::kImage, 1).post_warp);
   EXPECT_EQ(choosePath({SurfaceKind::kObject, ViewerKind::kTracked, ContentKind::kMesh3d, 1})
                 .error()
                 .code,
             ErrorCode::kNotFound);
-  EXPECT_EQ(choosePath({SurfaceKind::kPlanar, ViewerKind::kTracked, ContentKind::kImage, 0})
-                .error()
-                .code,
-            ErrorCode::kInvalidInput);
+  EXPECT_EQ(
+      choosePath({SurfaceKind::kPlanar, ViewerKind::kTracked, ContentKind::kImage, 0}).error().code,
+      ErrorCode::kInvalidInput);
 }
 
 TEST(CpuRenderer, UnchangedFrameIsNotRenderedAgain) {
@@ -88,10 +88,10 @@ TEST(CpuRenderer, PlanarMeshTwoPassEqualsTheInducedHomography) {
   // A planar surface rendered by the two-pass path must give the homography path's image:
   // the path choice changes cost, never the picture.
   const SurfaceMesh wall = test::planeMesh(Vec3(0, 3, 1.2), Vec3::UnitX(), Vec3::UnitZ(), 3, 2, 2);
-  const Mat34 P = test::lookAtProjection(300, 159.5, 119.5, Vec3(-0.4, 0, 1.0), Vec3(0, 3, 1.3),
-                                         Vec3::UnitZ());
-  const Mat34 V = test::lookAtProjection(250, 99.5, 79.5, Vec3(0.3, 0.2, 1.4), Vec3(0, 3, 1.2),
-                                         Vec3::UnitZ());
+  const Mat34 P =
+      test::lookAtProjection(300, 159.5, 119.5, Vec3(-0.4, 0, 1.0), Vec3(0, 3, 1.3), Vec3::UnitZ());
+  const Mat34 V =
+      test::lookAtProjection(250, 99.5, 79.5, Vec3(0.3, 0.2, 1.4), Vec3(0, 3, 1.2), Vec3::UnitZ());
   RenderSetup mesh;
   mesh.output_size = {320, 240};
   mesh.content_size = {200, 160};

@@ -9,9 +9,13 @@
 namespace procam::render {
 namespace {
 
-double light(int code, double gamma) { return std::pow(code / 255.0, gamma); }
+double light(int code, double gamma) {
+  return std::pow(code / 255.0, gamma);
+}
 
-int blended(int c, int alpha, const Lut& lut) { return (c * lut[alpha] + 127) / 255; }
+int blended(int c, int alpha, const Lut& lut) {
+  return (c * lut[alpha] + 127) / 255;
+}
 
 TEST(FinalStage, ComplementaryMasksSumToTheContentLightThroughTheWeightLut) {
   // Two projectors with code^gamma response and masks a, 255 - a: with the weight LUT
@@ -23,7 +27,8 @@ TEST(FinalStage, ComplementaryMasksSumToTheContentLightThroughTheWeightLut) {
   ASSERT_TRUE(lut);
   for (int c : {64, 128, 200, 255}) {
     for (int a = 0; a <= 255; ++a) {
-      const double sum = light(blended(c, a, *lut), gamma) + light(blended(c, 255 - a, *lut), gamma);
+      const double sum =
+          light(blended(c, a, *lut), gamma) + light(blended(c, 255 - a, *lut), gamma);
       EXPECT_NEAR(sum, light(c, gamma), 2 * gamma / 255) << "c=" << c << " a=" << a;
     }
   }
@@ -41,8 +46,9 @@ TEST(FinalStage, AppliesMaskToColourOnlyThenOutputLut) {
   ASSERT_TRUE(applyFinalStage(s, img));
   EXPECT_EQ(img.at<cv::Vec4b>(0, 0), cv::Vec4b(200, 155, 50, 77));
   EXPECT_EQ(img.at<cv::Vec4b>(0, 1), cv::Vec4b(0, 255, 0, 77));
-  EXPECT_EQ(img.at<cv::Vec4b>(1, 0), cv::Vec4b((200 * 128 + 127) / 255, 255 - (100 * 128 + 127) / 255,
-                                               (50 * 128 + 127) / 255, 77));
+  EXPECT_EQ(img.at<cv::Vec4b>(1, 0),
+            cv::Vec4b((200 * 128 + 127) / 255, 255 - (100 * 128 + 127) / 255,
+                      (50 * 128 + 127) / 255, 77));
   cv::Mat wrong(3, 3, CV_8UC4);
   EXPECT_EQ(applyFinalStage(s, wrong).error().code, ErrorCode::kInvalidInput);
   EXPECT_EQ(weightLutForGamma(0).error().code, ErrorCode::kInvalidInput);

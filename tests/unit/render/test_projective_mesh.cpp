@@ -34,7 +34,8 @@ void expectMatchesRayCast(const SurfaceMesh& mesh, const Mat34& P, const Mat34& 
 
 TEST(ProjectiveTexture, ObliquePlaneMatchesRayCasting) {
   // Wall y = 3 (world +Z up), projector low and to the left, viewer elsewhere.
-  const SurfaceMesh wall = test::planeMesh(Vec3(0, 3, 1.2), Vec3::UnitX(), Vec3::UnitZ(), 2.0, 1.5, 3);
+  const SurfaceMesh wall =
+      test::planeMesh(Vec3(0, 3, 1.2), Vec3::UnitX(), Vec3::UnitZ(), 2.0, 1.5, 3);
   const Mat34 P = test::lookAtProjection(700, 319.5, 239.5, Vec3(-0.6, 0, 0.7), Vec3(0.1, 3, 1.3),
                                          Vec3::UnitZ());
   const Mat34 V = test::lookAtProjection(900, 511.5, 383.5, Vec3(0.4, 0.5, 1.6), Vec3(0, 3, 1.2),
@@ -44,13 +45,14 @@ TEST(ProjectiveTexture, ObliquePlaneMatchesRayCasting) {
 
 TEST(ProjectiveTexture, NearerSurfaceWinsTheDepthTest) {
   SurfaceMesh two = test::planeMesh(Vec3(0, 3, 1.2), Vec3::UnitX(), Vec3::UnitZ(), 2.0, 1.5, 1);
-  const SurfaceMesh front = test::planeMesh(Vec3(0.2, 2, 1.2), Vec3::UnitX(), Vec3::UnitZ(), 0.3, 0.3, 1);
+  const SurfaceMesh front =
+      test::planeMesh(Vec3(0.2, 2, 1.2), Vec3::UnitX(), Vec3::UnitZ(), 0.3, 0.3, 1);
   // Front panel listed after and before the wall: the result must not depend on order.
   const int base = static_cast<int>(two.vertices.size());
   two.vertices.insert(two.vertices.end(), front.vertices.begin(), front.vertices.end());
   for (auto t : front.triangles) two.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
-  const Mat34 P = test::lookAtProjection(600, 159.5, 119.5, Vec3(0, 0, 1.2), Vec3(0, 3, 1.2),
-                                         Vec3::UnitZ());
+  const Mat34 P =
+      test::lookAtProjection(600, 159.5, 119.5, Vec3(0, 0, 1.2), Vec3(0, 3, 1.2), Vec3::UnitZ());
   const Mat34 V = test::lookAtProjection(500, 159.5, 119.5, Vec3(-0.5, 0.3, 1.0), Vec3(0, 3, 1.2),
                                          Vec3::UnitZ());
   expectMatchesRayCast(two, P, V, {320, 240}, 3);

@@ -37,7 +37,8 @@ TEST(Remap, WithinTheQuantisationBoundOfTheDoubleSpecification) {
     for (int x = 0; x < out.width; ++x) {
       const cv::Vec2f s = map.xy.at<cv::Vec2f>(y, x);
       const cv::Vec4d e = sampleBilinear(img, s[0], s[1]);
-      for (int c = 0; c < 4; ++c) worst = std::max(worst, std::abs(dst.at<cv::Vec4b>(y, x)[c] - e[c]));
+      for (int c = 0; c < 4; ++c)
+        worst = std::max(worst, std::abs(dst.at<cv::Vec4b>(y, x)[c] - e[c]));
     }
   }
   EXPECT_LE(worst, 2.0 * 255.0 / 256.0 + 0.5);

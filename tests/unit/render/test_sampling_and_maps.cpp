@@ -24,7 +24,8 @@ TEST(Bilinear, PixelCentresAreExactAndMidpointsAverage) {
   const cv::Vec4d mid = sampleBilinear(img, 2.5, 3.5);
   for (int c = 0; c < 4; ++c) {
     const double expect = (img.at<cv::Vec4b>(3, 2)[c] + img.at<cv::Vec4b>(3, 3)[c] +
-                           img.at<cv::Vec4b>(4, 2)[c] + img.at<cv::Vec4b>(4, 3)[c]) / 4.0;
+                           img.at<cv::Vec4b>(4, 2)[c] + img.at<cv::Vec4b>(4, 3)[c]) /
+                          4.0;
     EXPECT_DOUBLE_EQ(mid[c], expect);
   }
 }
@@ -103,9 +104,11 @@ TEST(HomographyMap, Float32MapWithinHalfUlpOfDoubleMapping) {
         const Vec3 p = Hinv * Vec3(x, y, 1);
         const Vec2 s = p.hnormalized();
         const cv::Vec2f m = map->xy.at<cv::Vec2f>(y, x);
-        const double ulp = std::nextafter(float(std::abs(s.x())), INFINITY) - float(std::abs(s.x()));
+        const double ulp =
+            std::nextafter(float(std::abs(s.x())), INFINITY) - float(std::abs(s.x()));
         worst = std::max(worst, std::abs(m[0] - s.x()) / ulp);
-        const double ulpy = std::nextafter(float(std::abs(s.y())), INFINITY) - float(std::abs(s.y()));
+        const double ulpy =
+            std::nextafter(float(std::abs(s.y())), INFINITY) - float(std::abs(s.y()));
         worst = std::max(worst, std::abs(m[1] - s.y()) / ulpy);
       }
     }

@@ -67,7 +67,7 @@ TEST(SimCheckerboard, CornersLandWhereAnalyticProjectionSays) {
   ASSERT_TRUE(cv::findChessboardCornersSB(*image, cv::Size(kCols - 1, kRows - 1), found,
                                           cv::CALIB_CB_ACCURACY))
       << "checkerboard not found in the rendered camera image";
-  cv::cornerSubPix(*image, found, cv::Size(5, 5), cv::Size(-1, -1),
+  cv::cornerSubPix(*image, found, cv::Size(8, 8), cv::Size(-1, -1),
                    cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 100, 1e-4));
   ASSERT_EQ(found.size(), truth.size());
 

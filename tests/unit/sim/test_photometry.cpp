@@ -25,7 +25,10 @@ cv::Mat patches() {
   return fb;
 }
 
-// Exact radiance of one camera pixel (mean over its 2 x 2 stratum-centre samples),
+// The documented 2 x 2 rotated-grid sample positions (renderer.hpp).
+const Vec2 kSampleOffsets[4] = {{-0.375, -0.125}, {0.125, -0.375}, {-0.125, 0.375}, {0.375, 0.125}};
+
+// Exact radiance of one camera pixel (mean over its 2 x 2 samples),
 // or -1 when a sample's framebuffer neighbourhood is not one flat patch.
 struct Analytic {
   const Scene& scene;
@@ -38,7 +41,7 @@ struct Analytic {
     double sum = 0;
     patch = -1;
     for (int k = 0; k < 4; ++k) {
-      auto ray = c.model.backproject(Vec2(x - 0.25 + 0.5 * (k % 2), y - 0.25 + 0.5 * (k / 2)));
+      auto ray = c.model.backproject(Vec2(x, y) + kSampleOffsets[k]);
       const Vec3 X = ray->at((2.0 - ray->origin.y()) / ray->dir.y());  // wall y = 2
       const auto u = p.model.project(X);
       if (!u) return -1;

@@ -142,7 +142,7 @@ units = "g"
 name = "p"
 resolution = [64, 48]
 intrinsics = { hfov_deg = 40.0 }
-pose = { position = [0.0, 0.0, 1.0], pitch_deg = -90.0 }
+pose = { position = [0.0, 0.0, 1.0], pitch_deg = 90.0 }
 [[tilt_sensors]]
 name = "a"
 attached_to = "p"
@@ -152,7 +152,7 @@ units = "g"
 )",
                               "clamp.toml", {});
   ASSERT_TRUE(clamped);
-  // Looking straight down: +1 g along the projector's z; 1.7 g clamps to 1.5 g.
+  // Looking straight up: +1 g along the projector's z; 1.7 g clamps to 1.5 g.
   auto c = sampleTilt(*clamped, "a", 0.0, 1, false);
   ASSERT_TRUE(c);
   EXPECT_NEAR(c->value.z(), 1.5, 1e-12);

@@ -1,0 +1,235 @@
+#include "sim_plugin.hpp"
+
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <memory>
+#include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
+
+#include "sim/sensors.hpp"
+#include "sim_world.hpp"
+
+namespace procam::sim::mock {
+namespace {
+
+constexpr int kSimScore = 100;
+
+std::string property(const procam_device_desc* d, const char* key) {
+  for (size_t i = 0; i < d->n_properties; ++i) {
+    if (std::strcmp(d->properties[i].key, key) == 0) return d->properties[i].value;
+  }
+  return {};
+}
+
+int reason(char* err, size_t len, const std::string& text, int code) {
+  if (err && len > 0) std::snprintf(err, len, "%s", text.c_str());
+  return code;
+}
+
+struct Device {
+  std::shared_ptr<SimWorld> world;
+  std::string name;
+  std::vector<uint8_t> buffer;  // camera frames
+};
+
+int noFd(void*) {
+  return -1;
+}
+void destroy(void* self) {
+  delete static_cast<Device*>(self);
+}
+
+int probe(const procam_device_desc* d) {
+  return d->subsystem && std::strcmp(d->subsystem, "sim") == 0 ? kSimScore : 0;
+}
+
+// --- tilt ---
+int tiltRead(void* self, procam_tilt_sample* out, char* err, size_t len) {
+  auto* dev = static_cast<Device*>(self);
+  const double t = dev->world->now();
+  auto s = sampleTilt(dev->world->scene(), dev->name, t);
+  if (!s) return reason(err, len, s.error().message, PROCAM_EIO);
+  const TiltSensorSpec* spec = nullptr;
+  for (const auto& ts : dev->world->scene().tiltSensors()) {
+    if (ts.name == dev->name) spec = &ts;
+  }
+  const double unit = spec && spec->report_in_g ? kStandardGravity : 1.0;  // ABI: m/s^2
+  for (int i = 0; i < 3; ++i) out->specific_force[i] = s->value[i] * unit;
+  out->timestamp_ns = static_cast<uint64_t>(t * 1e9);
+  return PROCAM_OK;
+}
+const procam_tilt_ops kTiltOps = {tiltRead};
+
+// --- tracker ---
+int trackerRead(void* self, procam_pose_sample* out, char* err, size_t len) {
+  auto* dev = static_cast<Device*>(self);
+  const double t = dev->world->now();
+  auto s = sampleTracker(dev->world->scene(), dev->name, t);
+  if (!s) return reason(err, len, s.error().message, PROCAM_EIO);
+  for (int i = 0; i < 3; ++i) out->position[i] = s->position[i];
+  out->orientation[0] = 1;  // position-only trackers: identity orientation
+  out->orientation[1] = out->orientation[2] = out->orientation[3] = 0;
+  out->timestamp_ns = static_cast<uint64_t>(t * 1e9);
+  return PROCAM_OK;
+}
+const procam_tracker_ops kTrackerOps = {trackerRead};
+
+// --- output ---
+const ProjectorSpec* projectorSpec(const Device* dev) {
+  for (const auto& p : dev->world->scene().projectors()) {
+    if (p.name == dev->name) return &p;
+  }
+  return nullptr;
+}
+
+int outputMode(void* self, uint32_t* w, uint32_t* h, double* hz) {
+  const ProjectorSpec* p = projectorSpec(static_cast<Device*>(self));
+  if (!p) return PROCAM_ENODEV;
+  *w = static_cast<uint32_t>(p->width);
+  *h = static_cast<uint32_t>(p->height);
+  *hz = 60.0;
+  return PROCAM_OK;
+}
+
+int outputShow(void* self, const procam_image* frame, char* err, size_t len) {
+  auto* dev = static_cast<Device*>(self);
+  const ProjectorSpec* p = projectorSpec(dev);
+  if (!p) return reason(err, len, "projector gone", PROCAM_ENODEV);
+  if (static_cast<int>(frame->width) != p->width || static_cast<int>(frame->height) != p->height) {
+    return reason(err, len,
+                  "frame is not " + std::to_string(p->width) + "x" + std::to_string(p->height),
+                  PROCAM_EINVAL);
+  }
+  try {
+    cv::Mat bgr;
+    if (frame->format == PROCAM_PIXEL_RGB8) {
+      cv::cvtColor(cv::Mat(frame->height, frame->width, CV_8UC3, frame->data, frame->stride), bgr,
+                   cv::COLOR_RGB2BGR);
+    } else if (frame->format == PROCAM_PIXEL_GRAY8) {
+      bgr = cv::Mat(frame->height, frame->width, CV_8UC1, frame->data, frame->stride).clone();
+    } else if (frame->format == PROCAM_PIXEL_GRAY16) {
+      bgr = cv::Mat(frame->height, frame->width, CV_16UC1, frame->data, frame->stride).clone();
+    } else {
+      return reason(err, len, "unsupported pixel format", PROCAM_EINVAL);
+    }
+    dev->world->show(dev->name, std::move(bgr));
+  } catch (const std::exception& e) {
+    return reason(err, len, e.what(), PROCAM_EINTERNAL);
+  }
+  return PROCAM_OK;
+}
+const procam_output_ops kOutputOps = {outputMode, outputShow};
+
+// --- camera ---
+const CameraSpec* cameraSpec(const Device* dev) {
+  for (const auto& c : dev->world->scene().cameras()) {
+    if (c.name == dev->name) return &c;
+  }
+  return nullptr;
+}
+
+int cameraFormat(void* self, uint32_t* w, uint32_t* h, procam_pixel_format* f) {
+  const CameraSpec* c = cameraSpec(static_cast<Device*>(self));
+  if (!c) return PROCAM_ENODEV;
+  *w = static_cast<uint32_t>(c->width);
+  *h = static_cast<uint32_t>(c->height);
+  *f = c->channels == 3   ? PROCAM_PIXEL_RGB8
+       : c->bit_depth > 8 ? PROCAM_PIXEL_GRAY16
+                          : PROCAM_PIXEL_GRAY8;
+  return PROCAM_OK;
+}
+
+int cameraExposure(void*, double, char* err, size_t len) {
+  return reason(err, len, "the virtual camera's exposure is fixed by the scene", PROCAM_ENOTSUP);
+}
+
+int cameraCapture(void* self, int, procam_image* out, char* err, size_t len) {
+  auto* dev = static_cast<Device*>(self);
+  try {
+    const double t = dev->world->now();
+    const Scene& scene = dev->world->scene();
+    auto renderer = Renderer::create(scene, scene.at(t), dev->world->shown());
+    if (!renderer) return reason(err, len, renderer.error().message, PROCAM_EIO);
+    auto image = renderer->renderCamera(dev->name);
+    if (!image) return reason(err, len, image.error().message, PROCAM_EIO);
+    cv::Mat m = *image;
+    if (m.channels() == 3) cv::cvtColor(m, m, cv::COLOR_BGR2RGB);
+    if (!m.isContinuous()) m = m.clone();
+    dev->buffer.assign(m.datastart, m.dataend);
+    out->width = static_cast<uint32_t>(m.cols);
+    out->height = static_cast<uint32_t>(m.rows);
+    out->stride = static_cast<uint32_t>(m.step[0]);
+    out->format = m.channels() == 3     ? PROCAM_PIXEL_RGB8
+                  : m.depth() == CV_16U ? PROCAM_PIXEL_GRAY16
+                                        : PROCAM_PIXEL_GRAY8;
+    out->data = dev->buffer.data();
+    out->timestamp_ns = static_cast<uint64_t>(t * 1e9);
+  } catch (const std::exception& e) {
+    return reason(err, len, e.what(), PROCAM_EINTERNAL);
+  }
+  return PROCAM_OK;
+}
+const procam_camera_ops kCameraOps = {cameraFormat, cameraExposure, cameraCapture};
+
+template <procam_family Family>
+int create(const procam_device_desc* d, const procam_config*, procam_device* out, char* err,
+           size_t len) {
+  try {
+    const std::string scene = property(d, "SIM_SCENE");
+    const std::string name = property(d, "SIM_DEVICE");
+    if (scene.empty() || name.empty()) {
+      return reason(err, len, "a sim device needs SIM_SCENE and SIM_DEVICE", PROCAM_EINVAL);
+    }
+    auto world = SimWorld::open(scene);
+    if (!world) return reason(err, len, world.error().message, PROCAM_EINVAL);
+    auto dev = std::make_unique<Device>(Device{*world, name, {}});
+    bool known = false;
+    const Scene& s = (*world)->scene();
+    if constexpr (Family == PROCAM_FAMILY_CAMERA) {
+      known = cameraSpec(dev.get()) != nullptr;
+      out->ops.camera = &kCameraOps;
+    } else if constexpr (Family == PROCAM_FAMILY_TILT) {
+      for (const auto& t : s.tiltSensors()) known = known || t.name == name;
+      out->ops.tilt = &kTiltOps;
+    } else if constexpr (Family == PROCAM_FAMILY_TRACKER) {
+      for (const auto& t : s.trackers()) known = known || t.name == name;
+      out->ops.tracker = &kTrackerOps;
+    } else {
+      known = projectorSpec(dev.get()) != nullptr;
+      out->ops.output = &kOutputOps;
+    }
+    if (!known) {
+      return reason(err, len, "scene '" + s.name() + "' has no such device '" + name + "'",
+                    PROCAM_ENODEV);
+    }
+    out->family = Family;
+    out->self = dev.release();
+    out->poll_fd = noFd;
+    out->destroy = destroy;
+    return PROCAM_OK;
+  } catch (const std::exception& e) {
+    return reason(err, len, e.what(), PROCAM_EINTERNAL);
+  }
+}
+
+const procam_driver_factory kFactories[] = {
+    {PROCAM_FAMILY_CAMERA, "sim-camera", "virtual rig camera (ray-cast rendering)", probe,
+     create<PROCAM_FAMILY_CAMERA>},
+    {PROCAM_FAMILY_TILT, "sim-tilt", "virtual rig accelerometer", probe,
+     create<PROCAM_FAMILY_TILT>},
+    {PROCAM_FAMILY_TRACKER, "sim-tracker", "virtual rig head tracker", probe,
+     create<PROCAM_FAMILY_TRACKER>},
+    {PROCAM_FAMILY_OUTPUT, "sim-output", "virtual rig projector", probe,
+     create<PROCAM_FAMILY_OUTPUT>},
+};
+
+const procam_plugin_table kTable = {PROCAM_PLUGIN_ABI_VERSION, "sim", "1", 4, kFactories};
+
+}  // namespace
+}  // namespace procam::sim::mock
+
+extern "C" const procam_plugin_table* procam_sim_plugin_entry(void) {
+  return &procam::sim::mock::kTable;
+}

@@ -1,0 +1,131 @@
+// Virtual-rig render bench: time to render wall_oblique's 1280x960 camera while its
+// 1920x1080 projector shows a checkerboard, on one core, split into framebuffer
+// preparation (gamma LUT + footprint blur), ray casting/shading and the sensor
+// model. Baseline in the same run: cv::warpPerspective of the framebuffer into the
+// camera image through the wall homography (the cheapest possible "rendering" of a
+// plane, no distortion, photometry, shadows or noise).
+//
+//   bench_sim_render [--out DIR] [--runs N]
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
+
+#include "sim/projector_image.hpp"
+#include "sim/renderer.hpp"
+#include "sim/scene_library.hpp"
+
+using namespace procam;
+using namespace procam::sim;
+
+namespace {
+
+struct Timing {
+  double median_ms = 0, min_ms = 0;
+};
+
+Timing measure(int runs, const std::function<void()>& body) {
+  std::vector<double> ms;
+  for (int i = 0; i < runs; ++i) {
+    const auto t0 = std::chrono::steady_clock::now();
+    body();
+    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                     .count());
+  }
+  std::sort(ms.begin(), ms.end());
+  return {ms[ms.size() / 2], ms.front()};
+}
+
+cv::Mat checkerboard(int width, int height, int square) {
+  cv::Mat fb(height, width, CV_8UC3);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x)
+      fb.at<cv::Vec3b>(y, x) = ((x / square + y / square) % 2) ? cv::Vec3b(255, 255, 255)
+                                                               : cv::Vec3b(0, 0, 0);
+  return fb;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::filesystem::path out = ".";
+  int runs = 5;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--out" && i + 1 < argc) {
+      out = argv[++i];
+    } else if (a == "--runs" && i + 1 < argc) {
+      runs = std::max(1, std::stoi(argv[++i]));
+    } else {
+      std::fprintf(stderr, "usage: bench_sim_render [--out DIR] [--runs N]\n");
+      return 2;
+    }
+  }
+  std::filesystem::create_directories(out);
+  cv::setNumThreads(1);  // single core, OpenCV's own filters included
+
+  auto scene = resolveScene("wall_oblique");
+  if (!scene) {
+    std::fprintf(stderr, "bench_sim_render: %s\n", scene.error().message.c_str());
+    return 1;
+  }
+  const SceneState state = scene->at(0);
+  const ProjectorState& proj = state.projectors.at(0);
+  const CameraState& cam = state.cameras.at(0);
+  const cv::Mat fb = checkerboard(proj.model.width, proj.model.height, 60);
+
+  RenderOptions options;
+  options.threads = 1;
+  options.seed = 3;
+  cv::Mat image;
+  const Timing full = measure(runs, [&] {
+    auto r = Renderer::create(*scene, state, {{"proj", fb}});
+    image = *r->renderCamera(cam.spec.name, options);
+  });
+  const Timing prepare = measure(runs, [&] { (void)ProjectorImage::create(fb, proj.spec); });
+  auto renderer = Renderer::create(*scene, state, {{"proj", fb}});
+  const Timing radiance = measure(runs, [&] { (void)renderer->cameraRadiance(cam.spec.name, 1); });
+  const Timing camera = measure(runs, [&] { (void)renderer->renderCamera(cam.spec.name, options); });
+
+  // Baseline: framebuffer -> camera through the wall homography (plane y = 3).
+  const Mat34 Pp = proj.model.projectionMatrix(), Pc = cam.model.projectionMatrix();
+  Mat3 Hp, Hc;  // wall point (x, z, 1) -> image
+  Hp << Pp.col(0), Pp.col(2), Pp.col(1) * 3.0 + Pp.col(3);
+  Hc << Pc.col(0), Pc.col(2), Pc.col(1) * 3.0 + Pc.col(3);
+  const Mat3 H = Hc * Hp.inverse();
+  cv::Mat Hcv(3, 3, CV_64F);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) Hcv.at<double>(r, c) = H(r, c);
+  cv::Mat warped;
+  const Timing warp = measure(runs, [&] {
+    cv::warpPerspective(fb, warped, Hcv, cv::Size(cam.model.width, cam.model.height),
+                        cv::INTER_LINEAR);
+  });
+
+  const double samples = double(cam.model.width) * cam.model.height * cam.spec.supersamples;
+  std::ofstream csv(out / "bench_sim_render.csv");
+  csv << "case,camera,projector,supersamples,threads,median_ms,min_ms,ns_per_sample,"
+         "x_warpPerspective\n";
+  auto row = [&](const char* name, const Timing& t) {
+    csv << name << ',' << cam.model.width << 'x' << cam.model.height << ',' << proj.model.width
+        << 'x' << proj.model.height << ',' << cam.spec.supersamples << ",1," << t.median_ms << ','
+        << t.min_ms << ',' << t.median_ms * 1e6 / samples << ',' << t.median_ms / warp.median_ms
+        << '\n';
+    std::printf("%-34s median %9.2f ms  min %9.2f ms  %7.1f ns/sample  %7.1fx warpPerspective\n",
+                name, t.median_ms, t.min_ms, t.median_ms * 1e6 / samples,
+                t.median_ms / warp.median_ms);
+  };
+  row("sim_render_total", full);
+  row("sim_prepare_framebuffer", prepare);
+  row("sim_camera_radiance", radiance);
+  row("sim_render_camera", camera);
+  row("baseline_cv_warpPerspective", warp);
+  std::printf("wrote %s\n", (out / "bench_sim_render.csv").c_str());
+  return 0;
+}
