@@ -1,6 +1,7 @@
 #include "driver.hpp"
 
 #include <array>
+#include <cstring>
 
 namespace procam::plugins {
 
@@ -16,6 +17,17 @@ const char* familyName(procam_family family) {
       return "output";
   }
   return "unknown";
+}
+
+uint32_t rawFamily(const procam_family& field) {
+  static_assert(sizeof(procam_family) == sizeof(uint32_t), "the ABI's enums are 32 bits");
+  uint32_t raw = 0;
+  std::memcpy(&raw, &field, sizeof raw);
+  return raw;
+}
+
+bool isKnownFamily(uint32_t raw) {
+  return raw >= PROCAM_FAMILY_CAMERA && raw <= PROCAM_FAMILY_OUTPUT;
 }
 
 Result<procam_family> parseFamily(const std::string& text) {
@@ -118,10 +130,12 @@ Result<Device> createDevice(const Driver& driver, DeviceDescription& desc,
     return fail(ErrorCode::kInvalidInput, who + " returned a device without destroy()");
   }
   Device device(out, driver.library, driver.factory->name);  // owns it from here on
-  if (out.family != driver.factory->family) {
-    return fail(ErrorCode::kInvalidInput, who + " returned a " + familyName(out.family) +
-                                              " device for a " +
-                                              familyName(driver.factory->family) + " factory");
+  if (rawFamily(out.family) != rawFamily(driver.factory->family)) {
+    const uint32_t got = rawFamily(out.family);
+    return fail(ErrorCode::kInvalidInput,
+                who + " returned a device of family " +
+                    (isKnownFamily(got) ? familyName(out.family) : std::to_string(got)) +
+                    " for a " + familyName(driver.factory->family) + " factory");
   }
   if (!opsComplete(out)) {
     return fail(ErrorCode::kInvalidInput,

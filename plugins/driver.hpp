@@ -12,6 +12,11 @@
 namespace procam::plugins {
 
 const char* familyName(procam_family family);
+
+// The bits of a family field written by a plugin, read without assuming they
+// hold a valid enumerator (loading an out-of-range enum is undefined in C++).
+uint32_t rawFamily(const procam_family& field);
+bool isKnownFamily(uint32_t raw);
 // Parses "camera", "tilt", "tracker", "output".
 Result<procam_family> parseFamily(const std::string& text);
 

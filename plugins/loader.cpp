@@ -36,9 +36,9 @@ Result<void> validateTable(const procam_plugin_table* table, const std::string& 
     const procam_driver_factory& f = table->factories[i];
     const std::string where = "plugin " + origin + ", factory #" + std::to_string(i);
     if (!f.name || !*f.name) return fail(ErrorCode::kInvalidInput, where + " has no name");
-    if (f.family < PROCAM_FAMILY_CAMERA || f.family > PROCAM_FAMILY_OUTPUT) {
+    if (!isKnownFamily(rawFamily(f.family))) {
       return fail(ErrorCode::kInvalidInput, where + " ('" + f.name + "') has an unknown family " +
-                                                std::to_string(static_cast<int>(f.family)));
+                                                std::to_string(rawFamily(f.family)));
     }
     if (!f.probe || !f.create) {
       return fail(ErrorCode::kInvalidInput,

@@ -2,8 +2,8 @@
 
 #include <charconv>
 #include <cmath>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 
 namespace procam::cli {
 
@@ -14,7 +14,8 @@ Result<Arguments> Arguments::parse(int argc, char** argv, int first) {
     const std::string word = argv[i];
     if (word.rfind("--", 0) == 0 && word.size() > 2) {
       current = word.substr(2);
-      if (a.values_.count(current)) return fail(ErrorCode::kInvalidInput, "option --" + current + " given twice");
+      if (a.values_.count(current))
+        return fail(ErrorCode::kInvalidInput, "option --" + current + " given twice");
       a.values_[current];
     } else if (current.empty()) {
       return fail(ErrorCode::kInvalidInput, "unexpected argument '" + word + "'");
@@ -28,7 +29,8 @@ Result<Arguments> Arguments::parse(int argc, char** argv, int first) {
 Result<std::string> Arguments::one(const std::string& name) const {
   auto it = values_.find(name);
   if (it == values_.end()) return fail(ErrorCode::kInvalidInput, "missing --" + name);
-  if (it->second.size() != 1) return fail(ErrorCode::kInvalidInput, "--" + name + " takes one value");
+  if (it->second.size() != 1)
+    return fail(ErrorCode::kInvalidInput, "--" + name + " takes one value");
   return it->second[0];
 }
 

@@ -4,7 +4,6 @@
 #include <bit>
 #include <cstring>
 #include <fstream>
-
 #include <opencv2/imgcodecs.hpp>
 
 namespace procam::cli {
@@ -12,11 +11,16 @@ namespace {
 
 const char* kindName(sl::FrameKind k) {
   switch (k) {
-    case sl::FrameKind::kWhite: return "white";
-    case sl::FrameKind::kBlack: return "black";
-    case sl::FrameKind::kGray: return "gray";
-    case sl::FrameKind::kGrayInverse: return "gray_inverse";
-    case sl::FrameKind::kPhase: return "phase";
+    case sl::FrameKind::kWhite:
+      return "white";
+    case sl::FrameKind::kBlack:
+      return "black";
+    case sl::FrameKind::kGray:
+      return "gray";
+    case sl::FrameKind::kGrayInverse:
+      return "gray_inverse";
+    case sl::FrameKind::kPhase:
+      return "phase";
   }
   return "?";
 }
@@ -24,10 +28,12 @@ const char* kindName(sl::FrameKind k) {
 Result<std::vector<double>> numbers(const nlohmann::json& j, const char* key, std::size_t n,
                                     const std::string& where) {
   if (!j.contains(key) || !j[key].is_array() || j[key].size() != n)
-    return fail(ErrorCode::kParse, where + ": '" + key + "' must be an array of " + std::to_string(n) + " numbers");
+    return fail(ErrorCode::kParse,
+                where + ": '" + key + "' must be an array of " + std::to_string(n) + " numbers");
   std::vector<double> out;
   for (const auto& v : j[key]) {
-    if (!v.is_number()) return fail(ErrorCode::kParse, where + ": '" + key + "' holds a non-number");
+    if (!v.is_number())
+      return fail(ErrorCode::kParse, where + ": '" + key + "' holds a non-number");
     out.push_back(v.get<double>());
   }
   return out;
@@ -105,14 +111,14 @@ Result<sl::PatternSet> readSequence(const fs::path& dir) {
     if (!set) return tl::unexpected(set.error());
     const auto& frames = j->at("frames");
     if (frames.size() != set->frames.size())
-      return fail(ErrorCode::kParse, (dir / "sequence.json").string() + " lists " +
-                                         std::to_string(frames.size()) + " frames, the options give " +
-                                         std::to_string(set->frames.size()));
+      return fail(ErrorCode::kParse,
+                  (dir / "sequence.json").string() + " lists " + std::to_string(frames.size()) +
+                      " frames, the options give " + std::to_string(set->frames.size()));
     for (std::size_t i = 0; i < frames.size(); ++i)
       if (frames[i].at("name").get<std::string>() != set->frames[i].name)
         return fail(ErrorCode::kParse, "sequence.json frame " + std::to_string(i) + " is '" +
-                                           frames[i].at("name").get<std::string>() + "', expected '" +
-                                           set->frames[i].name + "'");
+                                           frames[i].at("name").get<std::string>() +
+                                           "', expected '" + set->frames[i].name + "'");
     return set;
   } catch (const nlohmann::json::exception& e) {
     return fail(ErrorCode::kParse, (dir / "sequence.json").string() + ": " + e.what());
@@ -120,7 +126,8 @@ Result<sl::PatternSet> readSequence(const fs::path& dir) {
 }
 
 Result<std::vector<cv::Mat>> readCaptures(const sl::PatternSet& set, const fs::path& dir) {
-  if (!fs::is_directory(dir)) return fail(ErrorCode::kIo, "captures directory " + dir.string() + " does not exist");
+  if (!fs::is_directory(dir))
+    return fail(ErrorCode::kIo, "captures directory " + dir.string() + " does not exist");
   std::vector<cv::Mat> out;
   for (const sl::FrameInfo& f : set.frames) {
     const fs::path file = dir / (f.name + ".png");
@@ -130,7 +137,8 @@ Result<std::vector<cv::Mat>> readCaptures(const sl::PatternSet& set, const fs::p
     if (!out.empty() && m.size() != out[0].size())
       return fail(ErrorCode::kInvalidInput, file.string() + " is " + std::to_string(m.cols) + "x" +
                                                 std::to_string(m.rows) + ", the first capture " +
-                                                std::to_string(out[0].cols) + "x" + std::to_string(out[0].rows));
+                                                std::to_string(out[0].cols) + "x" +
+                                                std::to_string(out[0].rows));
     out.push_back(std::move(m));
   }
   return out;
@@ -161,7 +169,8 @@ Result<std::vector<NamedCamera>> readCameras(const fs::path& file) {
   auto j = readJson(file);
   if (!j) return tl::unexpected(j.error());
   if (!j->contains("cameras") || !(*j)["cameras"].is_array() || (*j)["cameras"].empty())
-    return fail(ErrorCode::kParse, file.string() + ": expected {\"cameras\": [ ... ]} with at least one camera");
+    return fail(ErrorCode::kParse,
+                file.string() + ": expected {\"cameras\": [ ... ]} with at least one camera");
   std::vector<NamedCamera> out;
   for (const auto& c : (*j)["cameras"]) {
     NamedCamera n;
@@ -228,8 +237,10 @@ Result<std::vector<fs::path>> listImages(const fs::path& dir) {
   std::vector<fs::path> out;
   for (const auto& e : fs::directory_iterator(dir, ec)) {
     std::string ext = e.path().extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return std::tolower(ch); });
-    if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".tif" || ext == ".tiff" || ext == ".bmp")
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char ch) { return std::tolower(ch); });
+    if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".tif" || ext == ".tiff" ||
+        ext == ".bmp")
       out.push_back(e.path());
   }
   std::sort(out.begin(), out.end());

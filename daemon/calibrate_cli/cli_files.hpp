@@ -2,11 +2,10 @@
 // File formats of procam-calibrate: pattern PNGs and sequence.json, capture
 // directories, the correspondence PFM, cameras.json / rig.json (README.md here).
 #include <filesystem>
-#include <string>
-#include <vector>
-
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
+#include <string>
+#include <vector>
 
 #include "calibration/projector_calibration.hpp"
 #include "core/error.hpp"

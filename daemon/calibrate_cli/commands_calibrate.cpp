@@ -1,6 +1,5 @@
 // camera, stereo, solve (route a), solve-planes (route b), solve-fiducials (route c).
 #include <cstdio>
-
 #include <opencv2/imgcodecs.hpp>
 
 #include "calibration/camera_calibration.hpp"
@@ -30,19 +29,22 @@ Result<std::vector<calib::BoardView>> detectAll(const calib::BoardSpec& spec, co
     cv::Mat image = cv::imread(f.string(), cv::IMREAD_UNCHANGED);
     if (image.empty()) return fail(ErrorCode::kIo, "cannot read " + f.string());
     if (size.area() > 0 && image.size() != size)
-      return fail(ErrorCode::kInvalidInput, f.string() + " has a different size from the first image");
+      return fail(ErrorCode::kInvalidInput,
+                  f.string() + " has a different size from the first image");
     size = image.size();
     auto v = calib::detectBoard(spec, image);
     progress("board view " + std::to_string(i + 1) + "/" + std::to_string(files->size()) + " " +
-             f.filename().string() + ": " + (v ? std::to_string(v->image.size()) + " points" : v.error().message));
+             f.filename().string() + ": " +
+             (v ? std::to_string(v->image.size()) + " points" : v.error().message));
     if (v) views.push_back(std::move(*v));
   }
   return views;
 }
 
-Result<sl::Decoded> decodeDir(const sl::PatternSet& set, const std::string& dir, std::size_t i, std::size_t n) {
-  progress("decoding captures " + std::to_string(i + 1) + "/" + std::to_string(n) + " (" + dir + ", " +
-           std::to_string(set.frames.size()) + " frames)");
+Result<sl::Decoded> decodeDir(const sl::PatternSet& set, const std::string& dir, std::size_t i,
+                              std::size_t n) {
+  progress("decoding captures " + std::to_string(i + 1) + "/" + std::to_string(n) + " (" + dir +
+           ", " + std::to_string(set.frames.size()) + " frames)");
   auto frames = readCaptures(set, dir);
   if (!frames) return tl::unexpected(frames.error());
   auto d = sl::decode(set, *frames);
@@ -96,7 +98,8 @@ Result<void> runStereo(const Arguments& a) {
   const auto& dirs = a.all("images");
   auto board = a.one("board").and_then(calib::parseBoard);
   auto out = a.one("out");
-  if (dirs.size() != 2) return fail(ErrorCode::kInvalidInput, "--images takes two directories (same file names)");
+  if (dirs.size() != 2)
+    return fail(ErrorCode::kInvalidInput, "--images takes two directories (same file names)");
   if (!board) return asVoid(board);
   if (!out) return asVoid(out);
   // Keep only file names present in both directories and detected in both.
@@ -107,8 +110,10 @@ Result<void> runStereo(const Arguments& a) {
   for (const fs::path& f : *fa) {
     const fs::path g = fs::path(dirs[1]) / f.filename();
     if (!fs::exists(g)) continue;
-    cv::Mat ia = cv::imread(f.string(), cv::IMREAD_UNCHANGED), ib = cv::imread(g.string(), cv::IMREAD_UNCHANGED);
-    if (ia.empty() || ib.empty()) return fail(ErrorCode::kIo, "cannot read " + f.filename().string());
+    cv::Mat ia = cv::imread(f.string(), cv::IMREAD_UNCHANGED),
+            ib = cv::imread(g.string(), cv::IMREAD_UNCHANGED);
+    if (ia.empty() || ib.empty())
+      return fail(ErrorCode::kIo, "cannot read " + f.filename().string());
     size = ia.size();
     auto da = calib::detectBoard(*board, ia), db = calib::detectBoard(*board, ib);
     const bool both = da && db && da->board == db->board;
@@ -132,7 +137,9 @@ Result<void> runStereo(const Arguments& a) {
 }
 
 Result<void> runSolve(const Arguments& a) {
-  if (auto ok = a.only({"patterns", "captures", "cameras", "out", "surface-out", "step", "name"}); !ok) return ok;
+  if (auto ok = a.only({"patterns", "captures", "cameras", "out", "surface-out", "step", "name"});
+      !ok)
+    return ok;
   auto patterns = a.one("patterns");
   auto cameras_file = a.one("cameras");
   auto out = a.one("out");
@@ -158,32 +165,40 @@ Result<void> runSolve(const Arguments& a) {
     if (!d) return asVoid(d);
     const auto& cam = (*cameras)[i].model;
     if (d->u.cols != cam.width || d->u.rows != cam.height)
-      return fail(ErrorCode::kInvalidInput, "captures in " + dirs[i] + " are " + std::to_string(d->u.cols) + "x" +
-                                                std::to_string(d->u.rows) + " but camera '" + (*cameras)[i].name +
-                                                "' is " + std::to_string(cam.width) + "x" + std::to_string(cam.height));
+      return fail(ErrorCode::kInvalidInput,
+                  "captures in " + dirs[i] + " are " + std::to_string(d->u.cols) + "x" +
+                      std::to_string(d->u.rows) + " but camera '" + (*cameras)[i].name + "' is " +
+                      std::to_string(cam.width) + "x" + std::to_string(cam.height));
     auto s = surface::sampleProjectorGrid(*d, pw, ph, {.step = *step});
     if (!s) return asVoid(s);
     samples.push_back(std::move(*s));
   }
-  auto points = surface::triangulateStereo((*cameras)[0].model, samples[0], (*cameras)[1].model, samples[1]);
+  auto points =
+      surface::triangulateStereo((*cameras)[0].model, samples[0], (*cameras)[1].model, samples[1]);
   if (!points) return asVoid(points);
   progress("triangulated " + std::to_string(points->world.size()) + " projector nodes (every " +
            std::to_string(*step) + " px)");
   if (points->world.size() < 20)
-    return fail(ErrorCode::kTooFewPoints, "only " + std::to_string(points->world.size()) +
-                                              " projector nodes were seen by both cameras (need 20)");
-  auto model = surface::buildSurface(*points);
-  if (!model) return asVoid(model);
+    return fail(ErrorCode::kTooFewPoints,
+                "only " + std::to_string(points->world.size()) +
+                    " projector nodes were seen by both cameras (need 20)");
   auto projector = calib::calibrateProjectorFromSurface(*points);
   if (!projector) return asVoid(projector);
+  // The surface from the points consistent with the calibrated projector.
+  const surface::SurfacePoints kept = surface::keepPoints(*points, projector->inliers);
+  progress(std::to_string(kept.world.size()) + " points consistent with the projector");
+  auto model = surface::buildSurface(kept);
+  if (!model) return asVoid(model);
   nlohmann::json surf;
   if (model->planar) {
     surf = {{"plane", {model->plane.n.x(), model->plane.n.y(), model->plane.n.z(), model->plane.d}},
             {"rms_m", model->plane_rms}};
   } else {
-    const std::string ply = a.optional("surface-out").value_or(fs::path(*out).replace_extension(".ply").string());
+    const std::string ply =
+        a.optional("surface-out").value_or(fs::path(*out).replace_extension(".ply").string());
     progress("surface is not planar (" + std::to_string(model->inlier_fraction * 100) +
-             "% on the best plane): mesh of " + std::to_string(model->mesh.faces.size()) + " triangles -> " + ply);
+             "% on the best plane): mesh of " + std::to_string(model->mesh.faces.size()) +
+             " triangles -> " + ply);
     if (auto w = writeText(ply, surface::toPly(model->mesh)); !w) return w;
     surf = {{"mesh", ply}};
   }
@@ -192,8 +207,8 @@ Result<void> runSolve(const Arguments& a) {
 }
 
 Result<void> runSolvePlanes(const Arguments& a) {
-  if (auto ok = a.only({"patterns", "captures", "cameras", "camera", "out", "plane-distance", "principal-x",
-                        "step", "name"});
+  if (auto ok = a.only({"patterns", "captures", "cameras", "camera", "out", "plane-distance",
+                        "principal-x", "step", "name"});
       !ok)
     return ok;
   auto patterns = a.one("patterns");
@@ -205,7 +220,8 @@ Result<void> runSolvePlanes(const Arguments& a) {
   if (!step) return asVoid(step);
   const auto& dirs = a.all("captures");
   if (dirs.size() < 2)
-    return fail(ErrorCode::kInvalidInput, "solve-planes needs --captures with one directory per plane orientation (>= 2)");
+    return fail(ErrorCode::kInvalidInput,
+                "solve-planes needs --captures with one directory per plane orientation (>= 2)");
   auto cameras = readCameras(*cameras_file);
   if (!cameras) return asVoid(cameras);
   std::size_t ci = 0;
@@ -234,21 +250,24 @@ Result<void> runSolvePlanes(const Arguments& a) {
   for (std::size_t i = 0; i < dirs.size(); ++i) {
     auto d = decodeDir(*set, dirs[i], i, dirs.size());
     if (!d) return asVoid(d);
-    auto s = surface::sampleProjectorGrid(*d, o.projector_width, o.projector_height, {.step = *step});
+    auto s =
+        surface::sampleProjectorGrid(*d, o.projector_width, o.projector_height, {.step = *step});
     if (!s) return asVoid(s);
     views.push_back({s->camera, s->projector});
   }
   progress("solving route (b) over " + std::to_string(views.size()) + " plane orientations");
   auto projector = calib::calibrateProjectorFromPlanes((*cameras)[ci].model, views, o);
   if (!projector) return asVoid(projector);
-  NamedProjector p{a.optional("name").value_or("projector"), o.projector_width, o.projector_height, *projector};
+  NamedProjector p{a.optional("name").value_or("projector"), o.projector_width, o.projector_height,
+                   *projector};
   return writeRig(*out, *cameras, p, nullptr);
 }
 
 Result<void> runSolveFiducials(const Arguments& a) {
   if (auto ok = a.only({"fiducials", "projector", "cameras", "out", "name"}); !ok) return ok;
   auto file = a.one("fiducials");
-  auto size = a.one("projector").and_then([](const std::string& s) { return toSize(s, "--projector"); });
+  auto size =
+      a.one("projector").and_then([](const std::string& s) { return toSize(s, "--projector"); });
   auto out = a.one("out");
   if (!file) return asVoid(file);
   if (!size) return asVoid(size);
@@ -265,7 +284,10 @@ Result<void> runSolveFiducials(const Arguments& a) {
       pixels.emplace_back(q.at(0).get<double>(), q.at(1).get<double>());
     }
   } catch (const nlohmann::json::exception& e) {
-    return fail(ErrorCode::kParse, *file + ": expected {\"points\": [{\"world\": [x, y, z], \"projector\": [u, v]}, ...]}: " + e.what());
+    return fail(
+        ErrorCode::kParse,
+        *file + ": expected {\"points\": [{\"world\": [x, y, z], \"projector\": [u, v]}, ...]}: " +
+            e.what());
   }
   progress(std::to_string(world.size()) + " fiducials");
   auto projector = calib::calibrateProjectorFromFiducials(world, pixels);

@@ -6,12 +6,17 @@
 
 namespace procam::cli {
 
-void progress(const std::string& line) { std::fprintf(stderr, "procam-calibrate: %s\n", line.c_str()); }
+void progress(const std::string& line) {
+  std::fprintf(stderr, "procam-calibrate: %s\n", line.c_str());
+}
 
 Result<void> runPatterns(const Arguments& a) {
-  if (auto ok = a.only({"projector", "mode", "step", "phase-steps", "phase-period", "gamma", "out"}); !ok)
+  if (auto ok =
+          a.only({"projector", "mode", "step", "phase-steps", "phase-period", "gamma", "out"});
+      !ok)
     return ok;
-  auto size = a.one("projector").and_then([](const std::string& s) { return toSize(s, "--projector"); });
+  auto size =
+      a.one("projector").and_then([](const std::string& s) { return toSize(s, "--projector"); });
   if (!size) return tl::unexpected(size.error());
   auto out = a.one("out");
   if (!out) return tl::unexpected(out.error());
@@ -59,8 +64,9 @@ Result<void> runDecode(const Arguments& a) {
   progress("decoded " + std::to_string(decoded->decoded) + " of " +
            std::to_string(decoded->u.total()) + " camera pixels");
   if (decoded->decoded == 0)
-    return fail(ErrorCode::kTooFewPoints, "no camera pixel could be decoded (projector not visible, "
-                                          "or captures in the wrong order?)");
+    return fail(ErrorCode::kTooFewPoints,
+                "no camera pixel could be decoded (projector not visible, "
+                "or captures in the wrong order?)");
   return writeCorrespondencePfm(*decoded, *out);
 }
 

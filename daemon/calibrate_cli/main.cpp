@@ -37,21 +37,25 @@ int main(int argc, char** argv) {
   const struct {
     const char* name;
     Command run;
-  } commands[] = {{"patterns", procam::cli::runPatterns},   {"decode", procam::cli::runDecode},
-                  {"camera", procam::cli::runCamera},       {"stereo", procam::cli::runStereo},
-                  {"solve", procam::cli::runSolve},         {"solve-planes", procam::cli::runSolvePlanes},
+  } commands[] = {{"patterns", procam::cli::runPatterns},
+                  {"decode", procam::cli::runDecode},
+                  {"camera", procam::cli::runCamera},
+                  {"stereo", procam::cli::runStereo},
+                  {"solve", procam::cli::runSolve},
+                  {"solve-planes", procam::cli::runSolvePlanes},
                   {"solve-fiducials", procam::cli::runSolveFiducials}};
   for (const auto& c : commands) {
     if (std::strcmp(argv[1], c.name) != 0) continue;
     auto args = procam::cli::Arguments::parse(argc, argv, 2);
     if (!args) {
-      std::fprintf(stderr, "procam-calibrate %s: %s\n%s", c.name, args.error().message.c_str(), kUsage);
+      std::fprintf(stderr, "procam-calibrate %s: %s\n%s", c.name, args.error().message.c_str(),
+                   kUsage);
       return 2;
     }
     auto r = c.run(*args);
     if (!r) {
-      std::fprintf(stderr, "procam-calibrate %s: error (%s): %s\n", c.name, procam::toString(r.error().code),
-                   r.error().message.c_str());
+      std::fprintf(stderr, "procam-calibrate %s: error (%s): %s\n", c.name,
+                   procam::toString(r.error().code), r.error().message.c_str());
       return 1;
     }
     return 0;

@@ -10,13 +10,6 @@ int CameraResponse::outputType() const {
   return CV_MAKETYPE(spec_.bit_depth <= 8 ? CV_8U : CV_16U, spec_.channels);
 }
 
-double CameraResponse::expectedCode(double radiance) const {
-  const double max_dn = spec_.maxDn();
-  const double well = std::clamp(spec_.exposure * radiance, 0.0, 1.0);
-  const double linear = std::min(spec_.gain * well, 1.0);
-  return max_dn * std::pow(linear, 1.0 / spec_.response_gamma);
-}
-
 void CameraResponse::convertRow(const cv::Vec3f* radiance, int row, std::uint64_t seed,
                                 cv::Mat& out) const {
   const double max_dn = spec_.maxDn();
@@ -44,7 +37,8 @@ void CameraResponse::convertRow(const cv::Vec3f* radiance, int row, std::uint64_
       double dn = spec_.gain * well * max_dn;
       if (read) dn += spec_.read_noise_dn * normal(rng);
       const double linear = std::clamp(dn / max_dn, 0.0, 1.0);
-      const double code = std::round(max_dn * std::pow(linear, inv_gamma));
+      const double code =
+          std::round(max_dn * (inv_gamma == 1.0 ? linear : std::pow(linear, inv_gamma)));
       if (eight_bit) {
         out.ptr<std::uint8_t>(row)[x * channels + c] = static_cast<std::uint8_t>(code);
       } else {

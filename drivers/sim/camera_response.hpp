@@ -20,9 +20,6 @@ class CameraResponse {
   // a generator seeded by (seed, row) so the result does not depend on threading.
   void convertRow(const cv::Vec3f* radiance, int row, std::uint64_t seed, cv::Mat& out) const;
 
-  // Noise-free expected code for a linear radiance value (one channel).
-  double expectedCode(double radiance) const;
-
  private:
   const CameraSpec& spec_;
   bool noise_;

@@ -15,7 +15,8 @@ namespace procam::sim {
 
 namespace {
 
-tl::unexpected<Error> parseError(const std::string& origin, std::size_t line, const std::string& what) {
+tl::unexpected<Error> parseError(const std::string& origin, std::size_t line,
+                                 const std::string& what) {
   return fail(ErrorCode::kParse, origin + ":" + std::to_string(line) + ": " + what);
 }
 
@@ -95,14 +96,19 @@ PlyType plyType(const std::string& name) {
 std::size_t plySize(PlyType t) {
   switch (t) {
     case PlyType::kI8:
-    case PlyType::kU8: return 1;
+    case PlyType::kU8:
+      return 1;
     case PlyType::kI16:
-    case PlyType::kU16: return 2;
+    case PlyType::kU16:
+      return 2;
     case PlyType::kI32:
     case PlyType::kU32:
-    case PlyType::kF32: return 4;
-    case PlyType::kF64: return 8;
-    case PlyType::kInvalid: break;
+    case PlyType::kF32:
+      return 4;
+    case PlyType::kF64:
+      return 8;
+    case PlyType::kInvalid:
+      break;
   }
   return 0;
 }
@@ -134,15 +140,26 @@ class PlyReader {
     const char* p = body_.data() + pos_;
     pos_ += n;
     switch (type) {
-      case PlyType::kI8: out = static_cast<std::int8_t>(p[0]); return true;
-      case PlyType::kU8: out = static_cast<std::uint8_t>(p[0]); return true;
-      case PlyType::kI16: return copyAs<std::int16_t>(p, out);
-      case PlyType::kU16: return copyAs<std::uint16_t>(p, out);
-      case PlyType::kI32: return copyAs<std::int32_t>(p, out);
-      case PlyType::kU32: return copyAs<std::uint32_t>(p, out);
-      case PlyType::kF32: return copyAs<float>(p, out);
-      case PlyType::kF64: return copyAs<double>(p, out);
-      case PlyType::kInvalid: break;
+      case PlyType::kI8:
+        out = static_cast<std::int8_t>(p[0]);
+        return true;
+      case PlyType::kU8:
+        out = static_cast<std::uint8_t>(p[0]);
+        return true;
+      case PlyType::kI16:
+        return copyAs<std::int16_t>(p, out);
+      case PlyType::kU16:
+        return copyAs<std::uint16_t>(p, out);
+      case PlyType::kI32:
+        return copyAs<std::int32_t>(p, out);
+      case PlyType::kU32:
+        return copyAs<std::uint32_t>(p, out);
+      case PlyType::kF32:
+        return copyAs<float>(p, out);
+      case PlyType::kF64:
+        return copyAs<double>(p, out);
+      case PlyType::kInvalid:
+        break;
     }
     return false;
   }
@@ -184,8 +201,10 @@ Result<geom::TriangleMesh> parsePly(std::string_view bytes, const std::string& o
     if (tag == "format") {
       std::string fmt;
       f >> fmt;
-      if (fmt == "binary_little_endian") binary = true;
-      else if (fmt != "ascii") return parseError(origin, line_no, "unsupported PLY format " + fmt);
+      if (fmt == "binary_little_endian")
+        binary = true;
+      else if (fmt != "ascii")
+        return parseError(origin, line_no, "unsupported PLY format " + fmt);
     } else if (tag == "element") {
       PlyElement e;
       if (!(f >> e.name >> e.count)) return parseError(origin, line_no, "bad element line");
@@ -256,7 +275,8 @@ Result<geom::TriangleMesh> loadMesh(const std::filesystem::path& file) {
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   if (ext == ".obj") return parseObj(bytes, file.string());
   if (ext == ".ply") return parsePly(bytes, file.string());
-  return fail(ErrorCode::kInvalidInput, "unknown mesh format (want .obj or .ply): " + file.string());
+  return fail(ErrorCode::kInvalidInput,
+              "unknown mesh format (want .obj or .ply): " + file.string());
 }
 
 }  // namespace procam::sim

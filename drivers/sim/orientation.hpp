@@ -12,8 +12,12 @@
 namespace procam::sim {
 
 inline constexpr double kPi = 3.14159265358979323846;
-inline double degToRad(double deg) { return deg * kPi / 180.0; }
-inline double radToDeg(double rad) { return rad * 180.0 / kPi; }
+inline double degToRad(double deg) {
+  return deg * kPi / 180.0;
+}
+inline double radToDeg(double rad) {
+  return rad * 180.0 / kPi;
+}
 
 // Columns are the device axes (x right, y down, z forward) in world coordinates
 // for a device in the world frame (up = +Z, right = +X, forward = +Y at zero angles).

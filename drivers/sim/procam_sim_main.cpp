@@ -7,6 +7,7 @@
 #include <charconv>
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
@@ -113,6 +114,8 @@ int render(const Args& a) {
   if (!scene) return fail(scene.error().message);
   procam::sim::Framebuffers shown;
   for (const auto& [projector, file] : a.shows) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(file, ec)) return fail("no image file '" + file + "'");
     cv::Mat image = cv::imread(file, cv::IMREAD_UNCHANGED);
     if (image.empty()) return fail("cannot read image '" + file + "'");
     if (!shown.emplace(projector, image).second)
@@ -162,7 +165,7 @@ int main(int argc, char** argv) {
     }
     throw UsageError{"unknown command '" + args.command + "'"};
   } catch (const UsageError& e) {
-    std::cerr << "procam-sim: " << e.message << "\n\n" << kUsage;
+    std::cerr << "procam-sim: " << e.message << "\nTry 'procam-sim --help'.\n";
     return 2;
   } catch (const std::exception& e) {
     return fail(e.what());

@@ -9,11 +9,11 @@ namespace procam::sim {
 Result<ProjectorImage> ProjectorImage::create(const cv::Mat& framebuffer,
                                               const ProjectorSpec& spec) {
   if (framebuffer.cols != spec.width || framebuffer.rows != spec.height)
-    return fail(ErrorCode::kInvalidInput,
-                "framebuffer for projector '" + spec.name + "' is " +
-                    std::to_string(framebuffer.cols) + "x" + std::to_string(framebuffer.rows) +
-                    ", the projector is " + std::to_string(spec.width) + "x" +
-                    std::to_string(spec.height));
+    return fail(ErrorCode::kInvalidInput, "framebuffer for projector '" + spec.name + "' is " +
+                                              std::to_string(framebuffer.cols) + "x" +
+                                              std::to_string(framebuffer.rows) +
+                                              ", the projector is " + std::to_string(spec.width) +
+                                              "x" + std::to_string(spec.height));
   const int depth = framebuffer.depth();
   const int channels = framebuffer.channels();
   if ((depth != CV_8U && depth != CV_16U) || (channels != 1 && channels != 3 && channels != 4))
@@ -34,9 +34,8 @@ Result<ProjectorImage> ProjectorImage::create(const cv::Mat& framebuffer,
     for (int x = 0; x < framebuffer.cols; ++x) {
       for (int c = 0; c < 3; ++c) {
         const int src_c = channels == 1 ? 0 : c;
-        const int code = depth == CV_8U
-                             ? framebuffer.ptr<std::uint8_t>(y)[x * channels + src_c]
-                             : framebuffer.ptr<std::uint16_t>(y)[x * channels + src_c];
+        const int code = depth == CV_8U ? framebuffer.ptr<std::uint8_t>(y)[x * channels + src_c]
+                                        : framebuffer.ptr<std::uint16_t>(y)[x * channels + src_c];
         out[x][c] = lut[static_cast<std::size_t>(code)];
       }
     }

@@ -93,8 +93,7 @@ std::optional<geom::Ray> pixelRay(const geom::CameraModel& view, double x, doubl
   return ray;
 }
 
-Result<Renderer> Renderer::create(const Scene& scene, SceneState state,
-                                  const Framebuffers& shown) {
+Result<Renderer> Renderer::create(const Scene& scene, SceneState state, const Framebuffers& shown) {
   for (const auto& [name, image] : shown) {
     if (!state.projector(name))
       return fail(ErrorCode::kNotFound, "no projector named '" + name + "' in the scene");
@@ -203,9 +202,8 @@ Result<cv::Mat> Renderer::renderCamera(std::string_view camera,
   const CameraResponse response(cam->spec, options.noise);
   cv::Mat out(cam->model.height, cam->model.width, response.outputType());
   const std::uint64_t seed = mixSeed(options.seed, cam->spec.name);
-  forEachRow(out.rows, options.threads, [&](int y) {
-    response.convertRow(radiance->ptr<cv::Vec3f>(y), y, seed, out);
-  });
+  forEachRow(out.rows, options.threads,
+             [&](int y) { response.convertRow(radiance->ptr<cv::Vec3f>(y), y, seed, out); });
   return out;
 }
 

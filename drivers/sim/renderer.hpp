@@ -8,12 +8,11 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "core/error.hpp"
 #include "sim/projector_image.hpp"
@@ -37,8 +36,8 @@ struct PixelTruth {
   Vec3 point = Vec3::Zero();
   Vec3 normal = Vec3::Zero();  // facing the camera
   struct Light {
-    bool in_front = false;  // point in front of the projector (pixel below is valid)
-    bool lit = false;       // inside the frame, facing it, no shadow
+    bool in_front = false;      // point in front of the projector (pixel below is valid)
+    bool lit = false;           // inside the frame, facing it, no shadow
     Vec2 pixel = Vec2::Zero();  // framebuffer coordinates of the point
     double cos_incidence = 0, distance = 0;
   };
@@ -47,8 +46,8 @@ struct PixelTruth {
 
 // Per-pixel truth over a whole camera image (centre rays).
 struct TruthMaps {
-  cv::Mat point;    // CV_64FC3 world point; zeros where nothing is hit
-  cv::Mat surface;  // CV_32S surface index, -1 where nothing is hit
+  cv::Mat point;                         // CV_64FC3 world point; zeros where nothing is hit
+  cv::Mat surface;                       // CV_32S surface index, -1 where nothing is hit
   std::vector<cv::Mat> projector_pixel;  // per projector, CV_32FC2 framebuffer coordinates
   std::vector<cv::Mat> lit;              // per projector, CV_8U: 255 where lit
 };

@@ -36,8 +36,10 @@ const Trajectory* Scene::trajectory(std::string_view name) const {
 
 geom::Pose Scene::placementPose(const Placement& p, double time) const {
   switch (p.kind) {
-    case Placement::Kind::kFixed: return p.fixed;
-    case Placement::Kind::kTrajectory: return trajectory(p.trajectory)->poseAt(time);
+    case Placement::Kind::kFixed:
+      return p.fixed;
+    case Placement::Kind::kTrajectory:
+      return trajectory(p.trajectory)->poseAt(time);
     case Placement::Kind::kAttached:
       // The parser guarantees the parent exists and is itself not attached.
       for (const auto& proj : projectors_) {

@@ -58,26 +58,26 @@ struct CameraSpec {
 
 struct TiltSensorSpec {
   std::string name;
-  std::string projector;           // the projector it is mounted on
+  std::string projector;                          // the projector it is mounted on
   Mat3 sensor_from_projector = Mat3::Identity();  // mount rotation; row i = sensor axis i
-  double noise_density_ug = 0.0;   // white noise, micro-g per sqrt(Hz)
-  Vec3 bias_mg = Vec3::Zero();     // constant bias per sensor axis, milli-g
-  double rate_hz = 100.0;          // output data rate
-  double full_scale_g = 0.0;       // clamp of each axis, g; 0 = unlimited
-  bool report_in_g = false;        // units of samples: g, or m/s^2 (default)
+  double noise_density_ug = 0.0;                  // white noise, micro-g per sqrt(Hz)
+  Vec3 bias_mg = Vec3::Zero();                    // constant bias per sensor axis, milli-g
+  double rate_hz = 100.0;                         // output data rate
+  double full_scale_g = 0.0;                      // clamp of each axis, g; 0 = unlimited
+  bool report_in_g = false;                       // units of samples: g, or m/s^2 (default)
 };
 
 struct TrackerSpec {
   std::string name;
-  std::string trajectory;       // what it tracks; empty = the viewer
-  double noise_sigma_m = 0.0;   // isotropic position noise per sample
+  std::string trajectory;      // what it tracks; empty = the viewer
+  double noise_sigma_m = 0.0;  // isotropic position noise per sample
   double rate_hz = 60.0;
 };
 
 struct ViewerSpec {
   Placement placement;  // kFixed or kTrajectory
   int width = 640, height = 480;
-  geom::Intrinsics K;   // for renderings of what the viewer perceives
+  geom::Intrinsics K;  // for renderings of what the viewer perceives
 };
 
 // True state of every device at one time.

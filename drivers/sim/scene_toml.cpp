@@ -270,7 +270,8 @@ class Reader {
   ViewerSpec viewer(const Fields& f) {
     ViewerSpec s;
     s.placement = placement(f, false);
-    const auto res = f.has("resolution") ? f.resolution("resolution") : std::array<int, 2>{640, 480};
+    const auto res =
+        f.has("resolution") ? f.resolution("resolution") : std::array<int, 2>{640, 480};
     s.width = res[0];
     s.height = res[1];
     if (f.has("intrinsics")) {
@@ -370,10 +371,12 @@ class SceneBuilder {
     scene.world_ = World(std::move(surfaces));
     for (const Fields& f : root.tableArray("tilt_sensors"))
       scene.tilt_sensors_.push_back(reader.tiltSensor(f));
-    for (const Fields& f : root.tableArray("trackers")) scene.trackers_.push_back(reader.tracker(f));
+    for (const Fields& f : root.tableArray("trackers"))
+      scene.trackers_.push_back(reader.tracker(f));
     if (root.has("viewer")) {
       scene.viewer_ = reader.viewer(root.table("viewer"));
-    } else {
+    } else {  // at the origin, looking along +Y, 60 degrees wide
+      scene.viewer_.placement.fixed = poseFromCenter(Vec3::Zero(), worldFromDeviceYpr(0, 0, 0));
       scene.viewer_.K.fx = scene.viewer_.K.fy = 0.5 * 640 / std::tan(degToRad(30));
       scene.viewer_.K.cx = 319.5;
       scene.viewer_.K.cy = 239.5;

@@ -13,8 +13,8 @@ std::mt19937_64 sampleRng(std::uint64_t seed, std::string_view device, double ti
   std::uint64_t h = 1469598103934665603ull;  // FNV-1a of the device name
   for (const char c : device) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
   std::seed_seq seq{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
-                    static_cast<std::uint32_t>(h), static_cast<std::uint32_t>(h >> 32),
-                    static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(k >> 32)};
+                    static_cast<std::uint32_t>(h),    static_cast<std::uint32_t>(h >> 32),
+                    static_cast<std::uint32_t>(k),    static_cast<std::uint32_t>(k >> 32)};
   return std::mt19937_64(seq);
 }
 
@@ -42,7 +42,8 @@ double tiltNoiseSigmaG(const TiltSensorSpec& spec) {
 Result<TiltSample> sampleTilt(const Scene& scene, std::string_view sensor, double time,
                               std::uint64_t seed, bool noise) {
   const TiltSensorSpec* spec = findSensor(scene, sensor);
-  if (!spec) return fail(ErrorCode::kNotFound, "no tilt sensor named '" + std::string(sensor) + "'");
+  if (!spec)
+    return fail(ErrorCode::kNotFound, "no tilt sensor named '" + std::string(sensor) + "'");
   if (!std::isfinite(time)) return fail(ErrorCode::kInvalidInput, "sample time must be finite");
   const SceneState state = scene.at(time);
   const TiltSensorState* s = state.tiltSensor(sensor);
@@ -60,10 +61,11 @@ Result<TiltSample> sampleTilt(const Scene& scene, std::string_view sensor, doubl
 }
 
 Result<std::vector<TiltSample>> sampleTiltSeries(const Scene& scene, std::string_view sensor,
-                                                 double t_begin, double t_end,
-                                                 std::uint64_t seed, bool noise) {
+                                                 double t_begin, double t_end, std::uint64_t seed,
+                                                 bool noise) {
   const TiltSensorSpec* spec = findSensor(scene, sensor);
-  if (!spec) return fail(ErrorCode::kNotFound, "no tilt sensor named '" + std::string(sensor) + "'");
+  if (!spec)
+    return fail(ErrorCode::kNotFound, "no tilt sensor named '" + std::string(sensor) + "'");
   if (!std::isfinite(t_begin) || !std::isfinite(t_end) || t_end < t_begin)
     return fail(ErrorCode::kInvalidInput, "need finite t_begin <= t_end");
   const auto first = static_cast<long long>(std::ceil(t_begin * spec->rate_hz - 1e-9));

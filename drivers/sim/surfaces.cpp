@@ -44,8 +44,8 @@ bool World::occluded(const geom::Ray& ray, double t_max, int on_surface) const {
   const geom::RayRange range{1e-9, t_max};
   for (std::size_t i = 0; i < surfaces_.size(); ++i) {
     const Shape& shape = surfaces_[i].shape;
-    if (static_cast<int>(i) == on_surface &&
-        (std::holds_alternative<geom::Plane>(shape) || std::holds_alternative<geom::Rectangle>(shape)))
+    if (static_cast<int>(i) == on_surface && (std::holds_alternative<geom::Plane>(shape) ||
+                                              std::holds_alternative<geom::Rectangle>(shape)))
       continue;
     if (intersectShape(shape, ray, range)) return true;
   }

@@ -20,7 +20,9 @@ std::string rangeText(double lo, double hi, bool open_lo) {
 Fields::Fields(const toml::table& table, std::string path, const std::string* origin)
     : table_(&table), path_(std::move(path)), origin_(origin) {}
 
-bool Fields::has(std::string_view key) const { return table_->contains(key); }
+bool Fields::has(std::string_view key) const {
+  return table_->contains(key);
+}
 
 std::string Fields::keyPath(std::string_view key) const {
   return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
@@ -177,7 +179,8 @@ std::array<int, 2> Fields::resolution(std::string_view key) const {
     error(key, "expected [width, height] as two integers");
   const auto w = (*arr)[0].value<std::int64_t>().value_or(0);
   const auto h = (*arr)[1].value<std::int64_t>().value_or(0);
-  if (w < 1 || h < 1 || w > 16384 || h > 16384) error(key, "width and height must be in [1, 16384]");
+  if (w < 1 || h < 1 || w > 16384 || h > 16384)
+    error(key, "width and height must be in [1, 16384]");
   return {static_cast<int>(w), static_cast<int>(h)};
 }
 

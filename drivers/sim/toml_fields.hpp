@@ -3,11 +3,12 @@
 // key path (e.g. "cameras[1].bit_depth") and the line in its error; finish() rejects
 // keys nobody asked for. Internal to the scene reader: failures are thrown as
 // SceneFileError and turned into procam::Error by Scene::parse, never beyond it.
+#include <toml++/toml.h>
+
 #include <optional>
 #include <set>
 #include <string>
 #include <string_view>
-#include <toml++/toml.h>
 #include <vector>
 
 #include "core/types.hpp"
@@ -46,7 +47,7 @@ class Fields {
   std::array<int, 2> resolution(std::string_view key) const;
   Mat3 matrix3(std::string_view key) const;
 
-  Fields table(std::string_view key) const;  // required sub-table
+  Fields table(std::string_view key) const;                    // required sub-table
   std::vector<Fields> tableArray(std::string_view key) const;  // [[key]] or [{...}, ...]
 
   [[noreturn]] void error(std::string_view key, const std::string& what) const;

@@ -8,7 +8,8 @@
 namespace procam::sim {
 
 Result<Trajectory> Trajectory::create(std::string name, std::vector<Keyframe> keys, bool loop) {
-  if (keys.empty()) return fail(ErrorCode::kInvalidInput, "trajectory '" + name + "' has no keyframes");
+  if (keys.empty())
+    return fail(ErrorCode::kInvalidInput, "trajectory '" + name + "' has no keyframes");
   for (std::size_t i = 0; i < keys.size(); ++i) {
     if (!std::isfinite(keys[i].time) || !keys[i].center.allFinite())
       return fail(ErrorCode::kInvalidInput, "trajectory '" + name + "': non-finite keyframe");
@@ -51,6 +52,8 @@ geom::Pose Trajectory::poseAt(double time) const {
   return poseFromCenter(k.center, k.orientation.toRotationMatrix());
 }
 
-Vec3 Trajectory::centerAt(double time) const { return sample(time).center; }
+Vec3 Trajectory::centerAt(double time) const {
+  return sample(time).center;
+}
 
 }  // namespace procam::sim

@@ -13,9 +13,9 @@
 namespace procam::sim {
 
 struct Keyframe {
-  double time = 0;                  // seconds
-  Vec3 center = Vec3::Zero();       // device origin in world, metres
-  Eigen::Quaterniond orientation;   // world-from-device rotation (unit)
+  double time = 0;                 // seconds
+  Vec3 center = Vec3::Zero();      // device origin in world, metres
+  Eigen::Quaterniond orientation;  // world-from-device rotation (unit)
 };
 
 class Trajectory {

@@ -21,7 +21,9 @@ json matrixJson(const Eigen::MatrixBase<Derived>& m) {
   return rows;
 }
 
-json vecJson(const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
+json vecJson(const Vec3& v) {
+  return json::array({v.x(), v.y(), v.z()});
+}
 
 json modelJson(const std::string& name, const geom::CameraModel& m) {
   json j;
@@ -38,8 +40,10 @@ json modelJson(const std::string& name, const geom::CameraModel& m) {
 
 json placementJson(const Placement& p) {
   switch (p.kind) {
-    case Placement::Kind::kFixed: return "fixed";
-    case Placement::Kind::kTrajectory: return {{"trajectory", p.trajectory}};
+    case Placement::Kind::kFixed:
+      return "fixed";
+    case Placement::Kind::kTrajectory:
+      return {{"trajectory", p.trajectory}};
     case Placement::Kind::kAttached:
       return {{"attached_to", p.parent},
               {"R_from_parent", matrixJson(p.offset.R)},
@@ -55,10 +59,13 @@ json shapeJson(const Shape& shape) {
       return {{"origin", vecJson(s.origin)}, {"u", vecJson(s.u)}, {"v", vecJson(s.v)}};
     }
     json operator()(const geom::Box& s) const {
-      return {{"center", vecJson(s.center)}, {"half", vecJson(s.half)}, {"axes", matrixJson(s.axes)}};
+      return {
+          {"center", vecJson(s.center)}, {"half", vecJson(s.half)}, {"axes", matrixJson(s.axes)}};
     }
     json operator()(const geom::Cylinder& s) const {
-      return {{"base", vecJson(s.base)}, {"axis", vecJson(s.axis)}, {"radius", s.radius},
+      return {{"base", vecJson(s.base)},
+              {"axis", vecJson(s.axis)},
+              {"radius", s.radius},
               {"height", s.height}};
     }
     json operator()(const geom::Sphere& s) const {

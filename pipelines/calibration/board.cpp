@@ -1,7 +1,6 @@
 #include "calibration/board.hpp"
 
 #include <cstdio>
-
 #include <opencv2/aruco/charuco.hpp>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -53,7 +52,8 @@ Result<BoardSpec> parseBoard(const std::string& text) {
   char kind[16] = {0};
   double a = 0, b = 0;
   int n = 0;
-  const int fields = std::sscanf(text.c_str(), "%15[a-z]:%dx%d:%lf%n", kind, &s.cols, &s.rows, &a, &n);
+  const int fields =
+      std::sscanf(text.c_str(), "%15[a-z]:%dx%d:%lf%n", kind, &s.cols, &s.rows, &a, &n);
   const std::string k = kind;
   const char* rest = text.c_str() + (fields == 4 ? n : 0);
   if (fields == 4 && *rest == ':' && std::sscanf(rest, ":%lf", &b) == 1) {
@@ -62,15 +62,17 @@ Result<BoardSpec> parseBoard(const std::string& text) {
   }
   if (fields != 4 || s.cols < 2 || s.rows < 2 || !(a > 0))
     return fail(ErrorCode::kParse,
-                "board '" + text + "': expected checker:COLSxROWS:SQUARE_M, "
-                "charuco:COLSxROWS:SQUARE_M:MARKER_M or aprilgrid:COLSxROWS:TAG_M[:GAP_M]");
+                "board '" + text +
+                    "': expected checker:COLSxROWS:SQUARE_M, "
+                    "charuco:COLSxROWS:SQUARE_M:MARKER_M or aprilgrid:COLSxROWS:TAG_M[:GAP_M]");
   s.square_m = a;
   if (k == "checker") {
     s.kind = BoardKind::kChecker;
   } else if (k == "charuco") {
     s.kind = BoardKind::kCharuco;
     s.marker_m = b;
-    if (!(b > 0 && b < a)) return fail(ErrorCode::kParse, "charuco: marker must be smaller than the square");
+    if (!(b > 0 && b < a))
+      return fail(ErrorCode::kParse, "charuco: marker must be smaller than the square");
   } else if (k == "aprilgrid") {
     s.kind = BoardKind::kAprilGrid;
     s.gap_m = b;
@@ -93,8 +95,9 @@ Result<BoardView> detectBoard(const BoardSpec& s, const cv::Mat& image) {
                                        cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE |
                                            cv::CALIB_CB_FAST_CHECK))
           return fail(ErrorCode::kNotFound, "checkerboard not found");
-        cv::cornerSubPix(g, corners, cv::Size(5, 5), cv::Size(-1, -1),
-                         cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-4));
+        cv::cornerSubPix(
+            g, corners, cv::Size(5, 5), cv::Size(-1, -1),
+            cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-4));
         for (int i = 0; i < static_cast<int>(corners.size()); ++i) {
           v.image.emplace_back(corners[i].x, corners[i].y);
           v.board.emplace_back((i % s.cols) * s.square_m, (i / s.cols) * s.square_m, 0.0);

@@ -2,9 +2,8 @@
 // Calibration boards and their detection: checkerboard, ChArUco and an AprilTag
 // (tag36h11) grid. Each detection yields image points and the matching board
 // points (metres, board plane z = 0) for cv::calibrateCamera (seed §7.3, [Zhang99]).
-#include <string>
-
 #include <opencv2/core.hpp>
+#include <string>
 
 #include "core/error.hpp"
 #include "core/types.hpp"
@@ -27,8 +26,8 @@ struct BoardSpec {
 Result<BoardSpec> parseBoard(const std::string& text);
 
 struct BoardView {
-  Points2 image;   // pixel-centre convention
-  Points3 board;   // metres, z = 0
+  Points2 image;  // pixel-centre convention
+  Points3 board;  // metres, z = 0
 };
 
 // kNotFound when the board is not (fully enough) visible; 8-bit grey or BGR input.

@@ -1,7 +1,6 @@
 #include "calibration/camera_calibration.hpp"
 
 #include <cmath>
-
 #include <opencv2/calib3d.hpp>
 
 namespace procam::calib {
@@ -14,9 +13,11 @@ void toCv(const BoardView& v, ObjectPoints& object, ImagePoints& image) {
   object.emplace_back();
   image.emplace_back();
   for (std::size_t i = 0; i < v.board.size(); ++i) {
-    object.back().emplace_back(static_cast<float>(v.board[i].x()), static_cast<float>(v.board[i].y()),
+    object.back().emplace_back(static_cast<float>(v.board[i].x()),
+                               static_cast<float>(v.board[i].y()),
                                static_cast<float>(v.board[i].z()));
-    image.back().emplace_back(static_cast<float>(v.image[i].x()), static_cast<float>(v.image[i].y()));
+    image.back().emplace_back(static_cast<float>(v.image[i].x()),
+                              static_cast<float>(v.image[i].y()));
   }
 }
 
@@ -50,7 +51,8 @@ geom::Pose poseFromRvec(const cv::Mat& rvec, const cv::Mat& tvec) {
 }
 
 Result<void> checkViews(std::span<const BoardView> views) {
-  if (views.size() < 3) return fail(ErrorCode::kTooFewPoints, "camera calibration needs at least 3 board views");
+  if (views.size() < 3)
+    return fail(ErrorCode::kTooFewPoints, "camera calibration needs at least 3 board views");
   for (const BoardView& v : views)
     if (v.image.size() < 6 || v.image.size() != v.board.size())
       return fail(ErrorCode::kTooFewPoints, "every board view needs at least 6 matched points");
@@ -62,7 +64,8 @@ Result<void> checkViews(std::span<const BoardView> views) {
 Result<CameraCalibration> calibrateCamera(std::span<const BoardView> views, int width, int height,
                                           const CameraCalibrationOptions& o) {
   if (auto ok = checkViews(views); !ok) return tl::unexpected(ok.error());
-  if (width < 1 || height < 1) return fail(ErrorCode::kInvalidInput, "camera size must be positive");
+  if (width < 1 || height < 1)
+    return fail(ErrorCode::kInvalidInput, "camera size must be positive");
   ObjectPoints object;
   ImagePoints image;
   for (const BoardView& v : views) toCv(v, object, image);
@@ -78,7 +81,8 @@ Result<CameraCalibration> calibrateCamera(std::span<const BoardView> views, int 
     return fail(ErrorCode::kNoConvergence, std::string("cv::calibrateCamera: ") + e.what());
   }
   if (!std::isfinite(rms) || !cv::checkRange(K) || !cv::checkRange(dist))
-    return fail(ErrorCode::kNoConvergence, "camera calibration did not converge (views too similar?)");
+    return fail(ErrorCode::kNoConvergence,
+                "camera calibration did not converge (views too similar?)");
   CameraCalibration out;
   out.camera.width = width;
   out.camera.height = height;
@@ -87,12 +91,15 @@ Result<CameraCalibration> calibrateCamera(std::span<const BoardView> views, int 
   const double* d = dist.ptr<double>(0);
   out.camera.dist = {d[0], d[1], d[2], d[3], dist.total() > 4 ? d[4] : 0.0};
   out.rms_px = rms;
-  for (std::size_t i = 0; i < rvecs.size(); ++i) out.board_poses.push_back(poseFromRvec(rvecs[i], tvecs[i]));
+  for (std::size_t i = 0; i < rvecs.size(); ++i)
+    out.board_poses.push_back(poseFromRvec(rvecs[i], tvecs[i]));
   return out;
 }
 
-Result<StereoCalibration> calibrateStereo(const geom::CameraModel& a, std::span<const BoardView> views_a,
-                                          const geom::CameraModel& b, std::span<const BoardView> views_b) {
+Result<StereoCalibration> calibrateStereo(const geom::CameraModel& a,
+                                          std::span<const BoardView> views_a,
+                                          const geom::CameraModel& b,
+                                          std::span<const BoardView> views_b) {
   if (auto ok = checkViews(views_a); !ok) return tl::unexpected(ok.error());
   if (views_a.size() != views_b.size())
     return fail(ErrorCode::kInvalidInput, "stereo calibration: both cameras need the same views");
@@ -100,8 +107,9 @@ Result<StereoCalibration> calibrateStereo(const geom::CameraModel& a, std::span<
   ImagePoints image_a, image_b;
   for (std::size_t i = 0; i < views_a.size(); ++i) {
     if (views_a[i].board != views_b[i].board)
-      return fail(ErrorCode::kInvalidInput, "stereo calibration: view " + std::to_string(i) +
-                                                " does not show the same board points in both cameras");
+      return fail(ErrorCode::kInvalidInput,
+                  "stereo calibration: view " + std::to_string(i) +
+                      " does not show the same board points in both cameras");
     toCv(views_a[i], object, image_a);
     toCv(views_b[i], object_b, image_b);
   }
@@ -114,7 +122,8 @@ Result<StereoCalibration> calibrateStereo(const geom::CameraModel& a, std::span<
   } catch (const cv::Exception& e) {
     return fail(ErrorCode::kNoConvergence, std::string("cv::stereoCalibrate: ") + e.what());
   }
-  if (!std::isfinite(rms)) return fail(ErrorCode::kNoConvergence, "stereo calibration did not converge");
+  if (!std::isfinite(rms))
+    return fail(ErrorCode::kNoConvergence, "stereo calibration did not converge");
   StereoCalibration out;
   out.b_from_a = poseFromMatrix(R, T);
   out.rms_px = rms;

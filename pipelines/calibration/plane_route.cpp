@@ -12,11 +12,10 @@
 // planes follow from >= 2 orientations. The estimate minimises the projector-pixel
 // reprojection error over all correspondences (LM), started from homography
 // decompositions under a few focal-length and lens-shift guesses.
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <limits>
-
-#include <Eigen/SVD>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <unsupported/Eigen/LevenbergMarquardt>
@@ -296,9 +295,9 @@ Result<ProjectorCalibration> calibrateProjectorFromPlanes(const geom::CameraMode
     widest = std::max(widest, std::acos(std::clamp(m0.dot(mi), -1.0, 1.0)));
   }
   if (widest * 180 / M_PI < o.min_plane_angle_deg)
-    return fail(ErrorCode::kDegenerate,
-                "route (b): the plane orientations differ by less than " +
-                    std::to_string(o.min_plane_angle_deg) + " degrees; tilt the plane more");
+    return fail(ErrorCode::kDegenerate, "route (b): the plane orientations differ by less than " +
+                                            std::to_string(o.min_plane_angle_deg) +
+                                            " degrees; tilt the plane more");
 
   c.K = {best(0), best(0), cx, best(1), 0.0};
   const Mat3 R = rotation(best);

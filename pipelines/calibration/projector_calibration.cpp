@@ -1,5 +1,7 @@
 #include "calibration/projector_calibration.hpp"
 
+#include <algorithm>
+
 #include "geometry/projection_matrix.hpp"
 
 namespace procam::calib {
@@ -23,6 +25,31 @@ Result<ProjectorCalibration> fromCorrespondences(std::span<const Vec3> world,
 
 Result<ProjectorCalibration> calibrateProjectorFromSurface(const surface::SurfacePoints& points) {
   auto c = fromCorrespondences(points.world, points.projector);
+  // Two rounds of rejection at 3 sigma of the residual norm (sigma from its median:
+  // for 2D Gaussian noise the median norm is 1.177 sigma), with a floor of 0.1 px.
+  std::vector<std::uint8_t> keep(points.world.size(), 1);
+  for (int round = 0; round < 2 && c; ++round) {
+    const Mat34 P = geom::projectionMatrix(c->K, c->pose);
+    std::vector<double> err(points.world.size(), 1e9);
+    std::vector<double> kept;
+    for (std::size_t i = 0; i < points.world.size(); ++i) {
+      if (auto p = geom::projectWith(P, points.world[i]))
+        err[i] = (*p - points.projector[i]).norm();
+      if (keep[i]) kept.push_back(err[i]);
+    }
+    if (kept.empty()) break;
+    std::nth_element(kept.begin(), kept.begin() + kept.size() / 2, kept.end());
+    const double limit = std::max(0.1, 3.0 * kept[kept.size() / 2] / 1.177);
+    Points3 world;
+    Points2 projector;
+    for (std::size_t i = 0; i < points.world.size(); ++i) {
+      keep[i] = err[i] <= limit;
+      if (keep[i]) world.push_back(points.world[i]), projector.push_back(points.projector[i]);
+    }
+    if (world.size() == points.world.size()) break;
+    c = fromCorrespondences(world, projector);
+  }
+  if (c) c->inliers = std::move(keep);
   if (!c && c.error().code == ErrorCode::kCoplanar)
     return fail(ErrorCode::kCoplanar,
                 "the decoded surface is planar, so the projector's depth scale is ambiguous "
@@ -34,7 +61,8 @@ Result<ProjectorCalibration> calibrateProjectorFromSurface(const surface::Surfac
 Result<ProjectorCalibration> calibrateProjectorFromFiducials(std::span<const Vec3> world,
                                                              std::span<const Vec2> projector) {
   if (world.size() != projector.size())
-    return fail(ErrorCode::kInvalidInput, "fiducials: as many projector pixels as 3D points needed");
+    return fail(ErrorCode::kInvalidInput,
+                "fiducials: as many projector pixels as 3D points needed");
   if (world.size() < 6)
     return fail(ErrorCode::kTooFewPoints, "fiducials: at least 6 points are needed (11 unknowns)");
   auto c = fromCorrespondences(world, projector);

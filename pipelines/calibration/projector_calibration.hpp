@@ -7,6 +7,7 @@
 //      for a projector with square pixels, zero skew and a known c_x (see below);
 //  (c) >= 6 fiducials with known 3D positions + the projector pixels lighting them
 //      (seed §5.2.5).
+#include <cstdint>
 #include <optional>
 #include <span>
 #include <vector>
@@ -20,14 +21,19 @@ namespace procam::calib {
 
 struct ProjectorCalibration {
   geom::Intrinsics K;
-  geom::Pose pose;     // world -> projector
-  double rms_px = 0;   // reprojection RMS in projector pixels
+  geom::Pose pose;    // world -> projector
+  double rms_px = 0;  // reprojection RMS in projector pixels
   int points = 0;
   bool scale_known = true;  // route (b) without a known distance: t is up to scale
+  // Route (a): per input point, whether it was kept (1) or rejected as inconsistent
+  // with the fitted projector (0).
+  std::vector<std::uint8_t> inliers;
 };
 
-// Route (a). kCoplanar when the surface is (nearly) a plane: the message says to
-// add a non-planar object to the scene or to use route (b).
+// Route (a). Points whose reprojection error is far above the fit's (a biased
+// triangulation, e.g. where a neighbourhood straddles a surface crease) are dropped
+// and the matrix refitted. kCoplanar when the surface is (nearly) a plane: the
+// message says to add a non-planar object to the scene or to use route (b).
 Result<ProjectorCalibration> calibrateProjectorFromSurface(const surface::SurfacePoints& points);
 
 // Route (c). kTooFewPoints below 6 fiducials, kCoplanar for coplanar fiducials.
@@ -46,7 +52,7 @@ struct PlaneView {
 // (b) fixes zero skew, f_x = f_y and c_x; it estimates f, c_y, R, t.
 struct PlaneRouteOptions {
   int projector_width = 0, projector_height = 0;  // 0: from the largest projector pixel seen
-  std::optional<double> principal_x;  // c_x; default the image centre (width - 1) / 2
+  std::optional<double> principal_x;              // c_x; default the image centre (width - 1) / 2
   // Distance from the camera centre to the first plane, metres. A blank plane fixes
   // everything but the overall scale; without this, t has unit length.
   std::optional<double> first_plane_distance;

@@ -221,7 +221,7 @@ Result<HomographyFit> finish(const Normalized& n, const Mat3& Hn, double conditi
 Result<double> checkedCondition(const Dlt& dlt, const HomographyOptions& options) {
   if (!(dlt.condition <= options.max_condition)) {
     return fail(ErrorCode::kIllConditioned,
-                "homography: DLT condition number " + std::to_string(dlt.condition) +
+                "homography: DLT condition number " + detail::shortNumber(dlt.condition) +
                     " exceeds the limit (points nearly collinear or clustered)");
   }
   return dlt.condition;

@@ -43,7 +43,7 @@ Result<HomographyFit> refineHomography(const Mat3& H0, std::span<const Vec2> src
                                        std::span<const Vec2> dst,
                                        const HomographyOptions& options = {});
 
-// DLT followed, if options.refine, by LM.
+// DLT followed, if options.refine, by LM (not for n = 4: the DLT is then exact).
 Result<HomographyFit> fitHomography(std::span<const Vec2> src, std::span<const Vec2> dst,
                                     const HomographyOptions& options = {});
 

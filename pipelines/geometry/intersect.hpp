@@ -65,7 +65,9 @@ struct Sphere {
 };
 std::optional<Hit> intersectSphere(const Ray& ray, const Sphere& sphere, RayRange range = {});
 
-// Single triangle (Möller–Trumbore), two-sided.
+// Single triangle (Möller–Trumbore), two-sided. A triangle whose angle at `a` has a
+// sine below 1e-8 counts as degenerate (its plane is not resolvable in doubles), and
+// a ray within ~1e-12 rad of the triangle's plane is a miss.
 std::optional<Hit> intersectTriangle(const Ray& ray, const Vec3& a, const Vec3& b, const Vec3& c,
                                      RayRange range = {});
 

@@ -2,8 +2,11 @@
 // Internal to pipelines/geometry: Hartley normalisation (isotropic scaling, HZ §4.4.4)
 // shared by the DLT estimators. Points are translated to their centroid and scaled so
 // the mean distance from it is sqrt(dim); estimation then happens in that frame.
+// Also the input bounds and scale helpers those estimators share.
 #include <cmath>
+#include <cstdio>
 #include <span>
+#include <string>
 
 #include "core/error.hpp"
 #include "core/types.hpp"
@@ -72,6 +75,13 @@ Result<Similarity<D>> hartley(std::span<const Eigen::Matrix<double, D, 1>> point
   T.centroid = c;
   T.scale = scale;
   return T;
+}
+
+// Short form of a number for error messages (e.g. "3.2e+09", "0.00012").
+inline std::string shortNumber(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
 }
 
 // M / ||M||_F without overflow or underflow in the norm for any finite, non-zero M.

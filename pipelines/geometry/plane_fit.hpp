@@ -19,10 +19,13 @@ struct Plane {
 
 struct PlaneFit {
   Plane plane;
-  double rms = 0;                 // RMS distance of the inliers
+  double rms = 0;                      // RMS distance of the inliers
   std::vector<std::uint32_t> inliers;  // indices (all points for least squares)
 };
 
+// kDegenerate for coincident or collinear points (extent ratio < 1e-9 or within the
+// rounding of the coordinates) and for isotropic sets with no unique best plane.
+// n is oriented so that its largest-magnitude component is positive.
 Result<PlaneFit> fitPlane(std::span<const Vec3> points);
 
 struct RansacOptions {

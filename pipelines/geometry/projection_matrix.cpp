@@ -72,7 +72,7 @@ Result<Normalized> prepare(std::span<const Vec3> world, std::span<const Vec2> pi
   if (!(ratio >= options.coplanar_ratio)) {
     return fail(ErrorCode::kCoplanar,
                 "projection matrix: the 3D points are (nearly) coplanar (thickness/extent = " +
-                    std::to_string(ratio) +
+                    detail::shortNumber(ratio) +
                     "), so depth and focal length cannot be separated; add points on a "
                     "non-planar surface, e.g. a second wall at an angle (seed §4.1.1)");
   }
@@ -183,7 +183,7 @@ Result<ProjectionFit> fitProjectionMatrix(std::span<const Vec3> world, std::span
   const Dlt dlt = solveDlt(*n);
   if (!(dlt.condition <= options.max_condition)) {
     return fail(ErrorCode::kIllConditioned, "projection matrix: DLT condition number " +
-                                                std::to_string(dlt.condition) +
+                                                detail::shortNumber(dlt.condition) +
                                                 " exceeds the limit (near-degenerate points)");
   }
   Mat34 Pn = dlt.Pn;

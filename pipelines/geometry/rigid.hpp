@@ -14,7 +14,9 @@ struct RigidFit {
   double rms = 0;      // RMS of ||to - (s R from + t)||
 };
 
-// to ≈ s R from + t; n >= 3 non-collinear points.
+// to ≈ s R from + t; n >= 3 non-collinear points. kDegenerate when either set is
+// coincident or collinear (second/first principal extent < 1e-5, or within the
+// rounding of the coordinates); R is always a rotation (det +1).
 Result<RigidFit> fitRigidTransform(std::span<const Vec3> from, std::span<const Vec3> to,
                                    bool with_scale = false);
 

@@ -62,7 +62,8 @@ Result<Vec3> triangulateLinear(std::span<const Mat34> P, std::span<const Vec2> p
     }
   }
   // World normalisation (Hartley): centre and scale on the finite camera centres so
-  // that the unknown is O(1) whatever the scene units and offsets.
+  // that the four columns of the system have comparable size whatever the scene
+  // units and offsets (a 1e4 offset would otherwise swamp the 4th column).
   Vec3 centroid = Vec3::Zero();
   std::vector<Vec3> centres;
   for (const Mat34& p : P) {

@@ -61,9 +61,9 @@ Result<PlanarityTest> testPlanarity(const PatternSet& coarse, const Decoded& d,
   for (const BlockSum& b : blocks)
     if (b.count > 0 && !b.touches_border) counts.push_back(b.count);
   if (counts.size() < 8)
-    return fail(ErrorCode::kTooFewPoints,
-                format("coarse pass: only %zu whole projector blocks are visible (need 8)",
-                       counts.size()));
+    return fail(
+        ErrorCode::kTooFewPoints,
+        format("coarse pass: only %zu whole projector blocks are visible (need 8)", counts.size()));
   std::nth_element(counts.begin(), counts.begin() + counts.size() / 2, counts.end());
   const int median = counts[counts.size() / 2];
 
@@ -83,15 +83,14 @@ Result<PlanarityTest> testPlanarity(const PatternSet& coarse, const Decoded& d,
       t.projector.emplace_back(x0 + (cw - 1) * 0.5, y0 + (ch - 1) * 0.5);
     }
   if (t.camera.size() < 8)
-    return fail(ErrorCode::kTooFewPoints,
-                format("coarse pass: only %zu fully decoded projector blocks (need 8)",
-                       t.camera.size()));
+    return fail(
+        ErrorCode::kTooFewPoints,
+        format("coarse pass: only %zu fully decoded projector blocks (need 8)", t.camera.size()));
   auto fit = geom::fitHomography(t.camera, t.projector);
   if (!fit) return tl::unexpected(fit.error());
   t.H = fit->H;
   t.rms_px = fit->rms;
-  t.tolerance_px =
-      o.planar_tolerance * std::min(coarse.columns.cell, coarse.rows.cell);
+  t.tolerance_px = o.planar_tolerance * std::min(coarse.columns.cell, coarse.rows.cell);
   t.planar = t.rms_px <= t.tolerance_px;
   return t;
 }

@@ -17,7 +17,7 @@
 namespace procam::sl {
 
 struct AdaptiveOptions {
-  PatternOptions full;          // full set for non-planar surfaces (width/height = projector)
+  PatternOptions full;  // full set for non-planar surfaces (width/height = projector)
   int blocks_x = 16, blocks_y = 12;
   // Planar when the coarse correspondences fit one homography to within this
   // fraction of the block size, RMS in projector pixels (block centroids are biased

@@ -1,19 +1,19 @@
 #include "structured_light/apriltag_grid.hpp"
 
-#include <memory>
-
 #include <apriltag/apriltag.h>
 #include <apriltag/common/image_u8.h>
 #include <apriltag/common/zarray.h>
 #include <apriltag/tag36h11.h>
+
+#include <memory>
 #include <opencv2/imgproc.hpp>
 
 namespace procam::sl {
 namespace {
 
-constexpr int kTotalModules = 10;   // tag36h11 with its one-module white border
-constexpr int kBorderStart = 1;     // first black module
-constexpr int kBorderEnd = 9;       // one past the last black module
+constexpr int kTotalModules = 10;  // tag36h11 with its one-module white border
+constexpr int kBorderStart = 1;    // first black module
+constexpr int kBorderEnd = 9;      // one past the last black module
 
 struct FamilyDeleter {
   void operator()(apriltag_family_t* f) const { tag36h11_destroy(f); }
@@ -40,8 +40,7 @@ Result<TagGrid> makeTagGrid(const TagGridOptions& o) {
   const int pitch = pitch_modules * module;
   const int cols = (o.width - kTotalModules * module) / pitch + 1;
   const int rows = (o.height - kTotalModules * module) / pitch + 1;
-  if (o.width < kTotalModules * module || o.height < kTotalModules * module || cols < 2 ||
-      rows < 2)
+  if (o.width < kTotalModules * module || o.height < kTotalModules * module || cols < 2 || rows < 2)
     return fail(ErrorCode::kInvalidInput, "tag grid: not even 2x2 tags fit the image");
   Family family(tag36h11_create());
   if (cols * rows > static_cast<int>(family->ncodes))

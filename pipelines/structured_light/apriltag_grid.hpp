@@ -4,9 +4,8 @@
 // fast path, the handheld keystone's camera and drift checks during display.
 // Corners are in DESIGN.md's pixel-centre convention on both sides.
 #include <array>
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "core/error.hpp"
 #include "core/types.hpp"
@@ -41,9 +40,9 @@ Result<cv::Mat> renderTagGrid(const TagGrid& grid);
 
 struct TagCorrespondence {
   int id = 0;
-  int corner = 0;   // 0..3 as in TagPlacement::corners
-  Vec2 image;       // detected, pixel-centre convention
-  Vec2 pattern;     // the same corner in the grid image
+  int corner = 0;  // 0..3 as in TagPlacement::corners
+  Vec2 image;      // detected, pixel-centre convention
+  Vec2 pattern;    // the same corner in the grid image
 };
 
 struct TagDetectOptions {

@@ -4,10 +4,9 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
-#include <vector>
-
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
+#include <vector>
 
 #include "structured_light/gray_code.hpp"
 
@@ -26,7 +25,8 @@ AxisFrames axisFrames(const PatternSet& set, Axis axis) {
     a.gray.push_back(findFrame(set, FrameKind::kGray, axis, b));
     a.inverse.push_back(findFrame(set, FrameKind::kGrayInverse, axis, b));
   }
-  for (int n = 0; n < set.phaseSteps(); ++n) a.phase.push_back(findFrame(set, FrameKind::kPhase, axis, n));
+  for (int n = 0; n < set.phaseSteps(); ++n)
+    a.phase.push_back(findFrame(set, FrameKind::kPhase, axis, n));
   return a;
 }
 
@@ -36,7 +36,14 @@ struct Scratch {
   std::vector<std::uint8_t> weak, bad;
   std::vector<float> min1, min2, inv_contrast, tolerance, sin_sum, cos_sum;
   explicit Scratch(int n)
-      : code(n), weak(n), bad(n), min1(n), min2(n), inv_contrast(n), tolerance(n), sin_sum(n),
+      : code(n),
+        weak(n),
+        bad(n),
+        min1(n),
+        min2(n),
+        inv_contrast(n),
+        tolerance(n),
+        sin_sum(n),
         cos_sum(n) {}
 };
 
@@ -45,7 +52,11 @@ class RowDecoder {
  public:
   RowDecoder(const PatternSet& set, const std::vector<cv::Mat>& frames,
              const DecodeOptions& options, double full_scale, Decoded& out)
-      : set_(set), frames_(frames), o_(options), full_(static_cast<float>(full_scale)), out_(out),
+      : set_(set),
+        frames_(frames),
+        o_(options),
+        full_(static_cast<float>(full_scale)),
+        out_(out),
         white_(findFrame(set, FrameKind::kWhite, Axis::kColumns, 0)),
         black_(findFrame(set, FrameKind::kBlack, Axis::kColumns, 0)),
         axes_{axisFrames(set, Axis::kColumns), axisFrames(set, Axis::kRows)} {
@@ -76,7 +87,8 @@ class RowDecoder {
         if (b[x] >= saturated || (phase && w[x] >= saturated)) f |= kSaturated;
         flags[x] = f;
         s.inv_contrast[x] = contrast > 0 ? 1.0f / contrast : 0.0f;
-        s.tolerance[x] = static_cast<float>(o_.range_tolerance) * std::max(contrast, 0.0f) + tol_abs;
+        s.tolerance[x] =
+            static_cast<float>(o_.range_tolerance) * std::max(contrast, 0.0f) + tol_abs;
         confidence[x] = 1.0f;
       }
       decodeAxis(axes_[0], y, w, b, s, flags, confidence.data(), out_.u.ptr<float>(y));
@@ -198,11 +210,10 @@ Result<Decoded> decode(const PatternSet& set, std::span<const cv::Mat> captures,
   for (std::size_t i = 0; i < captures.size(); ++i) {
     const cv::Mat& c = captures[i];
     if (c.size() != size)
-      return fail(ErrorCode::kInvalidInput, "capture " + set.frames[i].name + " is " +
-                                                std::to_string(c.cols) + "x" +
-                                                std::to_string(c.rows) + ", expected " +
-                                                std::to_string(size.width) + "x" +
-                                                std::to_string(size.height));
+      return fail(ErrorCode::kInvalidInput,
+                  "capture " + set.frames[i].name + " is " + std::to_string(c.cols) + "x" +
+                      std::to_string(c.rows) + ", expected " + std::to_string(size.width) + "x" +
+                      std::to_string(size.height));
     if (c.depth() != CV_8U && c.depth() != CV_16U)
       return fail(ErrorCode::kInvalidInput, "captures must be 8- or 16-bit");
     if (depth >= 0 && c.depth() != depth)
@@ -216,8 +227,22 @@ Result<Decoded> decode(const PatternSet& set, std::span<const cv::Mat> captures,
       return fail(ErrorCode::kInvalidInput, "captures must have 1, 3 or 4 channels");
     }
   }
-  const double full = options.full_scale > 0 ? options.full_scale
-                                             : (depth == CV_8U ? 255.0 : 65535.0);
+  double full = options.full_scale;
+  if (!(full > 0)) {
+    full = 255.0;
+    if (depth == CV_16U) {
+      double max_white = 0;
+      cv::minMaxLoc(
+          frames[static_cast<std::size_t>(findFrame(set, FrameKind::kWhite, Axis::kColumns, 0))],
+          nullptr, &max_white);
+      full = 65535.0;
+      for (int bits : {10, 12, 14})
+        if (max_white <= (1 << bits) - 1) {
+          full = (1 << bits) - 1;
+          break;
+        }
+    }
+  }
   Decoded out;
   out.u.create(size, CV_32F);
   out.v.create(size, CV_32F);

@@ -5,9 +5,8 @@
 // curve (gamma) and albedo cancel; mild defocus only blurs stripe edges, where the
 // Gray code's one-bit-per-edge property bounds the error to one cell.
 #include <cstdint>
-#include <span>
-
 #include <opencv2/core.hpp>
+#include <span>
 
 #include "core/error.hpp"
 #include "structured_light/pattern_set.hpp"
@@ -16,29 +15,31 @@ namespace procam::sl {
 
 // Why a camera pixel has no correspondence (bits of Decoded::flags; 0 = decoded).
 enum DecodeFlag : std::uint8_t {
-  kShadow = 1,         // white - black below min_contrast: the projector does not reach it
-  kLowContrast = 2,    // too many weak Gray bits, or phase modulation too low
-  kSaturated = 4,      // black frame clipped, or (phase) white frame clipped
-  kInconsistent = 8,   // a pattern frame outside [black, white], a code beyond the
-                       // projector, or Gray and phase disagreeing
+  kShadow = 1,        // white - black below min_contrast: the projector does not reach it
+  kLowContrast = 2,   // too many weak Gray bits, or phase modulation too low
+  kSaturated = 4,     // black frame clipped, or (phase) white frame clipped
+  kInconsistent = 8,  // a pattern frame outside [black, white], a code beyond the
+                      // projector, or Gray and phase disagreeing
 };
 
 struct DecodeOptions {
   // Thresholds as fractions of the capture's full scale (255 or 65535 unless set).
-  double min_contrast = 0.03;    // white - black
-  double bit_contrast = 0.12;    // |pattern - inverse| / (white - black) for a firm bit
-  int max_weak_bits = 1;         // per axis; the bit flipping at a stripe edge is weak
-  double range_tolerance = 0.15; // pattern may exceed [black, white] by this * (white - black)
-  double saturation = 0.995;     // clipped at or above this fraction of full scale
-  double min_modulation = 0.15;  // phase amplitude / ((white - black) / 2)
-  double full_scale = 0;         // 0: from the image depth
+  double min_contrast = 0.03;     // white - black
+  double bit_contrast = 0.12;     // |pattern - inverse| / (white - black) for a firm bit
+  int max_weak_bits = 1;          // per axis; the bit flipping at a stripe edge is weak
+  double range_tolerance = 0.15;  // pattern may exceed [black, white] by this * (white - black)
+  double saturation = 0.995;      // clipped at or above this fraction of full scale
+  double min_modulation = 0.15;   // phase amplitude / ((white - black) / 2)
+  // 0: 255 for 8-bit captures; for 16-bit ones the smallest 2^b - 1 (b = 10, 12, 14,
+  // 16) covering the white frame, as 10- and 12-bit sensors store codes in 16 bits.
+  double full_scale = 0;
 };
 
 struct Decoded {
-  cv::Mat u, v;         // CV_32F, projector pixel coordinates; -1 where undecoded
-  cv::Mat confidence;   // CV_32F in [0, 1]; 0 where undecoded
-  cv::Mat flags;        // CV_8U, DecodeFlag bits; 0 where decoded
-  int decoded = 0;      // pixels with flags == 0
+  cv::Mat u, v;        // CV_32F, projector pixel coordinates; -1 where undecoded
+  cv::Mat confidence;  // CV_32F in [0, 1]; 0 where undecoded
+  cv::Mat flags;       // CV_8U, DecodeFlag bits; 0 where decoded
+  int decoded = 0;     // pixels with flags == 0
 };
 
 // captures[i] shows set.frames[i]; all the same size, CV_8UC1/CV_16UC1 (3-channel

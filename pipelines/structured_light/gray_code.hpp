@@ -7,7 +7,9 @@
 
 namespace procam::sl {
 
-constexpr std::uint32_t toGray(std::uint32_t binary) { return binary ^ (binary >> 1); }
+constexpr std::uint32_t toGray(std::uint32_t binary) {
+  return binary ^ (binary >> 1);
+}
 
 constexpr std::uint32_t fromGray(std::uint32_t gray) {
   gray ^= gray >> 16;

@@ -73,7 +73,9 @@ std::uint8_t codeValue(const PatternSet& set, const FrameInfo& f, int coordinate
 
 }  // namespace
 
-const char* toString(Mode mode) { return mode == Mode::kGray ? "gray" : "gray+phase"; }
+const char* toString(Mode mode) {
+  return mode == Mode::kGray ? "gray" : "gray+phase";
+}
 
 Result<Mode> parseMode(const std::string& text) {
   if (text == "gray") return Mode::kGray;

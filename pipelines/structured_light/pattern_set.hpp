@@ -17,14 +17,14 @@ enum class Axis { kColumns, kRows };
 enum class FrameKind { kWhite, kBlack, kGray, kGrayInverse, kPhase };
 
 struct PatternOptions {
-  int width = 0;   // projector resolution
+  int width = 0;  // projector resolution
   int height = 0;
   Mode mode = Mode::kGray;
   // One code per `step` projector pixels: the low bits of the Gray code are dropped.
   int step = 1;
-  int step_rows = 0;       // rows' step when it differs (0: same as step); coarse passes
-  int phase_steps = 8;     // N >= 3 shifted sinusoids per axis (kGrayPhase)
-  int phase_period = 32;   // sinusoid period in projector pixels; raised to 4*step
+  int step_rows = 0;      // rows' step when it differs (0: same as step); coarse passes
+  int phase_steps = 8;    // N >= 3 shifted sinusoids per axis (kGrayPhase)
+  int phase_period = 32;  // sinusoid period in projector pixels; raised to 4*step
   // The sinusoid is pre-distorted by v^(1/gamma) so that a projector with this
   // response emits a sinusoidal radiance (1 = no pre-distortion). Gray frames are
   // binary and unaffected.
@@ -33,18 +33,18 @@ struct PatternOptions {
 
 // The code layout of one axis.
 struct AxisCode {
-  int extent = 0;      // projector pixels along the axis
-  int cell = 1;        // projector pixels per Gray cell
-  int cells = 0;       // ceil(extent / cell)
-  int bits = 0;        // Gray bits (frames = 2 * bits, with inverses)
-  int period = 0;      // phase period in projector pixels (0 without phase)
+  int extent = 0;  // projector pixels along the axis
+  int cell = 1;    // projector pixels per Gray cell
+  int cells = 0;   // ceil(extent / cell)
+  int bits = 0;    // Gray bits (frames = 2 * bits, with inverses)
+  int period = 0;  // phase period in projector pixels (0 without phase)
 };
 
 struct FrameInfo {
   FrameKind kind = FrameKind::kWhite;
   Axis axis = Axis::kColumns;
-  int index = 0;       // Gray: bit, 0 = most significant; phase: shift n in [0, N)
-  std::string name;    // file stem, e.g. "05_col_gray_02_inv"
+  int index = 0;     // Gray: bit, 0 = most significant; phase: shift n in [0, N)
+  std::string name;  // file stem, e.g. "05_col_gray_02_inv"
 };
 
 struct PatternSet {

@@ -1,10 +1,9 @@
 #include "surface/projector_samples.hpp"
 
-#include <algorithm>
-#include <cmath>
-
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
 
 namespace procam::surface {
 namespace {
@@ -75,11 +74,14 @@ Result<ProjectorSamples> sampleProjectorGrid(const sl::Decoded& d, int width, in
     for (int i = 0; i < s.nodes_x; ++i) {
       const NodeFit& n = fits[static_cast<std::size_t>(j) * s.nodes_x + i];
       if (n.count < o.min_pixels) continue;
+      // Near the projector's border the neighbourhood is one-sided and its edge
+      // pixels are partly lit: no sample there.
+      const double px = i * o.step, py = j * o.step;
+      if (px < r - 0.5 || py < r - 0.5 || px > width - 0.5 - r || py > height - 0.5 - r) continue;
       // The node must lie inside the decoded neighbourhood, not at its rim (the
       // mean offset is then small against the spread), and the system well posed.
       const Eigen::Vector2d mean = n.dd.block<2, 1>(1, 0) / n.count;
-      const Eigen::Matrix2d cov =
-          n.dd.block<2, 2>(1, 1) / n.count - mean * mean.transpose();
+      const Eigen::Matrix2d cov = n.dd.block<2, 2>(1, 1) / n.count - mean * mean.transpose();
       const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
       const double spread = std::sqrt(std::max(eig.eigenvalues()(0), 0.0));
       if (spread < 0.2 * r || mean.norm() > 0.5 * r) continue;
@@ -88,7 +90,8 @@ Result<ProjectorSamples> sampleProjectorGrid(const sl::Decoded& d, int width, in
       const Eigen::Matrix<double, 3, 2> coef = ldlt.solve(n.dx);
       const Vec2 cam = coef.row(0).transpose();
       if (!cam.allFinite()) continue;
-      s.index[static_cast<std::size_t>(j) * s.nodes_x + i] = static_cast<std::int32_t>(s.camera.size());
+      s.index[static_cast<std::size_t>(j) * s.nodes_x + i] =
+          static_cast<std::int32_t>(s.camera.size());
       s.camera.push_back(cam);
       s.projector.emplace_back(i * o.step, j * o.step);
     }

@@ -14,7 +14,7 @@
 namespace procam::surface {
 
 struct SampleOptions {
-  int step = 8;               // projector pixels between nodes
+  int step = 8;  // projector pixels between nodes
   // Neighbourhood half-width in projector pixels; at least step/2 and 1.5 times the
   // projector pixels one camera pixel spans (measured from the map), so that every
   // neighbourhood holds several camera pixels.
@@ -25,14 +25,12 @@ struct SampleOptions {
 
 struct ProjectorSamples {
   int step = 0;
-  int nodes_x = 0, nodes_y = 0;  // grid of the projector: node (i, j) at (i*step, j*step)
+  int nodes_x = 0, nodes_y = 0;     // grid of the projector: node (i, j) at (i*step, j*step)
   std::vector<std::int32_t> index;  // nodes_y * nodes_x: sample index or -1
   Points2 projector;                // node position, projector pixels
   Points2 camera;                   // camera pixel seeing it (distorted, as captured)
 
-  std::int32_t at(int i, int j) const {
-    return index[static_cast<std::size_t>(j) * nodes_x + i];
-  }
+  std::int32_t at(int i, int j) const { return index[static_cast<std::size_t>(j) * nodes_x + i]; }
 };
 
 // kInvalidInput for a bad step or decoded map; an empty result is not an error.

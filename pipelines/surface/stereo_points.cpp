@@ -33,4 +33,22 @@ Result<SurfacePoints> triangulateStereo(const geom::CameraModel& a, const Projec
   return p;
 }
 
+SurfacePoints keepPoints(const SurfacePoints& points, const std::vector<std::uint8_t>& keep) {
+  SurfacePoints out;
+  out.step = points.step;
+  out.nodes_x = points.nodes_x;
+  out.nodes_y = points.nodes_y;
+  out.index.assign(points.index.size(), -1);
+  for (std::size_t n = 0; n < points.index.size(); ++n) {
+    const std::int32_t k = points.index[n];
+    if (k < 0 || static_cast<std::size_t>(k) >= keep.size() || !keep[static_cast<std::size_t>(k)])
+      continue;
+    out.index[n] = static_cast<std::int32_t>(out.world.size());
+    out.world.push_back(points.world[static_cast<std::size_t>(k)]);
+    out.projector.push_back(points.projector[static_cast<std::size_t>(k)]);
+    out.gap.push_back(points.gap[static_cast<std::size_t>(k)]);
+  }
+  return out;
+}
+
 }  // namespace procam::surface

@@ -31,4 +31,7 @@ Result<SurfacePoints> triangulateStereo(const geom::CameraModel& a, const Projec
                                         const geom::CameraModel& b, const ProjectorSamples& sb,
                                         const TriangulateOptions& options = {});
 
+// The points whose keep[i] is non-zero (e.g. a projector calibration's inliers).
+SurfacePoints keepPoints(const SurfacePoints& points, const std::vector<std::uint8_t>& keep);
+
 }  // namespace procam::surface

@@ -16,23 +16,23 @@ namespace procam::surface {
 struct SurfaceOptions {
   double plane_threshold = 0.003;        // RANSAC inlier distance, metres
   double planar_inlier_fraction = 0.97;  // planar when at least this share are inliers
-  double mesh_tolerance = 0.001;  // a coarse quad replaces finer ones within this (metres)
-  double max_edge = 0.05;         // longer edges between neighbouring nodes: a hole (metres)
-  int max_quad_nodes = 16;        // largest simplified quad, in node intervals (power of 2)
+  double mesh_tolerance = 0.001;         // a coarse quad replaces finer ones within this (metres)
+  double max_edge = 0.05;                // longer edges between neighbouring nodes: a hole (metres)
+  int max_quad_nodes = 16;               // largest simplified quad, in node intervals (power of 2)
 };
 
 struct SurfaceMesh {
-  Points3 vertices;                     // world frame
-  Points2 projector;                    // projector pixel of each vertex
-  std::vector<Eigen::Vector3i> faces;   // vertex indices
+  Points3 vertices;                    // world frame
+  Points2 projector;                   // projector pixel of each vertex
+  std::vector<Eigen::Vector3i> faces;  // vertex indices
 };
 
 struct SurfaceModel {
   bool planar = false;
-  geom::Plane plane;            // best plane (also for non-planar surfaces)
-  double plane_rms = 0;         // RMS distance of the inliers
+  geom::Plane plane;     // best plane (also for non-planar surfaces)
+  double plane_rms = 0;  // RMS distance of the inliers
   double inlier_fraction = 0;
-  SurfaceMesh mesh;             // empty when planar
+  SurfaceMesh mesh;  // empty when planar
 };
 
 // kTooFewPoints below 3 points.

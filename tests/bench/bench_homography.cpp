@@ -73,7 +73,14 @@ std::vector<Trial> makeTrials(int n, int trials, std::uint64_t seed) {
 
 struct Accuracy {
   double res2 = 0, est2 = 0;  // sums over trials of per-coordinate mean squares
+  std::vector<double> est;    // per-trial per-coordinate RMS estimate error
   int ok = 0, failed = 0;
+
+  double medianEst() {
+    if (est.empty()) return NAN;
+    std::nth_element(est.begin(), est.begin() + est.size() / 2, est.end());
+    return est[est.size() / 2];
+  }
 };
 
 void score(Accuracy& acc, const Trial& t, const std::optional<Mat3>& H) {
@@ -94,6 +101,7 @@ void score(Accuracy& acc, const Trial& t, const std::optional<Mat3>& H) {
   const double coords = 2.0 * double(t.src.size());
   acc.res2 += res / coords;
   acc.est2 += est / coords;
+  acc.est.push_back(std::sqrt(est / coords));
   ++acc.ok;
 }
 
@@ -129,8 +137,8 @@ double timeAndScore(const std::vector<Trial>& trials, const Fit& fit, Accuracy& 
     const auto t0 = std::chrono::steady_clock::now();
     for (std::size_t i = 0; i < trials.size(); ++i) results[i] = fit(trials[i]);
     const auto t1 = std::chrono::steady_clock::now();
-    best = std::min(best, std::chrono::duration<double, std::micro>(t1 - t0).count() /
-                              double(trials.size()));
+    best = std::min(
+        best, std::chrono::duration<double, std::micro>(t1 - t0).count() / double(trials.size()));
     if (r + 1 == reps) {
       for (std::size_t i = 0; i < trials.size(); ++i) score(acc, trials[i], results[i]);
     }
@@ -146,22 +154,22 @@ void plot(const std::filesystem::path& out) {
   if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) return;
   const std::string csv = (out / "bench_homography.csv").string();
   std::ofstream gp(out / "bench_homography.gp");
-  gp << "set terminal pngcairo size 1200,500\n"
+  gp << "set terminal pngcairo size 1300,520 noenhanced\n"
      << "set output '" << (out / "bench_homography.png").string() << "'\n"
-     << "set datafile separator ','\nset key autotitle columnhead\n"
-     << "set multiplot layout 1,2 title 'Homography fit, sigma = 0.2 px, 1000 trials per n'\n"
+     << "set datafile separator ','\n"
+     << "set multiplot layout 1,2 title 'Homography fit, sigma = 0.2 px in dst, 1000 trials per "
+        "n'\n"
      << "set logscale xy\nset xlabel 'points n'\nset ylabel 'time per fit (us)'\n"
      << "set key top left\n"
-     << "plot '" << csv << "' using 1:4 with linespoints title 'procamd DLT+LM', '' using 1:5 "
-     << "with linespoints title 'procamd DLT', '' using 1:6 with linespoints title "
-     << "'cv::findHomography (method 0, LM)'\n"
-     << "unset logscale y\nset ylabel 'error / ML bound'\nset yrange [0.8:*]\n"
-     << "set key top right\n"
-     << "plot '" << csv << "' using 1:8 with linespoints title 'procamd residual / eps_res', "
-     << "'' using 1:9 with linespoints title 'OpenCV residual / eps_res', "
-     << "'' using 1:10 with linespoints title 'procamd estimate / eps_est', "
-     << "'' using 1:11 with linespoints title 'OpenCV estimate / eps_est', "
-     << "'' using 1:12 with linespoints title 'procamd DLT estimate / eps_est', "
+     << "plot '" << csv << "' skip 1 using 1:4 with linespoints title 'procamd DLT+LM', "
+     << "'' skip 1 using 1:5 with linespoints title 'procamd DLT only', "
+     << "'' skip 1 using 1:6 with linespoints title 'cv::findHomography method 0 (DLT+LM)'\n"
+     << "set ylabel 'RMS error / ML bound (1 = bound attained)'\nset key top left\n"
+     << "plot '" << csv << "' skip 1 using 1:8 with linespoints title 'procamd residual/eps_res', "
+     << "'' skip 1 using 1:9 with linespoints title 'OpenCV residual/eps_res', "
+     << "'' skip 1 using 1:10 with linespoints title 'procamd estimate/eps_est', "
+     << "'' skip 1 using 1:11 with linespoints title 'OpenCV estimate/eps_est', "
+     << "'' skip 1 using 1:12 with linespoints title 'procamd DLT only estimate/eps_est', "
      << "1 with lines dt 2 lc 'black' title 'ML bound'\n"
      << "unset multiplot\n";
   gp.close();
@@ -189,19 +197,21 @@ int main(int argc, char** argv) {
   std::ofstream csv(out / "bench_homography.csv");
   csv << "n,trials,sigma_px,procam_us,procam_dlt_us,opencv_us,time_ratio,"
          "procam_res_ratio,opencv_res_ratio,procam_est_ratio,opencv_est_ratio,"
-         "procam_dlt_est_ratio,procam_failures,opencv_failures\n";
-  std::printf("%6s %10s %10s %10s %8s %9s %9s %9s %9s %9s\n", "n", "procam_us", "dlt_us",
-              "opencv_us", "t_ratio", "res/b pc", "res/b cv", "est/b pc", "est/b cv",
-              "est/b dlt");
+         "procam_dlt_est_ratio,procam_est_median_ratio,opencv_est_median_ratio,"
+         "procam_failures,opencv_failures\n";
+  std::printf("%5s %9s %9s %9s %7s | %-15s | %-22s | %-22s\n", "n", "procam_us", "dlt_us",
+              "opencv_us", "ratio", "res/eps_res", "est/eps_est (rms)", "est/eps_est (median)");
+  std::printf("%5s %9s %9s %9s %7s | %7s %7s | %7s %7s %6s | %7s %7s\n", "", "", "", "", "",
+              "procam", "opencv", "procam", "opencv", "dlt", "procam", "opencv");
   for (int n : {4, 20, 100, 1000}) {
     const auto data = makeTrials(n, trials, 1000 + std::uint64_t(n));
     const int reps = n >= 1000 ? 3 : 5;
     Accuracy pc, dlt, cv;
     const double t_cv = timeAndScore(data, opencvFit, cv, reps);
-    const double t_pc = timeAndScore(data, [](const Trial& t) { return procamFit(t, true); }, pc,
-                                     reps);
-    const double t_dlt =
-        timeAndScore(data, [](const Trial& t) { return procamFit(t, false); }, dlt, reps);
+    const double t_pc = timeAndScore(
+        data, [](const Trial& t) { return procamFit(t, true); }, pc, reps);
+    const double t_dlt = timeAndScore(
+        data, [](const Trial& t) { return procamFit(t, false); }, dlt, reps);
     const double eps_res = kSigma * std::sqrt(1 - 4.0 / n);
     const double eps_est = kSigma * std::sqrt(4.0 / n);
     auto mean = [](double sum, const Accuracy& a) { return a.ok ? sum / a.ok : NAN; };
@@ -210,13 +220,17 @@ int main(int argc, char** argv) {
     const double r_est_pc = ratio(mean(pc.est2, pc), eps_est);
     const double r_est_cv = ratio(mean(cv.est2, cv), eps_est);
     const double r_est_dlt = ratio(mean(dlt.est2, dlt), eps_est);
-    csv << n << ',' << trials << ',' << kSigma << ',' << t_pc << ',' << t_dlt << ',' << t_cv
-        << ',' << t_pc / t_cv << ',' << r_res_pc << ',' << r_res_cv << ',' << r_est_pc << ','
-        << r_est_cv << ',' << r_est_dlt << ',' << pc.failed << ',' << cv.failed << '\n';
-    std::printf("%6d %10.2f %10.2f %10.2f %8.2f %9.4f %9.4f %9.4f %9.4f %9.4f\n", n, t_pc,
-                t_dlt, t_cv, t_pc / t_cv, r_res_pc, r_res_cv, r_est_pc, r_est_cv, r_est_dlt);
+    const double m_est_pc = pc.medianEst() / eps_est;
+    const double m_est_cv = cv.medianEst() / eps_est;
+    csv << n << ',' << trials << ',' << kSigma << ',' << t_pc << ',' << t_dlt << ',' << t_cv << ','
+        << t_pc / t_cv << ',' << r_res_pc << ',' << r_res_cv << ',' << r_est_pc << ',' << r_est_cv
+        << ',' << r_est_dlt << ',' << m_est_pc << ',' << m_est_cv << ',' << pc.failed << ','
+        << cv.failed << '\n';
+    std::printf("%5d %9.2f %9.2f %9.2f %7.2f | %7.4f %7.4f | %7.4f %7.4f %6.3f | %7.4f %7.4f\n", n,
+                t_pc, t_dlt, t_cv, t_pc / t_cv, r_res_pc, r_res_cv, r_est_pc, r_est_cv, r_est_dlt,
+                m_est_pc, m_est_cv);
     if (pc.failed || cv.failed) {
-      std::printf("       failures: procamd %d, OpenCV %d\n", pc.failed, cv.failed);
+      std::printf("      failures: procamd %d, OpenCV %d\n", pc.failed, cv.failed);
     }
   }
   csv.close();

@@ -35,8 +35,8 @@ Timing measure(int runs, const std::function<void()>& body) {
   for (int i = 0; i < runs; ++i) {
     const auto t0 = std::chrono::steady_clock::now();
     body();
-    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                     .count());
+    ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }
   std::sort(ms.begin(), ms.end());
   return {ms[ms.size() / 2], ms.front()};
@@ -46,8 +46,8 @@ cv::Mat checkerboard(int width, int height, int square) {
   cv::Mat fb(height, width, CV_8UC3);
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x)
-      fb.at<cv::Vec3b>(y, x) = ((x / square + y / square) % 2) ? cv::Vec3b(255, 255, 255)
-                                                               : cv::Vec3b(0, 0, 0);
+      fb.at<cv::Vec3b>(y, x) =
+          ((x / square + y / square) % 2) ? cv::Vec3b(255, 255, 255) : cv::Vec3b(0, 0, 0);
   return fb;
 }
 
@@ -91,7 +91,8 @@ int main(int argc, char** argv) {
   const Timing prepare = measure(runs, [&] { (void)ProjectorImage::create(fb, proj.spec); });
   auto renderer = Renderer::create(*scene, state, {{"proj", fb}});
   const Timing radiance = measure(runs, [&] { (void)renderer->cameraRadiance(cam.spec.name, 1); });
-  const Timing camera = measure(runs, [&] { (void)renderer->renderCamera(cam.spec.name, options); });
+  const Timing camera =
+      measure(runs, [&] { (void)renderer->renderCamera(cam.spec.name, options); });
 
   // Baseline: framebuffer -> camera through the wall homography (plane y = 3).
   const Mat34 Pp = proj.model.projectionMatrix(), Pc = cam.model.projectionMatrix();

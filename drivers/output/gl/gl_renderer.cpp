@@ -149,6 +149,7 @@ Result<void> GlRenderer::makeStage(Stage& stage, cv::Size size, bool with_depth)
 
 Result<void> GlRenderer::configure(const render::RenderSetup& setup) {
   if (auto ok = render::validateSetup(setup); !ok) return ok;
+  configured_ = false;  // until every object matches the new setup
   const cv::Size out = setup.output_size;
   const bool depth =
       setup.path == render::RenderPath::kTwoPassMesh || setup.path == render::RenderPath::kPlanar3d;

@@ -1,9 +1,10 @@
 #include "kms/kms_select.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
-#include <regex>
+#include <system_error>
 
 namespace procam::output::kms {
 
@@ -19,15 +20,27 @@ double refreshHz(uint32_t clock_khz, uint32_t htotal, uint32_t vtotal, bool inte
 Result<ModeSpec> parseModeSpec(const std::string& text) {
   ModeSpec spec;
   if (text.empty() || text == "preferred") return spec;
-  static const std::regex re(R"(^(\d{1,5})x(\d{1,5})(@(\d{1,3}(\.\d{1,3})?))?$)");
-  std::smatch m;
-  if (!std::regex_match(text, m, re)) {
+  // WIDTHxHEIGHT[@HZ]: digits, 'x', digits, optionally '@' and a decimal number.
+  auto bad = [&] {
     return fail(ErrorCode::kParse, "mode '" + text + "': expected preferred, WxH or WxH@Hz");
-  }
+  };
+  const char* p = text.data();
+  const char* end = p + text.size();
+  auto number = [&](int& out) {
+    const auto r = std::from_chars(p, end, out);
+    if (r.ec != std::errc() || r.ptr == p || r.ptr - p > 5) return false;
+    p = r.ptr;
+    return true;
+  };
   spec.preferred = false;
-  spec.width = std::stoi(m[1]);
-  spec.height = std::stoi(m[2]);
-  if (m[4].matched) spec.refresh_hz = std::stod(m[4]);
+  if (!number(spec.width) || p == end || *p++ != 'x' || !number(spec.height)) return bad();
+  if (p != end) {
+    if (*p++ != '@' || p == end) return bad();
+    double hz = 0;
+    const auto r = std::from_chars(p, end, hz);
+    if (r.ec != std::errc() || r.ptr != end || !(hz > 0) || hz > 1000) return bad();
+    spec.refresh_hz = hz;
+  }
   if (spec.width <= 0 || spec.height <= 0) {
     return fail(ErrorCode::kParse, "mode '" + text + "': zero size");
   }

@@ -2,10 +2,9 @@
 // Renders a calibration board as a camera with lens distortion sees it: every camera
 // pixel is undistorted, cast onto the board plane and looked up in a high-resolution
 // board image; 2x supersampling, a slight blur and read noise.
-#include <random>
-
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
+#include <random>
 
 #include "calibration/board.hpp"
 #include "geometry/camera_model.hpp"
@@ -13,9 +12,9 @@
 namespace procam::testing {
 
 struct BoardImage {
-  cv::Mat pixels;        // CV_8UC1
+  cv::Mat pixels;  // CV_8UC1
   double px_per_m = 0;
-  Vec2 origin_px;        // board point (0, 0) in pixel-centre coordinates of `pixels`
+  Vec2 origin_px;  // board point (0, 0) in pixel-centre coordinates of `pixels`
 };
 
 // Normalised (undistorted) ray of every 2x-supersampled camera pixel.
@@ -27,7 +26,8 @@ inline std::vector<cv::Point2f> cameraRays(const geom::CameraModel& cam) {
     for (int x = 0; x < W; ++x)  // hi-res pixel centre in camera pixel coordinates
       distorted.emplace_back((x + 0.5f) / 2 - 0.5f, (y + 0.5f) / 2 - 0.5f);
   const cv::Matx33d K(cam.K.fx, cam.K.skew, cam.K.cx, 0, cam.K.fy, cam.K.cy, 0, 0, 1);
-  const cv::Matx<double, 1, 5> dist(cam.dist.k1, cam.dist.k2, cam.dist.p1, cam.dist.p2, cam.dist.k3);
+  const cv::Matx<double, 1, 5> dist(cam.dist.k1, cam.dist.k2, cam.dist.p1, cam.dist.p2,
+                                    cam.dist.k3);
   std::vector<cv::Point2f> normalised;
   cv::undistortPoints(distorted, normalised, K, dist, cv::noArray(), cv::noArray(),
                       cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 30, 1e-9));
@@ -51,12 +51,13 @@ inline cv::Mat viewBoard(const BoardImage& board, const geom::CameraModel& cam,
     const double s = -o.z() / dir.z();
     const Vec3 b = o + s * dir;
     const bool ok = s > 0 && std::isfinite(s);
-    map_x.at<float>(i / W, i % W) = ok ? static_cast<float>(board.origin_px.x() + b.x() * board.px_per_m) : -1e5f;
-    map_y.at<float>(i / W, i % W) = ok ? static_cast<float>(board.origin_px.y() + b.y() * board.px_per_m) : -1e5f;
+    map_x.at<float>(i / W, i % W) =
+        ok ? static_cast<float>(board.origin_px.x() + b.x() * board.px_per_m) : -1e5f;
+    map_y.at<float>(i / W, i % W) =
+        ok ? static_cast<float>(board.origin_px.y() + b.y() * board.px_per_m) : -1e5f;
   }
   cv::Mat hi, out;
-  cv::remap(board.pixels, hi, map_x, map_y, cv::INTER_LINEAR,
-            cv::BORDER_CONSTANT, 128);
+  cv::remap(board.pixels, hi, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT, 128);
   cv::resize(hi, out, cv::Size(cam.width, cam.height), 0, 0, cv::INTER_AREA);
   cv::GaussianBlur(out, out, cv::Size(), 0.6);
   cv::Mat noisy(out.size(), CV_16S);

@@ -47,7 +47,8 @@ TEST(CameraCalibration, FifteenCheckerboardViews) {
   const auto rays = procam::testing::cameraRays(truth);
   const auto poses = procam::testing::boardPoses(8 * 0.03, 5 * 0.03, 15);
   for (std::size_t i = 0; i < poses.size(); ++i) {
-    const cv::Mat image = procam::testing::viewBoard(board, truth, rays, poses[i], 1.0, static_cast<unsigned>(i) + 1);
+    const cv::Mat image =
+        procam::testing::viewBoard(board, truth, rays, poses[i], 1.0, static_cast<unsigned>(i) + 1);
     auto v = detectBoard(spec, image);
     ASSERT_TRUE(v) << "view " << i << ": " << v.error().message;
     ASSERT_EQ(v->image.size(), 54u);
@@ -112,10 +113,12 @@ TEST(Board, CharucoAndAprilGridAreDetected) {
     origin /= static_cast<double>(flat->image.size());
     b.origin_px = origin;
     for (std::size_t i = 0; i < flat->image.size(); ++i)
-      EXPECT_LT((flat->image[i] - (origin + flat->board[i].head<2>() * b.px_per_m)).norm(), 1.0) << text;
+      EXPECT_LT((flat->image[i] - (origin + flat->board[i].head<2>() * b.px_per_m)).norm(), 1.0)
+          << text;
     // Seen by the camera: detected corners agree with the projection of the board points.
     geom::Pose pose = procam::testing::boardPoses(0.25, 0.18, 3)[1];
-    auto v = detectBoard(spec, procam::testing::viewBoard(b, truth, procam::testing::cameraRays(truth), pose, 1.0, 9));
+    auto v = detectBoard(spec, procam::testing::viewBoard(
+                                   b, truth, procam::testing::cameraRays(truth), pose, 1.0, 9));
     ASSERT_TRUE(v) << text << ": " << v.error().message;
     EXPECT_GE(v->image.size(), 12u) << text;
     double sum = 0;

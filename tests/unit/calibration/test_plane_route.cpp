@@ -83,8 +83,8 @@ TEST(RouteB, WithoutADistanceTheTranslationIsADirection) {
   EXPECT_FALSE(c->scale_known);
   EXPECT_NEAR(c->K.fx, projector.K.fx, 0.005 * projector.K.fx);
   EXPECT_NEAR(c->K.cy, projector.K.cy, 2.0);
-  const Vec3 true_dir =
-      (projector.pose.R * camera.pose.center() + projector.pose.t).normalized();  // camera in projector frame
+  const Vec3 true_dir = (projector.pose.R * camera.pose.center() + projector.pose.t)
+                            .normalized();  // camera in projector frame
   const Vec3 est_dir = (c->pose.R * camera.pose.center() + c->pose.t).normalized();
   EXPECT_LT((true_dir - est_dir).norm(), 1e-3);
 }
@@ -100,6 +100,7 @@ TEST(RouteB, OneOrientationOrParallelPlanesAreRejected) {
       views[0], planeView(projector, camera, planeThrough(Vec3(0.0, 0.45, 0.5), n), 8, 0.05, 5)};
   auto c = calibrateProjectorFromPlanes(camera, parallel);
   ASSERT_FALSE(c);
-  EXPECT_TRUE(c.error().code == ErrorCode::kDegenerate || c.error().code == ErrorCode::kNoConvergence)
+  EXPECT_TRUE(c.error().code == ErrorCode::kDegenerate ||
+              c.error().code == ErrorCode::kNoConvergence)
       << c.error().message;
 }

@@ -38,7 +38,8 @@ geom::CameraModel secondCamera() {
 
 // Exact samples of each camera for the projector nodes lit on `surface`.
 ProjectorSamples exactSamples(const geom::CameraModel& projector, const geom::CameraModel& cam,
-                              const std::function<std::optional<Vec3>(const Vec2&)>& surface, int step) {
+                              const std::function<std::optional<Vec3>(const Vec2&)>& surface,
+                              int step) {
   ProjectorSamples s;
   s.step = step;
   s.nodes_x = (projector.width - 1) / step + 1;
@@ -90,10 +91,9 @@ TEST(ProjectorSamples, RejectsBadInput) {
   sl::Decoded empty;
   EXPECT_EQ(sampleProjectorGrid(empty, 100, 100, {}).error().code, ErrorCode::kInvalidInput);
   Mat3 H = Mat3::Identity();
-  EXPECT_EQ(sampleProjectorGrid(quantisedMap(H, cv::Size(10, 10)), 100, 100, {.step = 0})
-                .error()
-                .code,
-            ErrorCode::kInvalidInput);
+  EXPECT_EQ(
+      sampleProjectorGrid(quantisedMap(H, cv::Size(10, 10)), 100, 100, {.step = 0}).error().code,
+      ErrorCode::kInvalidInput);
 }
 
 TEST(Surface, CornerIsTriangulatedMeshedWithHolesAndExported) {
@@ -138,8 +138,10 @@ TEST(Surface, CornerIsTriangulatedMeshedWithHolesAndExported) {
   }
   const std::string ply = toPly(mesh);
   EXPECT_EQ(ply.rfind("ply\nformat ascii 1.0\n", 0), 0u);
-  EXPECT_NE(ply.find("element vertex " + std::to_string(mesh.vertices.size()) + "\n"), std::string::npos);
-  EXPECT_NE(ply.find("element face " + std::to_string(mesh.faces.size()) + "\n"), std::string::npos);
+  EXPECT_NE(ply.find("element vertex " + std::to_string(mesh.vertices.size()) + "\n"),
+            std::string::npos);
+  EXPECT_NE(ply.find("element face " + std::to_string(mesh.faces.size()) + "\n"),
+            std::string::npos);
 }
 
 TEST(Surface, PlanarWallIsAPlane) {
@@ -148,7 +150,8 @@ TEST(Surface, PlanarWallIsAPlane) {
   const auto b = secondCamera();
   const geom::Plane wall = planeThrough(Vec3(0, 0.5, 0), Vec3(0.3, -1, 0.1));
   auto lit = [&](const Vec2& q) { return litPoint(projector, q, wall); };
-  auto pts = triangulateStereo(a, exactSamples(projector, a, lit, 16), b, exactSamples(projector, b, lit, 16));
+  auto pts = triangulateStereo(a, exactSamples(projector, a, lit, 16), b,
+                               exactSamples(projector, b, lit, 16));
   ASSERT_TRUE(pts);
   auto model = buildSurface(*pts);
   ASSERT_TRUE(model);

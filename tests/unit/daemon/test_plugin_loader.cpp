@@ -114,7 +114,9 @@ int noCreate(const procam_device_desc*, const procam_config*, procam_device*, ch
 }
 
 TEST(PluginTable, ValidationNamesTheProblem) {
-  procam_driver_factory bad_family{static_cast<procam_family>(9), "x", "", scoreFive, noCreate};
+  procam_driver_factory bad_family{PROCAM_FAMILY_TILT, "x", "", scoreFive, noCreate};
+  const uint32_t nine = 9;  // what a broken plugin might store; not a valid enumerator
+  std::memcpy(&bad_family.family, &nine, sizeof nine);
   procam_plugin_table table{PROCAM_PLUGIN_ABI_VERSION, "t", "1", 1, &bad_family};
   auto r = validateTable(&table, "test");
   ASSERT_FALSE(r);

@@ -34,7 +34,8 @@ name = "proj"
 resolution = [320, 240]
 intrinsics = { fx = 300.0, fy = 300.0, cx = 159.5, cy = 119.5 }
 pose = { position = [0.0, 0.0, 1.0], yaw_deg = 0.0 }
-gamma = )" + std::to_string(projector_gamma) +
+gamma = )" +
+         std::to_string(projector_gamma) +
          R"(
 brightness = 3.0
 [[cameras]]
@@ -42,7 +43,8 @@ name = "cam"
 resolution = [240, 180]
 intrinsics = { fx = 220.0, fy = 220.0, cx = 119.5, cy = 89.5 }
 pose = { position = [0.2, 0.0, 1.0], look_at = [0.2, 2.0, 1.0] }
-)" + camera + R"(
+)" + camera +
+         R"(
 [[surfaces]]
 name = "wall"
 type = "plane"

@@ -16,7 +16,9 @@ using testing::flatWallScene;
 
 // Framebuffer of 4 x 2 flat patches (80 x 120 px each) with increasing levels.
 constexpr int kPatchW = 80, kPatchH = 120;
-int patchLevel(int px, int py) { return (py / kPatchH * 4 + px / kPatchW) * 255 / 7; }
+int patchLevel(int px, int py) {
+  return (py / kPatchH * 4 + px / kPatchW) * 255 / 7;
+}
 
 cv::Mat patches() {
   cv::Mat fb(240, 320, CV_8UC1);
@@ -45,7 +47,8 @@ struct Analytic {
       const Vec3 X = ray->at((2.0 - ray->origin.y()) / ray->dir.y());  // wall y = 2
       const auto u = p.model.project(X);
       if (!u) return -1;
-      const int px = static_cast<int>(std::lround(u->x())), py = static_cast<int>(std::lround(u->y()));
+      const int px = static_cast<int>(std::lround(u->x())),
+                py = static_cast<int>(std::lround(u->y()));
       // Two framebuffer pixels of margin: bilinear neighbours share the level.
       if (px % kPatchW < 2 || px % kPatchW > kPatchW - 3 || py % kPatchH < 2 ||
           py % kPatchH > kPatchH - 3 || px < 0 || py < 0 || px >= 320 || py >= 240)
@@ -158,10 +161,10 @@ TEST(SimPhotometry, NoiseMeanAndSigmaMatchTheScene) {
 TEST(SimPhotometry, SaturatesAtTheFullScaleOfTheBitDepth) {
   for (const int bits : {8, 10, 14, 16}) {
     for (const int channels : {1, 3}) {
-      auto scene = Scene::parse(flatWallScene("bit_depth = " + std::to_string(bits) +
-                                              "\nchannels = " + std::to_string(channels) +
-                                              "\nexposure = 50.0\n"),
-                                "flat.toml", {});
+      auto scene = Scene::parse(
+          flatWallScene("bit_depth = " + std::to_string(bits) +
+                        "\nchannels = " + std::to_string(channels) + "\nexposure = 50.0\n"),
+          "flat.toml", {});
       ASSERT_TRUE(scene);
       auto r = Renderer::create(*scene, scene->at(0), {{"proj", cv::Mat(240, 320, CV_8UC1, 255)}});
       ASSERT_TRUE(r);
@@ -222,8 +225,8 @@ TEST(SimPhotometry, ViewerImageIsTheAnalyticRadiance) {
 }
 
 TEST(SimPhotometry, NoiseIsDeterministicAndIndependentOfThreads) {
-  auto scene = Scene::parse(flatWallScene("read_noise_dn = 2.0\nfull_well_e = 5000.0\n"),
-                            "flat.toml", {});
+  auto scene =
+      Scene::parse(flatWallScene("read_noise_dn = 2.0\nfull_well_e = 5000.0\n"), "flat.toml", {});
   ASSERT_TRUE(scene);
   auto one = render(*scene, true, 11, 1);
   auto all = render(*scene, true, 11, 0);

@@ -78,9 +78,9 @@ TEST(SimShadow, BoxShadowOnTableMatchesGeometry) {
         const Vec3 X = ray->at(s);
         const bool on_table = s > 0 && std::abs(X.x()) <= 0.8 && std::abs(X.y() - 1.5) <= 0.45;
         const auto u = proj.model.project(X);
-        usable = on_table && !segmentHitsBox(c_cam, X, box_lo, box_hi) && u &&
-                 u->x() > margin && u->x() < proj.model.width - 1 - margin &&
-                 u->y() > margin && u->y() < proj.model.height - 1 - margin;
+        usable = on_table && !segmentHitsBox(c_cam, X, box_lo, box_hi) && u && u->x() > margin &&
+                 u->x() < proj.model.width - 1 - margin && u->y() > margin &&
+                 u->y() < proj.model.height - 1 - margin;
         if (!usable) break;
         const bool dark = segmentHitsBox(c_proj, X, box_lo, box_hi);
         shadowed += dark;
@@ -95,9 +95,12 @@ TEST(SimShadow, BoxShadowOnTableMatchesGeometry) {
       worst = std::max(worst, std::abs(got - expected));
       ASSERT_LE(std::abs(got - expected), 1.0)
           << "pixel (" << x << ", " << y << ") with " << shadowed << "/4 samples in shadow";
-      if (shadowed == 4) ++full_shadow;
-      else if (shadowed > 0) ++partial;
-      else ++lit;
+      if (shadowed == 4)
+        ++full_shadow;
+      else if (shadowed > 0)
+        ++partial;
+      else
+        ++lit;
     }
   }
   std::printf("table pixels: %d in shadow, %d on the shadow edge, %d lit; worst |diff| %.0f DN\n",

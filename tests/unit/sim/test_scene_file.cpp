@@ -75,13 +75,15 @@ TEST(SimSceneFile, BadValuesNameTheKey) {
        "[[tilt_sensors]]\nname = \"t\"\nattached_to = \"proj\"\nmount_matrix = [[1.0, 0.0, 0.0], "
        "[0.0, 1.0, 0.0], [0.0, 0.0, -1.0]]\n[[surfaces]]",
        "tilt_sensors[0].mount_matrix"},
-      {"[[surfaces]]", "[[tilt_sensors]]\nname = \"t\"\nattached_to = \"proj\"\nunits = \"mg\"\n"
-                       "[[surfaces]]",
+      {"[[surfaces]]",
+       "[[tilt_sensors]]\nname = \"t\"\nattached_to = \"proj\"\nunits = \"mg\"\n"
+       "[[surfaces]]",
        "tilt_sensors[0].units"},
       {"pose = { position = [0.0, 0.0, 1.0], yaw_deg = 0.0 }", "trajectory = \"nowhere\"",
        "projectors[0].trajectory"},
-      {"[[surfaces]]", "[[trajectories]]\nname = \"t\"\nkeyframes = [{ t = 1.0, position = [0.0, "
-                       "0.0, 0.0] }, { t = 0.5, position = [0.0, 0.0, 0.0] }]\n[[surfaces]]",
+      {"[[surfaces]]",
+       "[[trajectories]]\nname = \"t\"\nkeyframes = [{ t = 1.0, position = [0.0, "
+       "0.0, 0.0] }, { t = 0.5, position = [0.0, 0.0, 0.0] }]\n[[surfaces]]",
        "trajectories[0].keyframes[1].t"},
   };
   for (const Case& c : cases) {

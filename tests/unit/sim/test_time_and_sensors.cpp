@@ -11,7 +11,9 @@
 namespace procam::sim {
 namespace {
 
-Vec3 forward(const geom::Pose& pose) { return pose.R.row(2).transpose(); }
+Vec3 forward(const geom::Pose& pose) {
+  return pose.R.row(2).transpose();
+}
 
 TEST(SimOrientation, YawPitchRollFollowTheDocumentedSigns) {
   // Zero angles: looking along +Y, image x = +X, image y = -Z.
@@ -38,15 +40,17 @@ TEST(SimTime, HandheldTrajectoryHitsItsKeyframesAndSlerpsBetween) {
   EXPECT_TRUE(forward(scene->at(1.0).projectors[0].model.pose).isApprox(Vec3(0, s45, s45), 1e-12));
   // Halfway between level and pitch +45 about a single axis: pitch 22.5 degrees.
   const double h = degToRad(22.5);
-  EXPECT_TRUE(
-      forward(scene->at(0.5).projectors[0].model.pose).isApprox(Vec3(0, std::cos(h), std::sin(h)), 1e-12));
+  EXPECT_TRUE(forward(scene->at(0.5).projectors[0].model.pose)
+                  .isApprox(Vec3(0, std::cos(h), std::sin(h)), 1e-12));
   // t = 4: yaw -30 (turned right).
   const double y = degToRad(-30);
   EXPECT_TRUE(forward(scene->at(4.0).projectors[0].model.pose)
                   .isApprox(Vec3(-std::sin(y), std::cos(y), 0), 1e-12));
   // Before the first and after the last keyframe the end poses hold.
-  EXPECT_TRUE(scene->at(-3).projectors[0].model.pose.R.isApprox(scene->at(0).projectors[0].model.pose.R));
-  EXPECT_TRUE(scene->at(99).projectors[0].model.pose.R.isApprox(scene->at(8).projectors[0].model.pose.R));
+  EXPECT_TRUE(
+      scene->at(-3).projectors[0].model.pose.R.isApprox(scene->at(0).projectors[0].model.pose.R));
+  EXPECT_TRUE(
+      scene->at(99).projectors[0].model.pose.R.isApprox(scene->at(8).projectors[0].model.pose.R));
   EXPECT_TRUE(scene->at(2.7).projectors[0].model.pose.center().isApprox(Vec3(0, 0, 1.2)));
 }
 
@@ -95,8 +99,8 @@ TEST(SimTilt, NoiseMatchesTheNoiseDensity) {
   auto series = sampleTiltSeries(*scene, "accel", 0.0, 80.0, 3);  // 8001 samples at 100 Hz
   ASSERT_TRUE(series);
   ASSERT_EQ(series->size(), 8001u);
-  const double sigma_model = spec.noise_density_ug * 1e-6 * std::sqrt(spec.rate_hz / 2) *
-                             kStandardGravity;  // m/s^2
+  const double sigma_model =
+      spec.noise_density_ug * 1e-6 * std::sqrt(spec.rate_hz / 2) * kStandardGravity;  // m/s^2
   const Vec3 bias = 1e-3 * kStandardGravity * spec.bias_mg;
   Vec3 sum = Vec3::Zero(), sum_sq = Vec3::Zero();
   for (const auto& s : *series) {

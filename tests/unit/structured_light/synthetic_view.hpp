@@ -5,10 +5,9 @@
 // position of every camera pixel, gets ambient light, read noise and quantisation.
 #include <cmath>
 #include <cstdint>
-#include <random>
-
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+#include <random>
 
 namespace procam::testing {
 
@@ -38,7 +37,8 @@ inline cv::Mat viewFrame(const cv::Mat& projector_frame, const ViewModel& m, std
   for (int y = 0; y < seen.rows; ++y) {
     const float* s = seen.ptr<float>(y);
     for (int x = 0; x < seen.cols; ++x) {
-      const double signal = std::pow(std::min(1.0, m.ambient + m.gain * s[x]), 1.0 / m.camera_gamma);
+      const double signal =
+          std::pow(std::min(1.0, m.ambient + m.gain * s[x]), 1.0 / m.camera_gamma);
       const double v = signal * full + noise(rng);
       const double q = std::clamp(std::round(v), 0.0, full);
       if (m.sixteen_bit)

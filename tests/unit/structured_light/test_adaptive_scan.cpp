@@ -19,7 +19,8 @@ CaptureFn captureWith(const ViewModel& m, int* calls) {
     ++*calls;
     std::vector<cv::Mat> out;
     for (std::size_t i = 0; i < set.frames.size(); ++i)
-      out.push_back(procam::testing::viewFrame(renderFrame(set, i), m, static_cast<std::uint32_t>(i)));
+      out.push_back(
+          procam::testing::viewFrame(renderFrame(set, i), m, static_cast<std::uint32_t>(i)));
     return out;
   };
 }

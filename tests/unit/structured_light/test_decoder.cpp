@@ -23,7 +23,8 @@ ViewModel obliqueView() {
 std::vector<cv::Mat> capture(const PatternSet& set, const ViewModel& m) {
   std::vector<cv::Mat> out;
   for (std::size_t i = 0; i < set.frames.size(); ++i)
-    out.push_back(procam::testing::viewFrame(renderFrame(set, i), m, static_cast<std::uint32_t>(i)));
+    out.push_back(
+        procam::testing::viewFrame(renderFrame(set, i), m, static_cast<std::uint32_t>(i)));
   return out;
 }
 
@@ -94,8 +95,8 @@ TEST(Decoder, GrayPhaseMeetsTenthPixel) {
   for (int steps : {3, 8}) {
     ViewModel m = obliqueView();
     m.defocus_sigma = 0.7;
-    auto set = makePatternSet({.width = kProjW, .height = kProjH, .mode = Mode::kGrayPhase,
-                               .phase_steps = steps});
+    auto set = makePatternSet(
+        {.width = kProjW, .height = kProjH, .mode = Mode::kGrayPhase, .phase_steps = steps});
     ASSERT_TRUE(set);
     auto d = decode(*set, capture(*set, m));
     ASSERT_TRUE(d);
@@ -109,8 +110,8 @@ TEST(Decoder, SixteenBitCapturesDecodeLikeEightBit) {
   ViewModel m = obliqueView();
   m.sixteen_bit = true;
   m.noise_dn = 257;  // 1 DN of 8 bits
-  auto set = makePatternSet({.width = kProjW, .height = kProjH, .mode = Mode::kGrayPhase,
-                             .phase_steps = 4});
+  auto set = makePatternSet(
+      {.width = kProjW, .height = kProjH, .mode = Mode::kGrayPhase, .phase_steps = 4});
   ASSERT_TRUE(set);
   const auto captures = capture(*set, m);
   ASSERT_EQ(captures[0].depth(), CV_16U);
@@ -119,6 +120,22 @@ TEST(Decoder, SixteenBitCapturesDecodeLikeEightBit) {
   const ErrorStats s = compare(*d, m);
   EXPECT_GE(s.decoded_fraction, 0.95);
   EXPECT_LE(s.rms, 0.1);
+}
+
+// A 10-bit sensor's codes in 16-bit images: the full scale follows the white frame.
+TEST(Decoder, TenBitCodesInSixteenBitImages) {
+  ViewModel m = obliqueView();
+  m.sixteen_bit = true;
+  m.noise_dn = 257;
+  auto set = makePatternSet({.width = kProjW, .height = kProjH});
+  ASSERT_TRUE(set);
+  auto captures = capture(*set, m);
+  for (auto& c : captures) c.convertTo(c, CV_16U, 1023.0 / 65535.0);
+  auto d = decode(*set, captures);
+  ASSERT_TRUE(d);
+  const ErrorStats s = compare(*d, m);
+  EXPECT_GE(s.decoded_fraction, 0.9);
+  EXPECT_LE(s.rms, 0.5);
 }
 
 TEST(Decoder, StepDecodesCellCentres) {

@@ -60,12 +60,16 @@ TEST(PatternSet, ColumnCodesAreGrayAndInverseIsComplement) {
 }
 
 TEST(PatternSet, PhaseFramesFollowTheSinusoid) {
-  auto set = makePatternSet({.width = 256, .height = 64, .mode = Mode::kGrayPhase,
-                             .phase_steps = 4, .phase_period = 32, .projector_gamma = 1.0});
+  auto set = makePatternSet({.width = 256,
+                             .height = 64,
+                             .mode = Mode::kGrayPhase,
+                             .phase_steps = 4,
+                             .phase_period = 32,
+                             .projector_gamma = 1.0});
   ASSERT_TRUE(set);
   EXPECT_EQ(set->columns.cell, 8);
   EXPECT_EQ(set->columns.bits, 5);  // 32 cells
-  EXPECT_EQ(set->rows.bits, 3);  // 8 cells
+  EXPECT_EQ(set->rows.bits, 3);     // 8 cells
   EXPECT_EQ(set->frames.size(), 2u + (2 * 5 + 4) + (2 * 3 + 4));
   const cv::Mat f = renderFrame(*set, findFrame(*set, FrameKind::kPhase, Axis::kRows, 1));
   for (int y = 0; y < 64; ++y) {
@@ -82,7 +86,8 @@ TEST(PatternSet, PhaseFramesFollowTheSinusoid) {
 TEST(PatternSet, RejectsInvalidOptions) {
   EXPECT_FALSE(makePatternSet({.width = 0, .height = 10}));
   EXPECT_FALSE(makePatternSet({.width = 10, .height = 10, .step = 0}));
-  EXPECT_FALSE(makePatternSet({.width = 10, .height = 10, .mode = Mode::kGrayPhase, .phase_steps = 2}));
+  EXPECT_FALSE(
+      makePatternSet({.width = 10, .height = 10, .mode = Mode::kGrayPhase, .phase_steps = 2}));
   EXPECT_FALSE(makePatternSet({.width = 10, .height = 10, .projector_gamma = 0}));
   EXPECT_EQ(makePatternSet({.width = 10, .height = 10, .step = -1}).error().code,
             ErrorCode::kInvalidInput);
