@@ -26,7 +26,8 @@ constexpr const char* kUsage = R"(usage:
       Render what camera NAME sees at time T (seconds, default 0) while each named
       projector shows its image (8/16-bit PNG, gray or colour, at the projector's
       resolution); projectors not listed are dark. Writes an 8-bit PNG for cameras of
-      <= 8 bits, else 16-bit with codes 0..2^bits-1.
+      <= 8 bits, else 16-bit with codes 0..2^bits-1. --seed picks the noise,
+      --no-noise turns it off, --threads 1 renders on one core (default: all).
   procam-sim truth --scene S [--json] [--time T]
       Print the true K, R, t (world -> device), distortion and resolution of every
       device, the tilt-sensor mounts, trackers, viewer and surfaces as JSON.

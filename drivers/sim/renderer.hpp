@@ -26,7 +26,7 @@ using Framebuffers = std::map<std::string, cv::Mat, std::less<>>;
 struct RenderOptions {
   bool noise = true;
   std::uint64_t seed = 1;
-  int threads = 0;  // 0: all cores (OpenCV's pool), 1: the calling thread only
+  int threads = 0;  // 1: the calling thread only; otherwise OpenCV's pool (all cores)
 };
 
 // What one camera pixel (its centre ray) sees.
@@ -59,7 +59,8 @@ class Renderer {
 
   // Camera image: CV_8U (<= 8 bits) or CV_16U, 1 or 3 channels (BGR).
   Result<cv::Mat> renderCamera(std::string_view camera, const RenderOptions& options = {}) const;
-  // Linear radiance the camera's pixels receive (mean over the supersamples), CV_32FC3.
+  // Linear radiance the camera's pixels receive (mean over the supersamples, then
+  // the lens blur), CV_32FC3, BGR.
   Result<cv::Mat> cameraRadiance(std::string_view camera, int threads = 0) const;
 
   // Noise-free linear radiance (CV_32FC3, BGR) seen through any pinhole, e.g. the
@@ -111,7 +112,8 @@ std::optional<geom::Ray> pixelRay(const geom::CameraModel& view, double x, doubl
 // (-3/8, -1/8), (1/8, -3/8), (-1/8, 3/8), (3/8, 1/8).
 std::vector<Vec2> sampleOffsets(int supersamples);
 
-// Runs body(row) for rows [0, rows) on `threads` threads (0: all cores).
+// Runs body(row) for rows [0, rows): in the calling thread if threads == 1, else
+// on OpenCV's thread pool.
 void forEachRow(int rows, int threads, const std::function<void(int)>& body);
 
 }  // namespace procam::sim
