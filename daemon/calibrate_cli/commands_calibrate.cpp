@@ -1,4 +1,5 @@
 // camera, stereo, solve (route a), solve-planes (route b), solve-fiducials (route c).
+#include <algorithm>
 #include <cstdio>
 #include <opencv2/imgcodecs.hpp>
 
@@ -50,6 +51,13 @@ Result<sl::Decoded> decodeDir(const sl::PatternSet& set, const std::string& dir,
   auto d = sl::decode(set, *frames);
   if (d) progress("  " + std::to_string(d->decoded) + " camera pixels decoded");
   return d;
+}
+
+// Neighbourhood for inverting the decoded map: Gray-only correspondences are cell
+// centres, so it spans several cells; phase-shifted ones are continuous.
+double radiusFor(const sl::PatternSet& set) {
+  if (set.options.mode == sl::Mode::kGrayPhase) return 2.0;
+  return std::max({2.0, static_cast<double>(set.columns.cell), static_cast<double>(set.rows.cell)});
 }
 
 Result<int> stepOption(const Arguments& a) {
@@ -169,7 +177,7 @@ Result<void> runSolve(const Arguments& a) {
                   "captures in " + dirs[i] + " are " + std::to_string(d->u.cols) + "x" +
                       std::to_string(d->u.rows) + " but camera '" + (*cameras)[i].name + "' is " +
                       std::to_string(cam.width) + "x" + std::to_string(cam.height));
-    auto s = surface::sampleProjectorGrid(*d, pw, ph, {.step = *step});
+    auto s = surface::sampleProjectorGrid(*d, pw, ph, {.step = *step, .radius = radiusFor(*set)});
     if (!s) return asVoid(s);
     samples.push_back(std::move(*s));
   }
@@ -250,8 +258,8 @@ Result<void> runSolvePlanes(const Arguments& a) {
   for (std::size_t i = 0; i < dirs.size(); ++i) {
     auto d = decodeDir(*set, dirs[i], i, dirs.size());
     if (!d) return asVoid(d);
-    auto s =
-        surface::sampleProjectorGrid(*d, o.projector_width, o.projector_height, {.step = *step});
+    auto s = surface::sampleProjectorGrid(*d, o.projector_width, o.projector_height,
+                                          {.step = *step, .radius = radiusFor(*set)});
     if (!s) return asVoid(s);
     views.push_back({s->camera, s->projector});
   }

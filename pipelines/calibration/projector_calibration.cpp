@@ -25,10 +25,12 @@ Result<ProjectorCalibration> fromCorrespondences(std::span<const Vec3> world,
 
 Result<ProjectorCalibration> calibrateProjectorFromSurface(const surface::SurfacePoints& points) {
   auto c = fromCorrespondences(points.world, points.projector);
-  // Two rounds of rejection at 3 sigma of the residual norm (sigma from its median:
-  // for 2D Gaussian noise the median norm is 1.177 sigma), with a floor of 0.1 px.
+  // Rejection at 3 sigma of the residual norm (sigma from its median: for 2D
+  // Gaussian noise the median norm is 1.177 sigma, floor 0.1 px), refitting until
+  // the inlier set is stable; gross outliers (a wrongly unwrapped phase) bias the
+  // first fits, so this takes a few rounds.
   std::vector<std::uint8_t> keep(points.world.size(), 1);
-  for (int round = 0; round < 2 && c; ++round) {
+  for (int round = 0; round < 6 && c; ++round) {
     const Mat34 P = geom::projectionMatrix(c->K, c->pose);
     std::vector<double> err(points.world.size(), 1e9);
     std::vector<double> kept;
@@ -42,11 +44,14 @@ Result<ProjectorCalibration> calibrateProjectorFromSurface(const surface::Surfac
     const double limit = std::max(0.1, 3.0 * kept[kept.size() / 2] / 1.177);
     Points3 world;
     Points2 projector;
+    bool changed = false;
     for (std::size_t i = 0; i < points.world.size(); ++i) {
-      keep[i] = err[i] <= limit;
-      if (keep[i]) world.push_back(points.world[i]), projector.push_back(points.projector[i]);
+      const std::uint8_t k = err[i] <= limit;
+      changed |= k != keep[i];
+      keep[i] = k;
+      if (k) world.push_back(points.world[i]), projector.push_back(points.projector[i]);
     }
-    if (world.size() == points.world.size()) break;
+    if (!changed) break;
     c = fromCorrespondences(world, projector);
   }
   if (c) c->inliers = std::move(keep);

@@ -30,11 +30,11 @@ AxisFrames axisFrames(const PatternSet& set, Axis axis) {
   return a;
 }
 
-// Per-row scratch, allocated once per stripe of rows (never per pixel).
+// Per-row scratch, allocated once per stripe of rows (never per pixel). Uniform
+// 32-bit lanes so that the per-bit loops vectorise.
 struct Scratch {
-  std::vector<std::uint32_t> code;
-  std::vector<std::uint8_t> weak, bad;
-  std::vector<float> min1, min2, inv_contrast, tolerance, sin_sum, cos_sum;
+  std::vector<std::uint32_t> code, weak, bad;
+  std::vector<float> min1, min2, inv_contrast, firm, hi, lo, sin_sum, cos_sum;
   explicit Scratch(int n)
       : code(n),
         weak(n),
@@ -42,7 +42,9 @@ struct Scratch {
         min1(n),
         min2(n),
         inv_contrast(n),
-        tolerance(n),
+        firm(n),
+        hi(n),
+        lo(n),
         sin_sum(n),
         cos_sum(n) {}
 };
@@ -87,12 +89,15 @@ class RowDecoder {
         if (b[x] >= saturated || (phase && w[x] >= saturated)) f |= kSaturated;
         flags[x] = f;
         s.inv_contrast[x] = contrast > 0 ? 1.0f / contrast : 0.0f;
-        s.tolerance[x] =
+        const float tol =
             static_cast<float>(o_.range_tolerance) * std::max(contrast, 0.0f) + tol_abs;
+        s.hi[x] = static_cast<float>(w[x]) + tol;
+        s.lo[x] = static_cast<float>(b[x]) - tol;
+        s.firm[x] = static_cast<float>(o_.bit_contrast) * contrast;
         confidence[x] = 1.0f;
       }
-      decodeAxis(axes_[0], y, w, b, s, flags, confidence.data(), out_.u.ptr<float>(y));
-      decodeAxis(axes_[1], y, w, b, s, flags, confidence.data(), out_.v.ptr<float>(y));
+      decodeAxis(axes_[0], y, s, flags, confidence.data(), out_.u.ptr<float>(y));
+      decodeAxis(axes_[1], y, s, flags, confidence.data(), out_.v.ptr<float>(y));
       float* u = out_.u.ptr<float>(y);
       float* v = out_.v.ptr<float>(y);
       float* c = out_.confidence.ptr<float>(y);
@@ -106,31 +111,38 @@ class RowDecoder {
   }
 
  private:
-  void decodeAxis(const AxisFrames& a, int y, const T* w, const T* b, Scratch& s,
-                  std::uint8_t* flags, float* confidence, float* out) const {
+  void decodeAxis(const AxisFrames& a, int y, Scratch& s, std::uint8_t* flags, float* confidence,
+                  float* out) const {
     const int width = frames_[0].cols;
-    const float firm = static_cast<float>(o_.bit_contrast);
     constexpr float kInf = std::numeric_limits<float>::infinity();
     std::fill(s.code.begin(), s.code.end(), 0u);
-    std::fill(s.weak.begin(), s.weak.end(), std::uint8_t{0});
-    std::fill(s.bad.begin(), s.bad.end(), std::uint8_t{0});
+    std::fill(s.weak.begin(), s.weak.end(), 0u);
+    std::fill(s.bad.begin(), s.bad.end(), 0u);
     std::fill(s.min1.begin(), s.min1.end(), kInf);
     std::fill(s.min2.begin(), s.min2.end(), kInf);
+    std::uint32_t* code_p = s.code.data();
+    std::uint32_t* weak_p = s.weak.data();
+    std::uint32_t* bad_p = s.bad.data();
+    float* min1_p = s.min1.data();
+    float* min2_p = s.min2.data();
+    const float* firm_p = s.firm.data();
+    const float* hi_p = s.hi.data();
+    const float* lo_p = s.lo.data();
     for (std::size_t bit = 0; bit < a.gray.size(); ++bit) {
       const T* p = frames_[a.gray[bit]].ptr<T>(y);
       const T* q = frames_[a.inverse[bit]].ptr<T>(y);
+      // Two smallest |pattern - inverse| (normalised at the end), weak-bit count and
+      // the range check against [black, white].
       for (int x = 0; x < width; ++x) {
         const float pv = static_cast<float>(p[x]), qv = static_cast<float>(q[x]);
         const float d = pv - qv;
-        s.code[x] = (s.code[x] << 1) | static_cast<std::uint32_t>(d > 0);
-        const float r = std::abs(d) * s.inv_contrast[x];
-        s.weak[x] = static_cast<std::uint8_t>(s.weak[x] + (r < firm));
-        s.min2[x] = std::min(s.min2[x], std::max(s.min1[x], r));
-        s.min1[x] = std::min(s.min1[x], r);
-        const float hi = std::max(pv, qv), lo = std::min(pv, qv);
-        const float tol = s.tolerance[x];
-        s.bad[x] |= static_cast<std::uint8_t>((hi > static_cast<float>(w[x]) + tol) |
-                                              (lo < static_cast<float>(b[x]) - tol));
+        const float ad = std::abs(d);
+        code_p[x] = (code_p[x] << 1) | static_cast<std::uint32_t>(d > 0);
+        weak_p[x] += static_cast<std::uint32_t>(ad < firm_p[x]);
+        min2_p[x] = std::min(min2_p[x], std::max(min1_p[x], ad));
+        min1_p[x] = std::min(min1_p[x], ad);
+        bad_p[x] |= static_cast<std::uint32_t>(std::max(pv, qv) > hi_p[x]) |
+                    static_cast<std::uint32_t>(std::min(pv, qv) < lo_p[x]);
       }
     }
     const AxisCode& code = a.code;
@@ -142,11 +154,12 @@ class RowDecoder {
     for (int x = 0; x < width; ++x) {
       if (flags[x] != 0) continue;
       std::uint8_t f = 0;
-      if (s.weak[x] > o_.max_weak_bits) f |= kLowContrast;
+      if (s.weak[x] > static_cast<std::uint32_t>(std::max(0, o_.max_weak_bits))) f |= kLowContrast;
       if (s.bad[x]) f |= kInconsistent;
       const std::uint32_t cell = fromGray(s.code[x]);
       if (cell >= static_cast<std::uint32_t>(code.cells)) f |= kInconsistent;
-      float conf = code.bits >= 2 ? s.min2[x] : (code.bits == 1 ? s.min1[x] : 1.0f);
+      float conf = (code.bits >= 2 ? s.min2[x] : (code.bits == 1 ? s.min1[x] : 1.0f)) *
+                   (code.bits >= 1 ? s.inv_contrast[x] : 1.0f);
       const int first = static_cast<int>(cell) * code.cell;
       const int width_of_cell = std::min(code.cell, code.extent - first);
       double position = first + (width_of_cell - 1) * 0.5;

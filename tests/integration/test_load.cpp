@@ -104,13 +104,17 @@ TEST(Load, ClientLimitRefusesExtraConnectionsWithBusy) {
   TempDir dir;
   DaemonProcess d(dir, withConfig(dir, "[daemon]\nmax_clients = 3\n"));
   ASSERT_TRUE(d.started());
-  // started() probed with one connection that closed: wait until it is gone.
+  // started() probed with a connection that closed: wait until the daemon has
+  // seen it go, so that exactly the held connections count.
   std::vector<Connection> held;
-  for (int i = 0; i < 3; ++i) held.emplace_back(d.socketPath());
+  held.emplace_back(d.socketPath());
   ASSERT_TRUE(eventually([&] {
     auto s = held[0].call({{"cmd", "status"}});
-    return s && (*s)["clients"] == 3;
+    return s && (*s)["clients"] == 1;
   }));
+  held.emplace_back(d.socketPath());
+  held.emplace_back(d.socketPath());
+  for (auto& h : held) ASSERT_EQ(h.banner()["class"], "VERSION");
   Connection extra(d.socketPath());
   ASSERT_TRUE(extra.ok());
   EXPECT_EQ(extra.banner()["class"], "ERROR");
