@@ -6,6 +6,7 @@
 #include <numbers>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
+#include <type_traits>
 #include <vector>
 
 #include "structured_light/gray_code.hpp"
@@ -30,27 +31,56 @@ AxisFrames axisFrames(const PatternSet& set, Axis axis) {
   return a;
 }
 
-// Per-row scratch, allocated once per stripe of rows (never per pixel). Uniform
-// 32-bit lanes so that the per-bit loops vectorise.
+// Per-row scratch, allocated once per stripe of rows (never per pixel). The per-bit
+// loops run on integer lanes of one width W (int16 for 8-bit captures, int32 for
+// 16-bit ones) so that they vectorise: min/max are single SIMD instructions there.
+template <class W>
 struct Scratch {
-  std::vector<std::uint32_t> code, weak, bad;
-  std::vector<float> min1, min2, inv_contrast, firm, hi, lo, sin_sum, cos_sum;
+  using U = std::make_unsigned_t<W>;
+  std::vector<U> code, weak, bad;
+  std::vector<W> min1, min2, firm, hi, lo;
+  std::vector<float> inv_contrast, sin_sum, cos_sum;
   explicit Scratch(int n)
       : code(n),
         weak(n),
         bad(n),
         min1(n),
         min2(n),
-        inv_contrast(n),
         firm(n),
         hi(n),
         lo(n),
+        inv_contrast(n),
         sin_sum(n),
         cos_sum(n) {}
 };
 
+// One Gray bit of a row: the code gains the bit, plus the two smallest |pattern -
+// inverse| (normalised at the end), the weak-bit count and the range check against
+// [black, white]. Restrict-qualified parameters let the compiler vectorise.
+template <class T, class W, class U>
+void accumulateBit(const T* __restrict p, const T* __restrict q, U* __restrict code,
+                   U* __restrict weak, U* __restrict bad, W* __restrict min1, W* __restrict min2,
+                   const W* __restrict firm, const W* __restrict hi, const W* __restrict lo,
+                   int width) {
+  for (int x = 0; x < width; ++x) {
+    const W pv = static_cast<W>(p[x]), qv = static_cast<W>(q[x]);
+    const W d = static_cast<W>(pv - qv);
+    const W ad = std::max(d, static_cast<W>(-d));
+    code[x] = static_cast<U>((code[x] << 1) | static_cast<U>(d > 0));
+    weak[x] = static_cast<U>(weak[x] + static_cast<U>(ad < firm[x]));
+    min2[x] = std::min(min2[x], std::max(min1[x], ad));
+    min1[x] = std::min(min1[x], ad);
+    bad[x] = static_cast<U>(bad[x] | static_cast<U>(std::max(pv, qv) > hi[x]) |
+                            static_cast<U>(std::min(pv, qv) < lo[x]));
+  }
+}
+
 template <class T>
 class RowDecoder {
+  using W = std::conditional_t<sizeof(T) == 1, std::int16_t, std::int32_t>;
+  using U = std::make_unsigned_t<W>;
+  using Rows = Scratch<W>;
+
  public:
   RowDecoder(const PatternSet& set, const std::vector<cv::Mat>& frames,
              const DecodeOptions& options, double full_scale, Decoded& out)
@@ -72,7 +102,7 @@ class RowDecoder {
 
   void operator()(const cv::Range& rows) const {
     const int width = frames_[0].cols;
-    Scratch s(width);
+    Rows s(width);
     std::vector<float> confidence(width);
     for (int y = rows.start; y < rows.end; ++y) {
       const T* w = frames_[white_].ptr<T>(y);
@@ -91,9 +121,10 @@ class RowDecoder {
         s.inv_contrast[x] = contrast > 0 ? 1.0f / contrast : 0.0f;
         const float tol =
             static_cast<float>(o_.range_tolerance) * std::max(contrast, 0.0f) + tol_abs;
-        s.hi[x] = static_cast<float>(w[x]) + tol;
-        s.lo[x] = static_cast<float>(b[x]) - tol;
-        s.firm[x] = static_cast<float>(o_.bit_contrast) * contrast;
+        s.hi[x] = static_cast<W>(std::lround(static_cast<float>(w[x]) + tol));
+        s.lo[x] = static_cast<W>(std::lround(static_cast<float>(b[x]) - tol));
+        s.firm[x] = static_cast<W>(
+            std::lround(static_cast<float>(o_.bit_contrast) * std::max(contrast, 0.0f)));
         confidence[x] = 1.0f;
       }
       decodeAxis(axes_[0], y, s, flags, confidence.data(), out_.u.ptr<float>(y));
@@ -111,39 +142,27 @@ class RowDecoder {
   }
 
  private:
-  void decodeAxis(const AxisFrames& a, int y, Scratch& s, std::uint8_t* flags, float* confidence,
+  void decodeAxis(const AxisFrames& a, int y, Rows& s, std::uint8_t* flags, float* confidence,
                   float* out) const {
     const int width = frames_[0].cols;
-    constexpr float kInf = std::numeric_limits<float>::infinity();
-    std::fill(s.code.begin(), s.code.end(), 0u);
-    std::fill(s.weak.begin(), s.weak.end(), 0u);
-    std::fill(s.bad.begin(), s.bad.end(), 0u);
-    std::fill(s.min1.begin(), s.min1.end(), kInf);
-    std::fill(s.min2.begin(), s.min2.end(), kInf);
-    std::uint32_t* code_p = s.code.data();
-    std::uint32_t* weak_p = s.weak.data();
-    std::uint32_t* bad_p = s.bad.data();
-    float* min1_p = s.min1.data();
-    float* min2_p = s.min2.data();
-    const float* firm_p = s.firm.data();
-    const float* hi_p = s.hi.data();
-    const float* lo_p = s.lo.data();
+    constexpr W kMax = std::numeric_limits<W>::max();
+    std::fill(s.code.begin(), s.code.end(), U{0});
+    std::fill(s.weak.begin(), s.weak.end(), U{0});
+    std::fill(s.bad.begin(), s.bad.end(), U{0});
+    std::fill(s.min1.begin(), s.min1.end(), kMax);
+    std::fill(s.min2.begin(), s.min2.end(), kMax);
+    U* code_p = s.code.data();
+    U* weak_p = s.weak.data();
+    U* bad_p = s.bad.data();
+    W* min1_p = s.min1.data();
+    W* min2_p = s.min2.data();
+    const W* firm_p = s.firm.data();
+    const W* hi_p = s.hi.data();
+    const W* lo_p = s.lo.data();
     for (std::size_t bit = 0; bit < a.gray.size(); ++bit) {
       const T* p = frames_[a.gray[bit]].ptr<T>(y);
       const T* q = frames_[a.inverse[bit]].ptr<T>(y);
-      // Two smallest |pattern - inverse| (normalised at the end), weak-bit count and
-      // the range check against [black, white].
-      for (int x = 0; x < width; ++x) {
-        const float pv = static_cast<float>(p[x]), qv = static_cast<float>(q[x]);
-        const float d = pv - qv;
-        const float ad = std::abs(d);
-        code_p[x] = (code_p[x] << 1) | static_cast<std::uint32_t>(d > 0);
-        weak_p[x] += static_cast<std::uint32_t>(ad < firm_p[x]);
-        min2_p[x] = std::min(min2_p[x], std::max(min1_p[x], ad));
-        min1_p[x] = std::min(min1_p[x], ad);
-        bad_p[x] |= static_cast<std::uint32_t>(std::max(pv, qv) > hi_p[x]) |
-                    static_cast<std::uint32_t>(std::min(pv, qv) < lo_p[x]);
-      }
+      accumulateBit(p, q, code_p, weak_p, bad_p, min1_p, min2_p, firm_p, hi_p, lo_p, width);
     }
     const AxisCode& code = a.code;
     const bool phase = !a.phase.empty();
@@ -154,12 +173,13 @@ class RowDecoder {
     for (int x = 0; x < width; ++x) {
       if (flags[x] != 0) continue;
       std::uint8_t f = 0;
-      if (s.weak[x] > static_cast<std::uint32_t>(std::max(0, o_.max_weak_bits))) f |= kLowContrast;
+      if (static_cast<int>(s.weak[x]) > o_.max_weak_bits) f |= kLowContrast;
       if (s.bad[x]) f |= kInconsistent;
-      const std::uint32_t cell = fromGray(s.code[x]);
+      const std::uint32_t cell = fromGray(static_cast<std::uint32_t>(s.code[x]));
       if (cell >= static_cast<std::uint32_t>(code.cells)) f |= kInconsistent;
-      float conf = (code.bits >= 2 ? s.min2[x] : (code.bits == 1 ? s.min1[x] : 1.0f)) *
-                   (code.bits >= 1 ? s.inv_contrast[x] : 1.0f);
+      float conf = code.bits >= 2   ? static_cast<float>(s.min2[x]) * s.inv_contrast[x]
+                   : code.bits == 1 ? static_cast<float>(s.min1[x]) * s.inv_contrast[x]
+                                    : 1.0f;
       const int first = static_cast<int>(cell) * code.cell;
       const int width_of_cell = std::min(code.cell, code.extent - first);
       double position = first + (width_of_cell - 1) * 0.5;
@@ -183,7 +203,7 @@ class RowDecoder {
     }
   }
 
-  void accumulatePhase(const AxisFrames& a, int y, Scratch& s) const {
+  void accumulatePhase(const AxisFrames& a, int y, Rows& s) const {
     const int width = frames_[0].cols;
     std::fill(s.sin_sum.begin(), s.sin_sum.end(), 0.0f);
     std::fill(s.cos_sum.begin(), s.cos_sum.end(), 0.0f);
