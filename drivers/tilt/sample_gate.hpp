@@ -30,6 +30,11 @@ class SampleGate {
   // The sample, or kInvalidInput naming the reason it was rejected.
   Result<TiltSample> check(const TiltSample& sample);
   const SampleCounts& counts() const { return counts_; }
+  // Samples the driver itself refused never reach check(); they are counted here: a
+  // value beyond the device's range (a HID field outside its logical range) or one
+  // that is no number at all (an IIO raw attribute that does not parse).
+  void countOutOfRange() { ++counts_.out_of_range; }
+  void countNotFinite() { ++counts_.not_finite; }
 
  private:
   SampleGateOptions options_;

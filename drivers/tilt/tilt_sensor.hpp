@@ -30,6 +30,9 @@ class TiltSensor {
   virtual Result<TiltSample> read() = 0;
   virtual void close() = 0;
   virtual std::string name() const = 0;
+  // A descriptor that becomes readable when a new sample is available, or -1 when the
+  // sensor has none and is polled by timer. Valid while open.
+  virtual int pollFd() const { return -1; }
 };
 
 // CLOCK_MONOTONIC in nanoseconds.

@@ -65,10 +65,12 @@ std::optional<CoarseOrientation> BallSwitchTilt::orientation() const {
 Result<TiltSample> BallSwitchTilt::read() {
   if (!debouncer_) return fail(ErrorCode::kIo, "gpio: not open");
   const std::uint64_t deadline = lines_->nowNs() + std::uint64_t(config_.wait_ms) * 1'000'000;
-  while (true) {
+  // Edges already queued are taken even with wait_ms = 0 (a timer-polled device); a
+  // switch chattering without end cannot hold the read past the deadline for long.
+  for (int late = 0; late < 64;) {
     const std::uint64_t now = lines_->nowNs();
-    if (now >= deadline) break;
-    auto edge = lines_->waitEdge(int((deadline - now) / 1'000'000));
+    late += now >= deadline;
+    auto edge = lines_->waitEdge(now >= deadline ? 0 : int((deadline - now) / 1'000'000));
     if (!edge) return tl::unexpected(edge.error());
     if (!*edge) break;
     debouncer_->edge(**edge);

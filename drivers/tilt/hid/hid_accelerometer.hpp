@@ -19,6 +19,8 @@ class HidTransport {
   // One input report (with its report ID byte when the device uses IDs); kNotFound
   // on timeout.
   virtual Result<std::vector<std::uint8_t>> readReport(int timeout_ms) = 0;
+  // Readable when a report is waiting; -1 when the transport has no descriptor.
+  virtual int pollFd() const { return -1; }
 };
 
 // /dev/hidrawN: HIDIOCGRDESCSIZE/HIDIOCGRDESC and read(). Owns the descriptor.
@@ -28,6 +30,7 @@ class HidrawTransport final : public HidTransport {
   ~HidrawTransport() override;
   Result<std::vector<std::uint8_t>> reportDescriptor() override;
   Result<std::vector<std::uint8_t>> readReport(int timeout_ms) override;
+  int pollFd() const override { return fd_; }
 
  private:
   HidrawTransport(int fd, std::string path) : fd_(fd), path_(std::move(path)) {}
@@ -46,6 +49,7 @@ class HidAccelerometer final : public TiltSensor {
   Result<TiltSample> read() override;
   void close() override { open_ = false; }
   std::string name() const override { return "hid"; }
+  int pollFd() const override { return transport_->pollFd(); }
 
   const HidAccelFields& fields() const { return fields_; }
 

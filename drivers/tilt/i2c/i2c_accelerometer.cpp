@@ -50,14 +50,24 @@ Result<void> I2cAccelerometer::open() {
   return {};
 }
 
+namespace {
+
+// After setup a NACK means the chip went away, not "no sample yet" (kNotFound).
+Error lostChip(const Error& e, const std::string& chip) {
+  if (e.code != ErrorCode::kNotFound) return e;
+  return {ErrorCode::kIo, chip + ": stopped acknowledging (" + e.message + ")"};
+}
+
+}  // namespace
+
 Result<TiltSample> I2cAccelerometer::read() {
   if (!open_) return fail(ErrorCode::kIo, name() + ": not open");
   for (int poll = 0; poll < config_.max_polls; ++poll) {
     auto ready = dataReady();
-    if (!ready) return tl::unexpected(ready.error());
+    if (!ready) return tl::unexpected(lostChip(ready.error(), name()));
     if (*ready) {
       auto counts = readCounts();
-      if (!counts) return tl::unexpected(counts.error());
+      if (!counts) return tl::unexpected(lostChip(counts.error(), name()));
       TiltSample s;
       s.timestamp_ns = monotonicNs();
       for (int a = 0; a < 3; ++a)

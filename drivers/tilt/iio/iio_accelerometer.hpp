@@ -32,6 +32,7 @@ class IioAccelerometer final : public TiltSensor {
   Result<TiltSample> read() override;
   void close() override;
   std::string name() const override { return "iio"; }
+  int pollFd() const override { return fd_; }  // the buffer's character device
 
   bool buffered() const { return fd_ >= 0; }
   std::optional<double> samplingHz() const { return sampling_hz_; }

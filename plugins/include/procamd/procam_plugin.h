@@ -111,6 +111,11 @@ typedef struct procam_tilt_ops {
   int (*read)(void* self, procam_tilt_sample* out, char* err, size_t err_len);
 } procam_tilt_ops;
 
+/* A tilt read() that drops a garbage sample (not finite, out of the sensor's
+ * range, stuck, |f| far from 1 g) returns PROCAM_EAGAIN with a reason that
+ * starts with this prefix, so that the daemon can count rejected samples. */
+#define PROCAM_TILT_REJECTED_PREFIX "rejected sample: "
+
 /* Head tracker: viewer position in the world frame (metres) and orientation
  * as a unit quaternion (w, x, y, z). */
 typedef struct procam_pose_sample {

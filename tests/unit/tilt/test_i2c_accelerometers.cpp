@@ -8,47 +8,7 @@
 namespace procam::tilt {
 namespace {
 
-using testing::FakeChip;
-using testing::FakeI2cBus;
-
-FakeChip adxl345() {
-  FakeChip c;
-  c.address = 0x53;
-  c.regs[0x00] = 0xE5;
-  c.ready_reg = 0x30, c.ready_mask = 0x80, c.data_reg = 0x32;
-  return c;
-}
-FakeChip mpu6050() {
-  FakeChip c;
-  c.address = 0x68;
-  c.regs[0x75] = 0x68;
-  c.ready_reg = 0x3A, c.ready_mask = 0x01, c.data_reg = 0x3B;
-  return c;
-}
-FakeChip lis3dh() {
-  FakeChip c;
-  c.address = 0x18;
-  c.regs[0x0F] = 0x33;
-  c.increment_needs_msb = true;
-  c.ready_reg = 0x27, c.ready_mask = 0x08, c.data_reg = 0x28;
-  return c;
-}
-
-// Datasheet encodings of counts.
-std::array<std::uint8_t, 6> littleEndian(std::array<int, 3> v) {
-  std::array<std::uint8_t, 6> b{};
-  for (int a = 0; a < 3; ++a) {
-    const auto u = std::uint16_t(std::int16_t(v[std::size_t(a)]));
-    b[std::size_t(2 * a)] = std::uint8_t(u & 0xFF);
-    b[std::size_t(2 * a + 1)] = std::uint8_t(u >> 8);
-  }
-  return b;
-}
-std::array<std::uint8_t, 6> bigEndian(std::array<int, 3> v) {
-  auto b = littleEndian(v);
-  for (int a = 0; a < 3; ++a) std::swap(b[std::size_t(2 * a)], b[std::size_t(2 * a + 1)]);
-  return b;
-}
+using namespace testing;
 
 struct Rig {
   std::shared_ptr<FakeI2cBus> bus = std::make_shared<FakeI2cBus>();
