@@ -8,6 +8,8 @@
 #include <mutex>
 #include <vector>
 
+#include "egl/driver_pin.hpp"
+
 namespace procam::output::egl {
 namespace {
 
@@ -70,6 +72,7 @@ Result<void> open(EGLenum platform, void* native, EGLint surface_type, EGLint vi
     return tl::unexpected(e);
   }
   retainDisplay(display);
+  pinLoadedGlDrivers();
   if (!eglBindAPI(EGL_OPENGL_ES_API)) return tl::unexpected(eglFailure("eglBindAPI"));
   const EGLint attrs[] = {EGL_SURFACE_TYPE,
                           surface_type,
