@@ -175,6 +175,7 @@ Result<void> Daemon::reloadConfig() {
   for (const auto& name : stale) devices_.close(name);
   const size_t before = devices_.entries().size();
   openDevices();
+  device_manager_->sync();
   for (size_t i = before; i < devices_.entries().size(); ++i) {
     broadcast("device-added", devices_.entries()[i].toJson());
   }

@@ -30,6 +30,7 @@ Daemon::~Daemon() {
   server_.reset();
   compute_worker_.reset();
   io_worker_.reset();
+  device_manager_.reset();
   devices_.closeAll();
   removeControlSocket(socket_info_);
 }
@@ -115,6 +116,14 @@ Result<void> Daemon::setup() {
     }
   }
   openDevices();
+  device_manager_ = std::make_unique<DeviceManager>(
+      *loop_, registry_, devices_,
+      [this](const std::string& event, nlohmann::json body) {
+        if (server_) broadcast(event, std::move(body));
+      },
+      [this](const std::string& message) { warn(message); });
+  // The virtual rig is the whole rig: no discovery of real devices beside it.
+  device_manager_->start({.udev = options_.sim_scene.empty()});
 
   io_worker_ = std::make_unique<WorkerPool>(*loop_, 1);
   compute_worker_ = std::make_unique<WorkerPool>(*loop_, 1);

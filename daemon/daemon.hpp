@@ -12,6 +12,7 @@
 #include "config.hpp"
 #include "control_server.hpp"
 #include "control_socket.hpp"
+#include "device_manager.hpp"
 #include "device_set.hpp"
 #include "event_loop.hpp"
 #include "registry.hpp"
@@ -106,6 +107,7 @@ class Daemon {
   std::unique_ptr<WorkerPool> io_worker_;       // state writes (fsync)
   std::unique_ptr<WorkerPool> compute_worker_;  // image decoding, pipelines
   DeviceSet devices_;
+  std::unique_ptr<DeviceManager> device_manager_;  // udev, hotplug, device fds, lost devices
   std::unique_ptr<ControlServer> server_;
 };
 

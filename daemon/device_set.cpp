@@ -4,23 +4,38 @@
 
 namespace procam::daemon {
 
+const procam_device& DeviceHandle::raw() const {
+  static const procam_device kNone{};
+  return valid() ? device_->raw() : kNone;
+}
+
+const char* DeviceEntry::state() const {
+  if (usable()) return "open";
+  return lost ? "lost" : "error";
+}
+
 nlohmann::json DeviceEntry::toJson() const {
   nlohmann::json j = {{"name", name},
                       {"family", plugins::familyName(description.family)},
                       {"driver", driver.empty() ? nlohmann::json(nullptr) : nlohmann::json(driver)},
-                      {"state", usable() ? "open" : "error"}};
+                      {"state", state()}};
+  if (!description.subsystem.empty()) j["subsystem"] = description.subsystem;
   if (!description.devnode.empty()) j["devnode"] = description.devnode;
+  if (!description.syspath.empty()) j["syspath"] = description.syspath;
   if (!origin.empty()) j["origin"] = origin;
+  if (score > 0) j["score"] = score;
   if (!error.empty()) j["error"] = error;
+  if (lost) j["retries"] = retries;
   return j;
 }
 
-DeviceEntry& DeviceSet::open(const plugins::DriverRegistry& registry,
-                             plugins::DeviceDescription desc, const std::string& driver_name,
-                             const std::vector<std::pair<std::string, std::string>>& options) {
+DeviceEntry DeviceSet::prepare(const plugins::DriverRegistry& registry,
+                               plugins::DeviceDescription desc, const std::string& driver_name,
+                               const DeviceOptions& options) {
   DeviceEntry entry;
   entry.name = desc.name;
   entry.description = std::move(desc);
+  entry.options = options;
   std::optional<plugins::Driver> driver;
   if (!driver_name.empty()) {
     driver = registry.find(entry.description.family, driver_name);
@@ -30,6 +45,7 @@ DeviceEntry& DeviceSet::open(const plugins::DriverRegistry& registry,
     }
   } else if (auto match = registry.bestMatch(entry.description)) {
     driver = match->driver;
+    entry.score = match->score;
   } else {
     entry.error = std::string("no ") + plugins::familyName(entry.description.family) +
                   " driver accepts this device";
@@ -44,6 +60,16 @@ DeviceEntry& DeviceSet::open(const plugins::DriverRegistry& registry,
       entry.error = device.error().message;
     }
   }
+  return entry;
+}
+
+DeviceEntry& DeviceSet::open(const plugins::DriverRegistry& registry,
+                             plugins::DeviceDescription desc, const std::string& driver_name,
+                             const DeviceOptions& options) {
+  return add(prepare(registry, std::move(desc), driver_name, options));
+}
+
+DeviceEntry& DeviceSet::add(DeviceEntry entry) {
   entries_.push_back(std::move(entry));
   return entries_.back();
 }
@@ -58,6 +84,30 @@ bool DeviceSet::close(const std::string& name) {
 
 void DeviceSet::closeAll() {
   entries_.clear();
+}
+
+namespace {
+
+template <class Pred>
+DeviceEntry* findIf(std::vector<DeviceEntry>& entries, Pred pred) {
+  auto it = std::find_if(entries.begin(), entries.end(), pred);
+  return it == entries.end() ? nullptr : &*it;
+}
+
+}  // namespace
+
+DeviceEntry* DeviceSet::find(const std::string& name) {
+  return findIf(entries_, [&](const DeviceEntry& e) { return e.name == name; });
+}
+
+DeviceEntry* DeviceSet::findBySyspath(const std::string& syspath) {
+  if (syspath.empty()) return nullptr;
+  return findIf(entries_, [&](const DeviceEntry& e) { return e.description.syspath == syspath; });
+}
+
+DeviceEntry* DeviceSet::findByDevnode(const std::string& devnode) {
+  if (devnode.empty()) return nullptr;
+  return findIf(entries_, [&](const DeviceEntry& e) { return e.description.devnode == devnode; });
 }
 
 DeviceEntry* DeviceSet::firstUsable(procam_family family) {

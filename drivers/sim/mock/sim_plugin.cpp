@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sim/sensors.hpp"
+#include "sim_unplug.hpp"
 #include "sim_world.hpp"
 
 namespace procam::sim::mock {
@@ -34,6 +35,15 @@ struct Device {
   std::vector<uint8_t> buffer;  // camera frames
 };
 
+// PROCAM_OK while the device is plugged in (sim_unplug.hpp).
+int presence(const std::string& name, char* err, size_t len) {
+  auto gone = unpluggedNow(name);
+  if (!gone) return reason(err, len, gone.error().message, PROCAM_EINVAL);
+  return *gone ? reason(err, len, "'" + name + "' is unplugged (" + kUnplugVariable + ")",
+                        PROCAM_ENODEV)
+               : PROCAM_OK;
+}
+
 int noFd(void*) {
   return -1;
 }
@@ -48,6 +58,7 @@ int probe(const procam_device_desc* d) {
 // --- tilt ---
 int tiltRead(void* self, procam_tilt_sample* out, char* err, size_t len) {
   auto* dev = static_cast<Device*>(self);
+  if (int rc = presence(dev->name, err, len); rc != PROCAM_OK) return rc;
   const double t = dev->world->now();
   auto s = sampleTilt(dev->world->scene(), dev->name, t);
   if (!s) return reason(err, len, s.error().message, PROCAM_EIO);
@@ -65,6 +76,7 @@ const procam_tilt_ops kTiltOps = {tiltRead};
 // --- tracker ---
 int trackerRead(void* self, procam_pose_sample* out, char* err, size_t len) {
   auto* dev = static_cast<Device*>(self);
+  if (int rc = presence(dev->name, err, len); rc != PROCAM_OK) return rc;
   const double t = dev->world->now();
   auto s = sampleTracker(dev->world->scene(), dev->name, t);
   if (!s) return reason(err, len, s.error().message, PROCAM_EIO);
@@ -86,7 +98,7 @@ const ProjectorSpec* projectorSpec(const Device* dev) {
 
 int outputMode(void* self, uint32_t* w, uint32_t* h, double* hz) {
   const ProjectorSpec* p = projectorSpec(static_cast<Device*>(self));
-  if (!p) return PROCAM_ENODEV;
+  if (!p || presence(p->name, nullptr, 0) != PROCAM_OK) return PROCAM_ENODEV;
   *w = static_cast<uint32_t>(p->width);
   *h = static_cast<uint32_t>(p->height);
   *hz = 60.0;
@@ -97,6 +109,7 @@ int outputShow(void* self, const procam_image* frame, char* err, size_t len) {
   auto* dev = static_cast<Device*>(self);
   const ProjectorSpec* p = projectorSpec(dev);
   if (!p) return reason(err, len, "projector gone", PROCAM_ENODEV);
+  if (int rc = presence(dev->name, err, len); rc != PROCAM_OK) return rc;
   if (static_cast<int>(frame->width) != p->width || static_cast<int>(frame->height) != p->height) {
     return reason(err, len,
                   "frame is not " + std::to_string(p->width) + "x" + std::to_string(p->height),
@@ -132,7 +145,7 @@ const CameraSpec* cameraSpec(const Device* dev) {
 
 int cameraFormat(void* self, uint32_t* w, uint32_t* h, procam_pixel_format* f) {
   const CameraSpec* c = cameraSpec(static_cast<Device*>(self));
-  if (!c) return PROCAM_ENODEV;
+  if (!c || presence(c->name, nullptr, 0) != PROCAM_OK) return PROCAM_ENODEV;
   *w = static_cast<uint32_t>(c->width);
   *h = static_cast<uint32_t>(c->height);
   *f = c->channels == 3   ? PROCAM_PIXEL_RGB8
@@ -147,6 +160,7 @@ int cameraExposure(void*, double, char* err, size_t len) {
 
 int cameraCapture(void* self, int, procam_image* out, char* err, size_t len) {
   auto* dev = static_cast<Device*>(self);
+  if (int rc = presence(dev->name, err, len); rc != PROCAM_OK) return rc;
   try {
     const double t = dev->world->now();
     const Scene& scene = dev->world->scene();
@@ -182,6 +196,7 @@ int create(const procam_device_desc* d, const procam_config*, procam_device* out
     if (scene.empty() || name.empty()) {
       return reason(err, len, "a sim device needs SIM_SCENE and SIM_DEVICE", PROCAM_EINVAL);
     }
+    if (int rc = presence(name, err, len); rc != PROCAM_OK) return rc;
     auto world = SimWorld::open(scene);
     if (!world) return reason(err, len, world.error().message, PROCAM_EINVAL);
     auto dev = std::make_unique<Device>(Device{*world, name, {}});

@@ -1,0 +1,415 @@
+#include "device_manager.hpp"
+
+#include <sys/epoll.h>
+
+#include <array>
+
+#include "log.hpp"
+#include "udev_monitor.hpp"
+
+namespace procam::daemon {
+
+using nlohmann::json;
+
+namespace {
+
+std::string describeFamily(const DeviceEntry& e) {
+  return std::string(plugins::familyName(e.description.family)) + " '" + e.name + "'";
+}
+
+}  // namespace
+
+DeviceManager::DeviceManager(EventLoop& loop, const plugins::DriverRegistry& registry,
+                             DeviceSet& devices, EventSink emit, WarnSink warn)
+    : loop_(loop),
+      registry_(registry),
+      devices_(devices),
+      emit_(std::move(emit)),
+      warn_(std::move(warn)),
+      opener_(std::make_unique<WorkerPool>(loop, 1)) {}
+
+DeviceManager::~DeviceManager() {
+  opener_.reset();
+  *alive_ = false;
+  for (const auto& [name, fd] : watched_) loop_.remove(fd);
+  for (const auto& [id, name] : polls_) loop_.removeTimer(id);
+  for (const auto& [name, r] : retries_) {
+    if (r.timer >= 0) loop_.removeTimer(r.timer);
+  }
+  if (presence_timer_ >= 0) loop_.removeTimer(presence_timer_);
+  if (monitor_) loop_.remove(monitor_->fd());
+}
+
+std::chrono::seconds DeviceManager::retryDelay(int attempt) {
+  static constexpr std::array<int, 4> kFirst{1, 2, 4, 8};
+  if (attempt >= 0 && attempt < static_cast<int>(kFirst.size())) {
+    return std::chrono::seconds(kFirst[static_cast<size_t>(attempt)]);
+  }
+  return std::chrono::seconds(10);
+}
+
+std::function<void()> DeviceManager::guarded(std::function<void()> fn) const {
+  return [alive = std::weak_ptr<bool>(alive_), fn = std::move(fn)] {
+    if (auto a = alive.lock(); a && *a) fn();
+  };
+}
+
+void DeviceManager::onDeviceAdded(DeviceCallback callback) {
+  on_added_.push_back(std::move(callback));
+}
+void DeviceManager::onDeviceRemoved(DeviceCallback callback) {
+  on_removed_.push_back(std::move(callback));
+}
+void DeviceManager::onReading(ReadingCallback callback) {
+  on_reading_.push_back(std::move(callback));
+}
+
+// --- start-up and hotplug ---
+
+void DeviceManager::start(const DeviceManagerOptions& options) {
+  for (const auto& e : devices_.entries()) watchFd(e);
+  if (options.udev) {
+    auto udev = Udev::create();
+    if (!udev) {
+      warn_("device discovery off: " + udev.error().message);
+    } else {
+      udev_ = std::make_unique<Udev>(std::move(*udev));
+      enumerate();
+      auto monitor = UdevMonitor::create(*udev_);
+      if (!monitor) {
+        warn_("hotplug off: " + monitor.error().message);
+      } else {
+        monitor_ = std::make_unique<UdevMonitor>(std::move(*monitor));
+        auto ok = loop_.add(monitor_->fd(), EPOLLIN, [this](uint32_t) {
+          while (auto record = monitor_->receive()) handleUdevEvent(*record);
+        });
+        if (!ok) {
+          warn_("hotplug off: " + ok.error().message);
+          monitor_.reset();
+        }
+      }
+    }
+  }
+  auto timer = loop_.addTimer(options.presence_interval, true, [this] { presenceCheck(); });
+  if (timer) {
+    presence_timer_ = *timer;
+  } else {
+    warn_("presence checks off: " + timer.error().message);
+  }
+}
+
+void DeviceManager::enumerate() {
+  auto records = udev_->enumerate();
+  if (!records) {
+    warn_("device discovery failed: " + records.error().message);
+    return;
+  }
+  size_t found = 0;
+  for (const UdevRecord& r : *records) {
+    if (auto desc = describeUdevDevice(r)) {
+      ++found;
+      openDiscovered(std::move(*desc), false);
+    }
+  }
+  logInfo("udev: " + std::to_string(found) + " device(s) with a procamd role");
+}
+
+void DeviceManager::handleUdevEvent(const UdevRecord& record) {
+  if (record.action == "remove") {
+    pending_.erase(record.syspath);  // an open still running is dropped when it ends
+    if (DeviceEntry* e = devices_.findBySyspath(record.syspath)) removeUnplugged(e->name);
+    return;
+  }
+  if (record.action != "add") return;
+  auto desc = describeUdevDevice(record);
+  if (!desc) return;
+  if (DeviceEntry* e = devices_.findBySyspath(desc->syspath)) {
+    // A lost device that udev announces again: try it now.
+    if (e->lost) {
+      e->retries = 0;
+      retry(e->name, retries_[e->name].token);
+    }
+    return;
+  }
+  openDiscovered(std::move(*desc), true);
+}
+
+void DeviceManager::openDiscovered(plugins::DeviceDescription desc, bool async) {
+  // A configured device with this node keeps it (config wins over discovery).
+  if (DeviceEntry* e = devices_.findByDevnode(desc.devnode);
+      e && e->description.subsystem == "config") {
+    logDebug("udev: " + desc.devnode + " is the configured device '" + e->name + "'");
+    return;
+  }
+  if (devices_.findBySyspath(desc.syspath) || pending_.count(desc.syspath)) return;
+  if (!async) {
+    addDiscovered(DeviceSet::prepare(registry_, std::move(desc), "", {}));
+    return;
+  }
+  const std::string syspath = desc.syspath;
+  pending_.insert(syspath);
+  opener_->submit([this, desc = std::move(desc), syspath]() mutable -> WorkerPool::Completion {
+    auto entry =
+        std::make_shared<DeviceEntry>(DeviceSet::prepare(registry_, std::move(desc), "", {}));
+    return guarded([this, entry, syspath] {
+      if (pending_.erase(syspath) == 0) return;  // unplugged while opening
+      addDiscovered(std::move(*entry));
+    });
+  });
+}
+
+void DeviceManager::addDiscovered(DeviceEntry entry) {
+  // Names are unique in the set: a configured device may already use the sysname.
+  if (devices_.find(entry.name)) entry.name += "@" + entry.description.subsystem;
+  const std::string name = entry.name;
+  DeviceEntry& e = devices_.add(std::move(entry));
+  if (e.usable()) {
+    logInfo("opened " + describeFamily(e) + " (" + e.description.devnode + ") with driver " +
+            e.driver);
+    watchFd(e);
+  } else {
+    // Listed with the reason; not a warning: a rig has devices procamd does not drive.
+    logInfo("not opened: " + describeFamily(e) + " (" + e.description.devnode + "): " + e.error);
+  }
+  emit_("device-added", e.toJson());
+  if (devices_.find(name)->usable()) added(name);
+}
+
+void DeviceManager::removeUnplugged(const std::string& name) {
+  cancelRetry(name);
+  unwatchFd(name);
+  DeviceEntry* e = devices_.find(name);
+  if (!e) return;
+  json body = e->toJson();
+  body["state"] = "removed";
+  e->device.reset();  // the set's reference; a worker's share ends with its job
+  e->error = "unplugged";
+  logInfo("unplugged: " + describeFamily(*e));
+  removed(name);
+  devices_.close(name);
+  emit_("device-removed", std::move(body));
+}
+
+// --- lost devices ---
+
+void DeviceManager::report(const std::string& name, int rc, const std::string& reason) {
+  if (rc == PROCAM_OK || rc == PROCAM_EAGAIN) return;
+  DeviceEntry* e = devices_.find(name);
+  if (!e || !e->usable()) return;
+  if (rc == PROCAM_ENODEV) {
+    markLost(name, reason.empty() ? "the device is gone" : reason);
+  } else {
+    logDebug(describeFamily(*e) + ": error " + std::to_string(rc) + ": " + reason);
+  }
+}
+
+void DeviceManager::markLost(const std::string& name, const std::string& reason) {
+  unwatchFd(name);
+  DeviceEntry* e = devices_.find(name);
+  if (!e) return;
+  e->device.reset();
+  e->lost = true;
+  e->retries = 0;
+  e->error = "lost: " + reason;
+  warn_(describeFamily(*e) + " lost (" + reason + "); reopening in " +
+        std::to_string(retryDelay(0).count()) + " s");
+  emit_("device-removed", e->toJson());
+  removed(name);
+  scheduleRetry(name);
+}
+
+void DeviceManager::scheduleRetry(const std::string& name) {
+  DeviceEntry* e = devices_.find(name);
+  if (!e) return;
+  Retry& r = retries_[name];
+  r.token = next_token_++;
+  const uint64_t token = r.token;
+  auto timer = loop_.addTimer(retryDelay(e->retries), false, [this, name, token] {
+    if (auto it = retries_.find(name); it != retries_.end() && it->second.token == token) {
+      it->second.timer = -1;  // fired: the loop dropped it
+    }
+    retry(name, token);
+  });
+  if (timer) {
+    r.timer = *timer;
+  } else {
+    warn_("device '" + name + "' will not be reopened: " + timer.error().message);
+  }
+}
+
+void DeviceManager::retry(const std::string& name, uint64_t token) {
+  DeviceEntry* e = devices_.find(name);
+  auto it = retries_.find(name);
+  if (!e || !e->lost || it == retries_.end() || it->second.token != token) return;
+  if (it->second.timer >= 0) loop_.removeTimer(it->second.timer);
+  it->second.timer = -1;
+  it->second.token = next_token_++;  // an earlier attempt still running is ignored
+  const uint64_t attempt = it->second.token;
+  opener_->submit([this, name, attempt, desc = e->description, driver = e->driver,
+                   options = e->options]() mutable -> WorkerPool::Completion {
+    // The driver that served it before, by name: a reopen must not switch drivers.
+    auto fresh = std::make_shared<DeviceEntry>(
+        DeviceSet::prepare(registry_, std::move(desc), driver, options));
+    return guarded([this, name, attempt, fresh] { finishRetry(name, attempt, std::move(*fresh)); });
+  });
+}
+
+void DeviceManager::finishRetry(const std::string& name, uint64_t token, DeviceEntry fresh) {
+  DeviceEntry* e = devices_.find(name);
+  auto it = retries_.find(name);
+  if (!e || !e->lost || it == retries_.end() || it->second.token != token) return;
+  if (!fresh.usable()) {
+    ++e->retries;
+    e->error = "lost: " + fresh.error;
+    logDebug("device '" + name + "' still gone (attempt " + std::to_string(e->retries) +
+             "): " + fresh.error);
+    scheduleRetry(name);
+    return;
+  }
+  retries_.erase(it);
+  e->device = std::move(fresh.device);
+  e->lost = false;
+  e->retries = 0;
+  e->error.clear();
+  logInfo(describeFamily(*e) + " is back");
+  watchFd(*e);
+  emit_("device-added", e->toJson());
+  added(name);
+}
+
+void DeviceManager::cancelRetry(const std::string& name) {
+  auto it = retries_.find(name);
+  if (it == retries_.end()) return;
+  if (it->second.timer >= 0) loop_.removeTimer(it->second.timer);
+  retries_.erase(it);
+}
+
+// --- device fds and reads ---
+
+void DeviceManager::watchFd(const DeviceEntry& e) {
+  // Outputs have no read operation in the ABI: their fds stay with the driver.
+  if (!e.usable() || e.description.family == PROCAM_FAMILY_OUTPUT) return;
+  const int fd = e.device.pollFd();
+  if (fd < 0 || watched_.count(e.name)) return;
+  const std::string name = e.name;
+  if (auto ok = loop_.add(fd, EPOLLIN, [this, name](uint32_t) { readEntry(name); }); !ok) {
+    warn_("device '" + name + "': cannot watch its fd: " + ok.error().message);
+    return;
+  }
+  watched_[name] = fd;
+}
+
+void DeviceManager::unwatchFd(const std::string& name) {
+  auto it = watched_.find(name);
+  if (it == watched_.end()) return;
+  loop_.remove(it->second);  // before the device closes the fd
+  watched_.erase(it);
+}
+
+void DeviceManager::sync() {
+  for (auto it = watched_.begin(); it != watched_.end();) {
+    const DeviceEntry* e = devices_.find(it->first);
+    if (e && e->usable() && e->device.pollFd() == it->second) {
+      ++it;
+    } else {
+      loop_.remove(it->second);
+      it = watched_.erase(it);
+    }
+  }
+  for (auto it = retries_.begin(); it != retries_.end();) {
+    const DeviceEntry* e = devices_.find(it->first);
+    if (e && e->lost) {
+      ++it;
+      continue;
+    }
+    if (it->second.timer >= 0) loop_.removeTimer(it->second.timer);
+    it = retries_.erase(it);
+  }
+  for (const auto& e : devices_.entries()) watchFd(e);
+}
+
+bool DeviceManager::read(const std::string& name) {
+  return readEntry(name);
+}
+
+bool DeviceManager::readEntry(const std::string& name) {
+  DeviceEntry* e = devices_.find(name);
+  if (!e || !e->usable()) {
+    unwatchFd(name);
+    return false;
+  }
+  const procam_device& raw = e->device.raw();
+  std::array<char, 256> err{};
+  int rc = PROCAM_ENOTSUP;
+  Reading reading;
+  switch (e->description.family) {
+    case PROCAM_FAMILY_TILT: {
+      procam_tilt_sample s{};
+      rc = raw.ops.tilt->read(raw.self, &s, err.data(), err.size() - 1);
+      reading = s;
+      break;
+    }
+    case PROCAM_FAMILY_TRACKER: {
+      procam_pose_sample s{};
+      rc = raw.ops.tracker->read(raw.self, &s, err.data(), err.size() - 1);
+      reading = s;
+      break;
+    }
+    case PROCAM_FAMILY_CAMERA: {
+      procam_image img{};
+      rc = raw.ops.camera->capture(raw.self, 0, &img, err.data(), err.size() - 1);
+      reading = img;
+      break;
+    }
+    case PROCAM_FAMILY_OUTPUT:
+      return false;
+  }
+  if (rc != PROCAM_OK) {
+    report(name, rc, err[0] ? err.data() : "read failed (code " + std::to_string(rc) + ")");
+    return false;
+  }
+  // Hooks may change the set: hand them a copy of the list and look nothing up after.
+  const auto hooks = on_reading_;
+  for (const auto& h : hooks) h(*e, reading);
+  return true;
+}
+
+Result<int> DeviceManager::pollEvery(const std::string& name, std::chrono::nanoseconds interval) {
+  if (!devices_.find(name)) return fail(ErrorCode::kNotFound, "no device '" + name + "'");
+  auto id = loop_.addTimer(interval, true, [this, name] { readEntry(name); });
+  if (id) polls_[*id] = name;
+  return id;
+}
+
+void DeviceManager::stopPolling(int id) {
+  if (polls_.erase(id) > 0) loop_.removeTimer(id);
+}
+
+void DeviceManager::presenceCheck() {
+  std::vector<std::string> names;
+  for (const auto& e : devices_.entries()) {
+    const auto family = e.description.family;
+    if (!e.usable() || (family != PROCAM_FAMILY_TILT && family != PROCAM_FAMILY_TRACKER)) continue;
+    if (watched_.count(e.name)) continue;
+    bool polled = false;
+    for (const auto& [id, n] : polls_) polled = polled || n == e.name;
+    if (!polled) names.push_back(e.name);
+  }
+  for (const auto& n : names) readEntry(n);
+}
+
+void DeviceManager::added(const std::string& name) {
+  const auto hooks = on_added_;
+  for (const auto& h : hooks) {
+    if (const DeviceEntry* e = devices_.find(name)) h(*e);
+  }
+}
+
+void DeviceManager::removed(const std::string& name) {
+  const auto hooks = on_removed_;
+  for (const auto& h : hooks) {
+    if (const DeviceEntry* e = devices_.find(name)) h(*e);
+  }
+}
+
+}  // namespace procam::daemon

@@ -1,0 +1,136 @@
+#pragma once
+// The device manager: finds procamd's devices with libudev at start, follows
+// hotplug through a udev monitor watched by the event loop, watches device
+// fds, and closes devices that fail with PROCAM_ENODEV ("lost") and reopens
+// them with back-off. Every method runs on the loop thread; only driver
+// create() calls for hotplugged and lost devices run on the manager's own
+// worker, so a slow open never blocks the loop.
+#include <chrono>
+#include <functional>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "device_set.hpp"
+#include "event_loop.hpp"
+#include "registry.hpp"
+#include "udev_device.hpp"
+#include "worker_pool.hpp"
+
+namespace procam::daemon {
+
+class Udev;
+class UdevMonitor;
+
+// What a device produced when read. A camera's image points into the
+// driver's buffer, valid only during the callback.
+using Reading = std::variant<procam_tilt_sample, procam_pose_sample, procam_image>;
+
+struct DeviceManagerOptions {
+  // Enumerate with libudev and follow hotplug (off on the virtual rig, whose
+  // devices are the whole rig).
+  bool udev = true;
+  // Tilt sensors and trackers without a poll fd that nobody polls are read
+  // this often, so that a device gone without a udev event is noticed.
+  std::chrono::milliseconds presence_interval{1000};
+};
+
+class DeviceManager {
+ public:
+  using DeviceCallback = std::function<void(const DeviceEntry&)>;
+  using ReadingCallback = std::function<void(const DeviceEntry&, const Reading&)>;
+  using EventSink = std::function<void(const std::string& event, nlohmann::json body)>;
+  using WarnSink = std::function<void(const std::string& message)>;
+
+  // `emit` receives the watch events (device-added, device-removed) and
+  // `warn` the warnings; both run on the loop thread.
+  DeviceManager(EventLoop& loop, const plugins::DriverRegistry& registry, DeviceSet& devices,
+                EventSink emit, WarnSink warn);
+  DeviceManager(const DeviceManager&) = delete;
+  DeviceManager& operator=(const DeviceManager&) = delete;
+  ~DeviceManager();
+
+  // Enumerates (synchronously, before the loop runs), starts the monitor and
+  // watches the fds of every usable device already in the set. Problems with
+  // udev are warnings: the daemon keeps its configured devices.
+  void start(const DeviceManagerOptions& options);
+  // Re-syncs the watched fds after entries were closed or opened behind the
+  // manager (configuration reload).
+  void sync();
+
+  // Hooks. Added: a device became usable (discovered, hotplugged, back after
+  // being lost). Removed: unplugged (udev) or lost; an operation that uses
+  // the device cancels itself here. The entry is still in the set during the
+  // callback; a removed one is no longer usable.
+  void onDeviceAdded(DeviceCallback callback);
+  void onDeviceRemoved(DeviceCallback callback);
+  // Every sample or frame the manager reads: on a readable device fd, from
+  // pollEvery() and from the presence reads.
+  void onReading(ReadingCallback callback);
+
+  // Reads a tilt sensor, tracker or camera (capture with timeout 0) once and
+  // hands the reading to the onReading hooks; false when nothing was read.
+  bool read(const std::string& name);
+  // Reads a device by timer (for devices whose poll fd is -1); returns an id
+  // for stopPolling().
+  Result<int> pollEvery(const std::string& name, std::chrono::nanoseconds interval);
+  void stopPolling(int id);
+  // For users that call a device's operations themselves: PROCAM_ENODEV
+  // marks the device lost (closed, device-removed, reopened with back-off).
+  void report(const std::string& name, int rc, const std::string& reason);
+
+  // One udev event ("add"/"remove"; others are ignored). The monitor feeds
+  // it; tests call it directly.
+  void handleUdevEvent(const UdevRecord& record);
+  bool monitoring() const { return monitor_ != nullptr; }
+  // The wait before reopen attempt `attempt` (0-based): 1, 2, 4, 8, then 10 s.
+  static std::chrono::seconds retryDelay(int attempt);
+
+ private:
+  void enumerate();
+  void openDiscovered(plugins::DeviceDescription desc, bool async);
+  void addDiscovered(DeviceEntry entry);
+  void removeUnplugged(const std::string& name);
+  void markLost(const std::string& name, const std::string& reason);
+  void scheduleRetry(const std::string& name);
+  void retry(const std::string& name, uint64_t token);
+  void finishRetry(const std::string& name, uint64_t token, DeviceEntry fresh);
+  void cancelRetry(const std::string& name);
+  void watchFd(const DeviceEntry& entry);
+  void unwatchFd(const std::string& name);
+  bool readEntry(const std::string& name);
+  void presenceCheck();
+  void added(const std::string& name);
+  void removed(const std::string& name);
+  // Posts `fn` to the loop unless the manager was destroyed meanwhile.
+  std::function<void()> guarded(std::function<void()> fn) const;
+
+  EventLoop& loop_;
+  const plugins::DriverRegistry& registry_;
+  DeviceSet& devices_;
+  EventSink emit_;
+  WarnSink warn_;
+  std::vector<DeviceCallback> on_added_, on_removed_;
+  std::vector<ReadingCallback> on_reading_;
+
+  std::unique_ptr<Udev> udev_;
+  std::unique_ptr<UdevMonitor> monitor_;
+  std::map<std::string, int> watched_;  // device name -> its poll fd in the loop
+  std::map<int, std::string> polls_;    // pollEvery timer id -> device name
+  std::set<std::string> pending_;       // syspaths being opened on the worker
+  struct Retry {
+    uint64_t token = 0;
+    int timer = -1;  // -1 while the attempt runs on the worker
+  };
+  std::map<std::string, Retry> retries_;
+  uint64_t next_token_ = 1;
+  int presence_timer_ = -1;
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+  std::unique_ptr<WorkerPool> opener_;  // last: joined first on destruction
+};
+
+}  // namespace procam::daemon
