@@ -1,7 +1,6 @@
 // The control protocol's commands (PROTOCOL.md), run on the loop thread.
 
 #include "daemon.hpp"
-#include "geometry/homography.hpp"
 #include "log.hpp"
 #include "request_args.hpp"
 
@@ -16,14 +15,6 @@ namespace {
 // behind them is part of the build.
 constexpr const char* kNoCalibration =
     "calibration needs the structured-light pipeline, which this procamd does not include";
-constexpr const char* kNoAutoKeystone =
-    "automatic keystone needs the keystone pipeline, which this procamd does not include";
-
-json quadJson(const Quad& q) {
-  json a = json::array();
-  for (const auto& p : q) a.push_back({p[0], p[1]});
-  return a;
-}
 
 }  // namespace
 
@@ -115,7 +106,8 @@ json Daemon::statusJson() const {
           {"recalibrate", recalibratePolicyName(config_.recalibrate)},
           {"operations", ops},
           {"log_level", logLevelName(logLevel())},
-          {"capabilities", {{"calibrate", false}, {"auto_keystone", false}, {"render", false}}},
+          {"outputs", outputsJson()},
+          {"capabilities", {{"calibrate", false}, {"auto_keystone", true}, {"render", true}}},
           {"warnings", warnings_}};
 }
 
@@ -177,86 +169,6 @@ void Daemon::cmdCancel(ClientId client, const proto::Request& req) {
         which ? "no running operation '" + *which + "'" : "this client has no running operation");
   }
   replyTo(client, req, "CANCEL", {{"cancelled", cancelled}});
-}
-
-json Daemon::keystoneJson() const {
-  json j = {{"auto", settings_.auto_keystone},
-            {"corners", settings_.keystone ? quadJson(*settings_.keystone) : json(nullptr)},
-            {"homography", nullptr},
-            {"output_size", nullptr}};
-  auto* self = const_cast<Daemon*>(this);  // device queries do not change the set
-  if (DeviceEntry* out = self->devices_.firstUsable(PROCAM_FAMILY_OUTPUT)) {
-    uint32_t w = 0, h = 0;
-    double hz = 0;
-    const auto& raw = out->device.raw();
-    if (raw.ops.output->get_mode(raw.self, &w, &h, &hz) == PROCAM_OK && w > 1 && h > 1) {
-      j["output_size"] = {w, h};
-      if (settings_.keystone) {
-        // The pre-warp of seed §3.2.5: full-frame pixel centres to the corners.
-        const std::array<Vec2, 4> frame{Vec2(0, 0), Vec2(w - 1.0, 0), Vec2(w - 1.0, h - 1.0),
-                                        Vec2(0, h - 1.0)};
-        std::array<Vec2, 4> corners;
-        for (int i = 0; i < 4; ++i)
-          corners[i] = Vec2((*settings_.keystone)[i][0], (*settings_.keystone)[i][1]);
-        if (auto H = geom::homographyFrom4(frame, corners)) {
-          const Mat3 Hn = *H / (*H)(2, 2);
-          j["homography"] = json::array();
-          for (int r = 0; r < 3; ++r) j["homography"].push_back({Hn(r, 0), Hn(r, 1), Hn(r, 2)});
-        }
-      }
-    }
-  }
-  return j;
-}
-
-void Daemon::cmdKeystone(ClientId client, const proto::Request& req) {
-  RequestArgs args(req.body);
-  PROCAM_CHECK_KEYS(args, "action", "corners", "enable");
-  const std::string action = args.string("action").value_or("get");
-  if (!args.ok()) return errorTo(client, req, code::kBadArgument, args.error());
-  if (action == "get") {
-    if (args.get("corners") || args.get("enable")) {
-      return errorTo(client, req, code::kBadArgument, "keystone get takes no arguments");
-    }
-  } else if (action == "set") {
-    const json* corners = args.get("corners");
-    if (!corners) {
-      return errorTo(client, req, code::kBadArgument,
-                     "keystone set needs \"corners\": 4 [x, y] pairs, or null to clear");
-    }
-    if (corners->is_null()) {
-      settings_.keystone.reset();
-    } else {
-      if (!corners->is_array() || corners->size() != 4) {
-        return errorTo(client, req, code::kBadArgument, "\"corners\" must be 4 [x, y] pairs");
-      }
-      Quad q{};
-      for (size_t i = 0; i < 4; ++i) {
-        const json& p = (*corners)[i];
-        if (!p.is_array() || p.size() != 2 || !p[0].is_number() || !p[1].is_number()) {
-          return errorTo(client, req, code::kBadArgument, "\"corners\" must be 4 [x, y] pairs");
-        }
-        q[i] = {p[0].get<double>(), p[1].get<double>()};
-      }
-      if (auto ok = validateQuad(q); !ok) {
-        return errorTo(client, req, code::kBadArgument, ok.error().message);
-      }
-      settings_.keystone = q;
-    }
-    broadcast("keystone", keystoneJson());
-  } else if (action == "auto") {
-    auto enable = args.boolean("enable");
-    if (!args.ok() || !enable) {
-      return errorTo(client, req, code::kBadArgument, "keystone auto needs \"enable\": true|false");
-    }
-    if (*enable) return errorTo(client, req, code::kUnavailable, kNoAutoKeystone);
-    settings_.auto_keystone = false;
-    broadcast("keystone", keystoneJson());
-  } else {
-    return errorTo(client, req, code::kBadArgument,
-                   "unknown keystone action '" + action + "' (get, set, auto)");
-  }
-  replyTo(client, req, "KEYSTONE", keystoneJson());
 }
 
 }  // namespace procam::daemon

@@ -1,53 +1,35 @@
 // Commands that change or persist settings: pattern, content, save, reload,
 // log-level (PROTOCOL.md).
-#include <opencv2/imgcodecs.hpp>
-
 #include "daemon.hpp"
 #include "log.hpp"
 #include "request_args.hpp"
-#include "test_pattern.hpp"
 
 namespace procam::daemon {
 
 using nlohmann::json;
 namespace code = proto::code;
 
-bool Daemon::showPattern() {
-  bool shown = false;
-  for (auto& e : devices_.entries()) {
-    if (e.description.family != PROCAM_FAMILY_OUTPUT || !e.usable()) continue;
-    const auto& raw = e.device.raw();
-    uint32_t w = 0, h = 0;
-    double hz = 0;
-    if (raw.ops.output->get_mode(raw.self, &w, &h, &hz) != PROCAM_OK || w == 0 || h == 0) continue;
-    RgbImage img = renderTestPattern(settings_.pattern, static_cast<int>(w), static_cast<int>(h));
-    procam_image frame{w, h, w * 3, PROCAM_PIXEL_RGB8, img.pixels.data(), 0};
-    char err[256] = {};
-    if (raw.ops.output->show(raw.self, &frame, err, sizeof err - 1) == PROCAM_OK) {
-      shown = true;
-    } else {
-      warn("output '" + e.name + "' could not show the pattern: " + err);
-    }
-  }
-  return shown;
-}
-
 void Daemon::cmdPattern(ClientId client, const proto::Request& req) {
   RequestArgs args(req.body);
   PROCAM_CHECK_KEYS(args, "name");
   auto name = args.string("name");
   if (!args.ok()) return errorTo(client, req, code::kBadArgument, args.error());
-  bool shown = false;
-  if (name) {
-    if (!isPatternName(*name)) {
-      return errorTo(client, req, code::kBadArgument,
-                     "unknown pattern '" + *name + "' (" + patternNames() + ")");
-    }
-    settings_.pattern = *name;
-    shown = showPattern();
-    broadcast("pattern", {{"pattern", settings_.pattern}, {"shown", shown}});
+  if (!name) {
+    replyTo(client, req, "PATTERN", {{"pattern", settings_.pattern}, {"shown", false}});
+    return;
   }
-  replyTo(client, req, "PATTERN", {{"pattern", settings_.pattern}, {"shown", shown}});
+  if (!isPatternName(*name)) {
+    return errorTo(client, req, code::kBadArgument,
+                   "unknown pattern '" + *name + "' (" + patternNames() + ")");
+  }
+  settings_.pattern = *name;
+  // Rendered on a worker (with the keystone warp); answered once it is shown.
+  server_->hold(client);
+  refreshOutputs([this, client, req, pattern = *name](bool shown) {
+    broadcast("pattern", {{"pattern", pattern}, {"shown", shown}});
+    replyTo(client, req, "PATTERN", {{"pattern", pattern}, {"shown", shown}});
+    server_->release(client);
+  });
 }
 
 json Daemon::contentJson() const {
@@ -69,7 +51,9 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
     if (action == "clear") {
       settings_.content.clear();
       content_info_ = {};
+      keystone_rt_.content.reset();
       broadcast("content", {{"content", nullptr}});
+      refreshOutputs();
     }
     replyTo(client, req, "CONTENT", {{"content", contentJson()}});
     return;
@@ -90,16 +74,10 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
       client, "progress",
       {{"operation", op_id}, {"kind", "content-load"}, {"fraction", 0.0}, {"stage", "decoding"}});
   compute_worker_->submit([this, client, req, op_id, cancelled, file = *path] {
-    cv::Mat image;
-    std::string failure;
-    try {
-      image = cv::imread(file, cv::IMREAD_UNCHANGED);
-    } catch (const cv::Exception& e) {
-      failure = e.what();
-    }
-    const int w = image.cols, h = image.rows;
-    if (failure.empty() && image.empty()) failure = "cannot read an image from " + file;
-    return [this, client, req, op_id, cancelled, file, w, h, failure] {
+    auto decoded = decodeContent(file);
+    std::shared_ptr<const cv::Mat> image = decoded ? *decoded : nullptr;
+    const std::string failure = decoded ? std::string() : decoded.error().message;
+    return [this, client, req, op_id, cancelled, file, image, failure] {
       operations_.erase(op_id);
       json finished = {{"operation", op_id}, {"kind", "content-load"}, {"ok", true}};
       if (cancelled->load()) {
@@ -122,8 +100,10 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
         errorTo(client, req, code::kIo, failure);
       } else {
         settings_.content = file;
-        content_info_ = {w, h};
+        content_info_ = {image->cols, image->rows};
+        keystone_rt_.content = image;
         broadcast("content", {{"content", contentJson()}});
+        refreshOutputs();
         replyTo(client, req, "CONTENT", {{"content", contentJson()}, {"operation", op_id}});
       }
       server_->release(client);  // after the reply: a half-closed client may close now
@@ -158,9 +138,6 @@ Result<void> Daemon::reloadConfig() {
   }
   auto cfg = loadConfig(options_.config_path);
   if (!cfg) return tl::unexpected(cfg.error());
-  if (cfg->auto_keystone) {
-    warn("policy.auto_keystone is set, but this build has no keystone pipeline; ignored");
-  }
   config_ = std::move(*cfg);
   setLogLevel(config_.log_level);
   server_->setOptions(serverOptions());

@@ -143,6 +143,43 @@ void parseSim(Checker& c, const toml::table& t, Config& cfg) {
   if (auto* n = t.get("scene")) c.string(*n, "sim.scene", cfg.sim_scene);
 }
 
+// A TOML array of exactly N numbers inside [lo, hi].
+template <size_t N>
+bool numbers(Checker& c, const toml::node& node, const std::string& key, double lo, double hi,
+             std::array<double, N>& out) {
+  const toml::array* a = node.as_array();
+  if (!a || a->size() != N) {
+    c.error(node.source(), key, "expected an array of " + std::to_string(N) + " numbers");
+    return false;
+  }
+  std::array<double, N> v{};
+  for (size_t i = 0; i < N; ++i) {
+    if (!c.number(*a->get(i), key + "[" + std::to_string(i) + "]", lo, hi, v[i])) return false;
+  }
+  out = v;
+  return true;
+}
+
+void parseKeystone(Checker& c, const toml::table& t, Config& cfg) {
+  c.onlyKnown(t, "keystone.",
+              {"cutoff_hz", "hysteresis_deg", "poll_hz", "mount", "accel_offset_g", "accel_scale"});
+  KeystoneConfig& k = cfg.keystone;
+  if (auto* n = t.get("cutoff_hz")) c.number(*n, "keystone.cutoff_hz", 0.01, 1000.0, k.cutoff_hz);
+  if (auto* n = t.get("hysteresis_deg")) {
+    c.number(*n, "keystone.hysteresis_deg", 0.0, 10.0, k.hysteresis_deg);
+  }
+  if (auto* n = t.get("poll_hz")) c.number(*n, "keystone.poll_hz", 1.0, 1000.0, k.poll_hz);
+  if (auto* n = t.get("mount")) {
+    std::array<double, 9> m{};
+    if (numbers(c, *n, "keystone.mount", -1.0, 1.0, m)) k.mount = m;
+  }
+  if (auto* n = t.get("accel_offset_g")) {
+    numbers(c, *n, "keystone.accel_offset_g", -1.0, 1.0, k.accel_offset_g);
+  }
+  if (auto* n = t.get("accel_scale"))
+    numbers(c, *n, "keystone.accel_scale", 0.5, 2.0, k.accel_scale);
+}
+
 void parseDevices(Checker& c, const toml::node& node, const std::string& section,
                   procam_family family, Config& cfg, std::set<std::string>& names) {
   const toml::array* list = node.as_array();
@@ -219,7 +256,8 @@ Result<Config> parseConfig(std::string_view text, const std::string& source) {
   Config cfg;
   cfg.source = source;
   Checker c(source);
-  c.onlyKnown(root, "", {"daemon", "policy", "sim", "projector", "camera", "tilt", "tracker"});
+  c.onlyKnown(root, "",
+              {"daemon", "policy", "keystone", "sim", "projector", "camera", "tilt", "tracker"});
   auto section = [&](const char* name, void (*parse)(Checker&, const toml::table&, Config&)) {
     if (auto* n = root.get(name)) {
       if (const toml::table* t = n->as_table()) {
@@ -232,6 +270,7 @@ Result<Config> parseConfig(std::string_view text, const std::string& source) {
   section("daemon", parseDaemon);
   section("policy", parsePolicy);
   section("sim", parseSim);
+  section("keystone", parseKeystone);
   std::set<std::string> names;
   const std::pair<const char*, procam_family> families[] = {{"projector", PROCAM_FAMILY_OUTPUT},
                                                             {"camera", PROCAM_FAMILY_CAMERA},

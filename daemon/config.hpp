@@ -2,6 +2,8 @@
 // procamd.toml: the rig (projectors, cameras, tilt sensors, trackers, their
 // drivers and options) and the daemon's policies. Every unknown key and every
 // bad value is an error naming the file, line and key.
+#include <array>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -24,6 +26,19 @@ struct DeviceConfig {
 
 enum class RecalibratePolicy { kOff, kOnDrift };
 
+// [keystone]: the automatic keystone loop (daemon/auto_keystone.hpp).
+struct KeystoneConfig {
+  double cutoff_hz = 10.0;       // tilt low-pass cut-off
+  double hysteresis_deg = 0.02;  // re-solve only when gravity turns by more than this
+  double poll_hz = 100.0;        // timer rate for tilt sensors without a poll fd
+  // Sensor -> projector mounting (row i = sensor axis i in projector axes) and the
+  // six-position accelerometer calibration (offset in g, per-axis gain); the
+  // virtual rig takes the mount from its scene and calibrates at start.
+  std::optional<std::array<double, 9>> mount;
+  std::array<double, 3> accel_offset_g{0, 0, 0};
+  std::array<double, 3> accel_scale{1, 1, 1};
+};
+
 struct Config {
   std::string source;  // file name, for messages
   LogLevel log_level = LogLevel::kInfo;
@@ -35,6 +50,7 @@ struct Config {
   bool auto_keystone = false;
   RecalibratePolicy recalibrate = RecalibratePolicy::kOff;
   std::string sim_scene;
+  KeystoneConfig keystone;
   std::vector<DeviceConfig> devices;
 };
 

@@ -111,9 +111,6 @@ Result<void> Daemon::setup() {
     }
     logInfo("virtual rig '" + options_.sim_scene +
             "': " + std::to_string(devices_.entries().size()) + " device(s)");
-    if (config_.auto_keystone || options_.sim_scene == kDefaultSimScene) {
-      warn("auto keystone requested, but this build has no keystone pipeline; it stays off");
-    }
   }
   openDevices();
   device_manager_ = std::make_unique<DeviceManager>(
@@ -132,6 +129,9 @@ Result<void> Daemon::setup() {
       [this](ClientId c, const proto::Request& r) { handle(c, r); },
       [this](ClientId c) { onDisconnect(c); });
   if (auto ok = server_->start(); !ok) return ok;
+  setupAutoKeystone();
+  loadContentAtStart();
+  refreshOutputs();
 
   if (auto ok = loop_->addTimer(std::chrono::seconds(1), true, [this] { housekeeping(); }); !ok) {
     return tl::unexpected(ok.error());
@@ -155,12 +155,6 @@ void Daemon::loadSettings() {
   if (loaded->from_backup) warn(loaded->warning);
   // The validator already accepted the text.
   settings_ = *settingsFromJson(loaded->contents);
-  if (settings_.auto_keystone) {
-    warn(
-        "saved setting auto keystone is on, but this build has no keystone pipeline; "
-        "automatic keystone stays off");
-    settings_.auto_keystone = false;
-  }
 }
 
 void Daemon::loadDrivers() {

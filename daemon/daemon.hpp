@@ -15,6 +15,7 @@
 #include "device_manager.hpp"
 #include "device_set.hpp"
 #include "event_loop.hpp"
+#include "keystone_runtime.hpp"
 #include "registry.hpp"
 #include "settings.hpp"
 #include "state_file.hpp"
@@ -77,7 +78,19 @@ class Daemon {
   nlohmann::json statusJson() const;
   nlohmann::json keystoneJson() const;
   nlohmann::json contentJson() const;
-  bool showPattern();
+  // daemon_keystone.cpp: auto keystone and what the outputs show.
+  void setupAutoKeystone();
+  void useKeystoneInputs(ProjectorModel projector, TiltMount mount);
+  Result<void> setAutoKeystone(bool enable);
+  void watchTiltSensor();
+  void stopTiltPolling();
+  void onTiltSample(const procam_tilt_sample& sample);
+  void requestSolve();
+  std::optional<Mat3> currentWarp(cv::Size content_size) const;
+  cv::Size currentSourceSize() const;
+  void refreshOutputs(std::function<void(bool shown)> done = {});
+  void loadContentAtStart();
+  nlohmann::json outputsJson() const;
   Result<void> reloadConfig();
 
   struct Operation {
@@ -102,6 +115,7 @@ class Daemon {
     int width = 0, height = 0;
   };
   ContentInfo content_info_;
+  KeystoneRuntime keystone_rt_;
   // Destroyed in reverse order: server and workers before the loop they use.
   std::unique_ptr<EventLoop> loop_;
   std::unique_ptr<WorkerPool> io_worker_;       // state writes (fsync)

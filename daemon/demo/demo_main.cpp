@@ -1,44 +1,52 @@
-// procam-demo: a scripted sequence on the virtual rig. Every frame the projector
-// shows a checkerboard, the rig's camera captures it (rendered with noise), the
-// corners are found and a projector -> camera homography is fitted; the tilt
-// sensor's gravity reading gives the projector's tilt. Each step is compared with
-// the rig's ground truth and the error printed.
+// procam-demo: the daemon on the virtual rig. Starts `procamd --sim SCENE` in a
+// temporary runtime and state directory, drives it with procamctl (status,
+// devices, keystone), follows the keystone updates with `procamctl watch` while
+// the simulated projector moves along the scene's trajectory, and prints for
+// every update its error against the rig's ground truth; then stops the daemon.
+#include <unistd.h>
+
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <opencv2/calib3d.hpp>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <string_view>
+#include <thread>
+#include <vector>
 
-#include "demo/checkerboard.hpp"
-#include "geometry/homography.hpp"
-#include "sim/orientation.hpp"
-#include "sim/renderer.hpp"
+#include "demo/child_process.hpp"
+#include "keystone/display_error.hpp"
+#include "keystone/keystone_solver.hpp"
+#include "keystone/orientation.hpp"
 #include "sim/scene_library.hpp"
-#include "sim/sensors.hpp"
 
 namespace {
 
-using procam::Points2;
-using procam::Vec2;
-using procam::Vec3;
+using nlohmann::json;
 using procam::Mat3;
-namespace geom = procam::geom;
+using procam::Vec2;
+namespace demo = procam::demo;
+namespace keystone = procam::keystone;
 namespace sim = procam::sim;
+constexpr double kDeg = 180.0 / 3.14159265358979323846;
 
 struct Options {
   std::string scene = "handheld";
-  int frames = 6;
-  int square = 96;
+  double seconds = 0;  // 0: the trajectory's length plus 4 s of hold
+  std::string procamd = PROCAMD_BIN;
+  std::string procamctl = PROCAMCTL_BIN;
 };
 
 void usage() {
   std::puts(
-      "usage: procam-demo [--scene NAME|FILE] [--frames N]\n"
-      "Runs a scripted sequence on the virtual rig and prints, per frame, what was\n"
-      "done and its error against ground truth. Default scene: handheld.");
+      "usage: procam-demo [--scene NAME|FILE] [--seconds S] [--procamd PATH] [--procamctl PATH]\n"
+      "Runs procamd on the virtual rig (default scene: handheld, auto keystone on) in a\n"
+      "temporary directory, drives it with procamctl and prints every keystone update\n"
+      "with its error against the rig's ground truth. The scene's wall must be the\n"
+      "world frame's plane facing -Y (as in handheld).");
 }
 
 bool parseArgs(int argc, char** argv, Options& out) {
@@ -49,11 +57,16 @@ bool parseArgs(int argc, char** argv, Options& out) {
       std::exit(0);
     }
     if (i + 1 >= argc) return false;
+    const std::string v = argv[++i];
     if (a == "--scene") {
-      out.scene = argv[++i];
-    } else if (a == "--frames") {
-      out.frames = std::atoi(argv[++i]);
-      if (out.frames < 1 || out.frames > 1000) return false;
+      out.scene = v;
+    } else if (a == "--seconds") {
+      out.seconds = std::atof(v.c_str());
+      if (!(out.seconds > 0 && out.seconds < 600)) return false;
+    } else if (a == "--procamd") {
+      out.procamd = v;
+    } else if (a == "--procamctl") {
+      out.procamctl = v;
     } else {
       return false;
     }
@@ -61,42 +74,44 @@ bool parseArgs(int argc, char** argv, Options& out) {
   return true;
 }
 
-double rms(const Points2& a, const Points2& b) {
-  double s = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) s += (a[i] - b[i]).squaredNorm();
-  return std::sqrt(s / static_cast<double>(a.size()));
-}
-
-// True ideal (undistorted) camera pixel of each projector framebuffer point:
-// projector ray -> nearest surface -> camera. Points hidden from the camera are
-// marked invalid.
-bool truthCorners(const sim::Scene& scene, const geom::CameraModel& proj,
-                  const geom::CameraModel& cam, const Points2& fb, Points2& out) {
-  geom::CameraModel ideal = cam;
-  ideal.dist = {};
-  out.clear();
-  for (const Vec2& p : fb) {
-    auto ray = proj.backproject(p);
-    if (!ray) return false;
-    auto hit = scene.world().intersect(*ray);
-    if (!hit) return false;
-    const Vec3 x = hit->hit.point;
-    const Vec3 c = cam.pose.center();
-    geom::Ray back{c, (x - c).normalized()};
-    if (scene.world().occluded(back, (x - c).norm() * (1 - 1e-9))) return false;
-    auto px = ideal.project(x);
-    if (!px) return false;
-    out.push_back(*px);
+Mat3 matrixOf(const json& rows) {
+  Mat3 H;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) H(r, c) = rows[r][c].get<double>();
   }
-  return true;
+  return H;
 }
 
-// Tilt of the projector's optical axis against the horizon and roll about it, in
-// degrees, from gravity expressed in the projector frame (x right, y down, z fwd).
-void tiltFromGravity(const Vec3& down, double& pitch_deg, double& roll_deg) {
-  const Vec3 g = down.normalized();
-  pitch_deg = sim::radToDeg(std::asin(std::clamp(-g.z(), -1.0, 1.0)));
-  roll_deg = sim::radToDeg(std::atan2(-g.x(), g.y()));
+struct Errors {
+  double corner_px = 0, aspect_pct = 0, area_pct = 0;
+};
+
+// The shown image's corners judged with orientation R (wall frame -> projector),
+// against the largest upright rectangle keystone::solveKeystone finds for R.
+Errors errorsAt(const sim::ProjectorSpec& p, const Mat3& R, const Mat3& H, int cw, int ch) {
+  keystone::KeystoneProblem problem;
+  problem.K = p.K;
+  problem.width = p.width;
+  problem.height = p.height;
+  problem.R = R;
+  problem.content_width = cw;
+  problem.content_height = ch;
+  auto best = keystone::solveKeystone(problem);
+  const std::array<Vec2, 4> edges = {Vec2(-0.5, -0.5), Vec2(cw - 0.5, -0.5),
+                                     Vec2(cw - 0.5, ch - 0.5), Vec2(-0.5, ch - 0.5)};
+  std::array<Vec2, 4> shown;
+  for (int i = 0; i < 4; ++i) shown[i] = (H * edges[i].homogeneous()).hnormalized();
+  const auto e = keystone::displayError(p.K, R, shown);
+  Errors out;
+  out.corner_px = e.max_corner_px;
+  out.aspect_pct = 100 * std::abs(e.aspect / (double(cw) / ch) - 1);
+  out.area_pct = best ? 100 * std::abs(e.area / best->rect.area() - 1) : NAN;
+  return out;
+}
+
+void section(const char* title) {
+  std::printf("\n== %s\n", title);
+  std::fflush(stdout);
 }
 
 }  // namespace
@@ -113,101 +128,132 @@ int main(int argc, char** argv) {
     return 1;
   }
   const sim::Scene& scene = *scene_or;
-  if (scene.projectors().empty() || scene.cameras().empty()) {
-    std::fprintf(stderr, "procam-demo: scene '%s' needs a projector and a camera\n",
+  if (scene.projectors().empty() || scene.tiltSensors().empty()) {
+    std::fprintf(stderr, "procam-demo: scene '%s' needs a projector with a tilt sensor\n",
                  scene.name().c_str());
     return 1;
   }
-  const auto& pspec = scene.projectors().front();
-  const auto& cspec = scene.cameras().front();
-  double duration = 0;
-  for (const auto& tr : scene.trajectories()) duration = std::max(duration, tr.duration());
-  const auto board = procam::demo::makeCheckerboard(pspec.width, pspec.height, opt.square);
+  const sim::ProjectorSpec& pspec = scene.projectors().front();
+  double trajectory = 0;
+  for (const auto& tr : scene.trajectories()) trajectory = std::max(trajectory, tr.duration());
+  const double seconds = opt.seconds > 0 ? opt.seconds : trajectory + 4.0;
 
-  std::printf("procam-demo: scene '%s' — projector '%s' %dx%d, camera '%s' %dx%d, %d frame(s)\n",
-              scene.name().c_str(), pspec.name.c_str(), pspec.width, pspec.height,
-              cspec.name.c_str(), cspec.width, cspec.height, opt.frames);
-  int failures = 0;
-  for (int f = 0; f < opt.frames; ++f) {
-    const double t = opt.frames > 1 ? duration * f / (opt.frames - 1) : 0.0;
-    const sim::SceneState state = scene.at(t);
-    const auto& proj = state.projectors.front().model;
-    const auto& cam = state.cameras.front().model;
-    std::printf("frame %d  t=%.2fs\n", f, t);
-
-    // Tilt sensor on this projector: its gravity reading against the true tilt.
-    for (const auto& ts : scene.tiltSensors()) {
-      if (ts.projector != pspec.name) continue;
-      auto sample = sim::sampleTilt(scene, ts.name, t, 1000 + f);
-      if (!sample) continue;
-      const Mat3 projector_from_sensor = ts.sensor_from_projector.transpose();
-      double p_meas, r_meas, p_true, r_true;
-      tiltFromGravity(-(projector_from_sensor * sample->value), p_meas, r_meas);
-      tiltFromGravity(-(projector_from_sensor * sample->truth), p_true, r_true);
-      std::printf("  tilt   '%s': pitch %+7.2f° (true %+7.2f°, error %.3f°)  roll %+7.2f° "
-                  "(true %+7.2f°, error %.3f°)  [uncalibrated sensor]\n",
-                  ts.name.c_str(), p_meas, p_true, std::abs(p_meas - p_true), r_meas, r_true,
-                  std::abs(r_meas - r_true));
-    }
-
-    sim::Framebuffers shown;
-    shown.emplace(pspec.name, board.image);
-    auto renderer = sim::Renderer::create(scene, state, shown);
-    if (!renderer) {
-      std::printf("  render failed: %s\n", renderer.error().message.c_str());
-      ++failures;
-      continue;
-    }
-    const auto t0 = std::chrono::steady_clock::now();
-    auto image = renderer->renderCamera(cspec.name, {.noise = true, .seed = 7u + f});
-    const double ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    if (!image) {
-      std::printf("  render failed: %s\n", image.error().message.c_str());
-      ++failures;
-      continue;
-    }
-    std::printf("  render camera '%s' with checkerboard shown: %.0f ms\n", cspec.name.c_str(), ms);
-
-    Points2 truth;
-    if (!truthCorners(scene, proj, cam, board.corners, truth)) {
-      std::printf("  checkerboard: not fully visible to the camera at this pose, skipped\n");
-      continue;
-    }
-    cv::Mat gray = *image;
-    if (gray.depth() != CV_8U) gray.convertTo(gray, CV_8U, 255.0 / cspec.maxDn());
-    std::vector<cv::Point2f> found;
-    if (!cv::findChessboardCornersSB(gray, board.inner, found, cv::CALIB_CB_ACCURACY)) {
-      std::printf("  checkerboard: not detected (%d x %d inner corners)\n", board.inner.width,
-                  board.inner.height);
-      ++failures;
-      continue;
-    }
-    Points2 detected;
-    for (const auto& p : found) {
-      auto u = cam.undistortPixel(Vec2(p.x, p.y));
-      detected.push_back(u ? *u : Vec2(p.x, p.y));
-    }
-    // The detector may start from the opposite corner of the board.
-    if ((detected.front() - truth.front()).norm() > (detected.back() - truth.front()).norm()) {
-      std::reverse(detected.begin(), detected.end());
-    }
-    const double detect_rms = rms(detected, truth);
-    auto fit = geom::fitHomography(board.corners, detected);
-    if (!fit) {
-      std::printf("  homography: %s (%s)\n", fit.error().message.c_str(),
-                  procam::toString(fit.error().code));
-      ++failures;
-      continue;
-    }
-    Points2 mapped;
-    for (const Vec2& p : board.corners) mapped.push_back(*geom::applyHomography(fit->H, p));
-    std::printf("  corners: %zu found, detection error %.3f px RMS against truth\n",
-                detected.size(), detect_rms);
-    std::printf("  homography projector->camera: residual %.3f px RMS, condition %.1f, "
-                "transfer error against truth %.3f px RMS\n",
-                fit->rms, fit->condition, rms(mapped, truth));
+  char tmpl[] = "/tmp/procam-demo.XXXXXX";
+  if (!::mkdtemp(tmpl)) {
+    std::perror("procam-demo: mkdtemp");
+    return 1;
   }
-  std::printf("procam-demo: done, %d frame(s) failed\n", failures);
-  return failures == 0 ? 0 : 1;
+  const std::string dir = tmpl;
+  const std::string socket = dir + "/run/control.sock";
+  const std::string log = dir + "/procamd.log";
+  auto ctl = [&](std::vector<std::string> args) {
+    args.insert(args.begin(), {opt.procamctl, "--socket", socket});
+    return demo::runToEnd(args);
+  };
+
+  section("start procamd on the virtual rig");
+  std::printf("$ procamd --sim %s --runtime-dir %s/run --state-dir %s/state  (log: %s)\n",
+              opt.scene.c_str(), dir.c_str(), dir.c_str(), log.c_str());
+  auto daemon = demo::Child::start({opt.procamd, "--sim", opt.scene, "--runtime-dir", dir + "/run",
+                                    "--state-dir", dir + "/state"},
+                                   log, false);
+  if (!daemon) {
+    std::fprintf(stderr, "procam-demo: cannot start %s\n", opt.procamd.c_str());
+    return 1;
+  }
+  bool up = false;
+  for (int i = 0; i < 100 && !up; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    up = std::filesystem::exists(socket) && ctl({"version"}).status == 0;
+  }
+  if (!up) {
+    std::fprintf(stderr, "procam-demo: procamd did not come up; see %s\n", log.c_str());
+    return 1;
+  }
+  section("procamctl status");
+  std::fputs(ctl({"status"}).out.c_str(), stdout);
+  section("procamctl devices");
+  std::fputs(ctl({"devices"}).out.c_str(), stdout);
+  section("procamctl keystone auto on");
+  const auto on = ctl({"keystone", "auto", "on"});
+  std::fputs(on.out.c_str(), stdout);
+
+  section("keystone updates while the projector moves (procamctl --json watch)");
+  std::printf(
+      "Error columns: the shown image judged with the true orientation at the tilt sample's\n"
+      "time (corner px in the framebuffer, aspect and area against the largest upright\n"
+      "rectangle). 'tilt' uses the true pitch and roll; 'full' adds the true yaw, which a\n"
+      "tilt sensor cannot see (seed §6.2.2: the camera gives the azimuth).\n\n");
+  std::printf("%7s %6s | %7s %7s %6s | %7s %7s | %9s %8s %7s | %9s\n", "t [s]", "still", "pitch",
+              "roll", "yaw", "est p", "est r", "tilt px", "aspect%", "area%", "full px");
+  auto watch = demo::Child::start({opt.procamctl, "--socket", socket, "--json", "watch"});
+  if (!watch) return 1;
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  int updates = 0, hidden = 0;
+  double last_printed = -1;
+  std::vector<double> moving_px;  // tilt corner errors while the trajectory runs
+  std::optional<Errors> final_hold;
+  double final_time = 0;
+  while (std::chrono::steady_clock::now() < end) {
+    auto line = watch->readLine(std::chrono::milliseconds(200));
+    if (!line) continue;
+    const json e = json::parse(*line, nullptr, false);
+    if (e.is_discarded() || e.value("event", "") != "keystone" || e.value("mode", "") != "auto") {
+      continue;
+    }
+    ++updates;
+    const double t = e["estimate"]["sample_time"].get<double>();
+    const int cw = e["content_size"][0].get<int>(), ch = e["content_size"][1].get<int>();
+    const Mat3 H = matrixOf(e["homography"]);
+    // The handheld wall is the world plane y = const facing -y: wall frame = world frame.
+    const Mat3 R_true = scene.at(t).projector(pspec.name)->model.pose.R;
+    const keystone::Angles truth = keystone::anglesFromRotation(R_true);
+    const Mat3 R_tilt = keystone::rotationFromAngles({truth.pitch, truth.roll, 0.0});
+    const Errors tilt = errorsAt(pspec, R_tilt, H, cw, ch);
+    const Errors full = errorsAt(pspec, R_true, H, cw, ch);
+    const bool still = e["tilt"].value("still", false);
+    if (t < trajectory) {
+      moving_px.push_back(tilt.corner_px);
+    } else {
+      final_hold = tilt;
+      final_time = t;
+    }
+    // While moving the daemon updates on every sample: print ten a second.
+    if (!still && t < trajectory && t - last_printed < 0.1) {
+      ++hidden;
+      continue;
+    }
+    last_printed = t;
+    std::printf("%7.2f %6s | %7.2f %7.2f %6.1f | %7.2f %7.2f | %9.3f %8.4f %7.4f | %9.2f\n", t,
+                still ? "yes" : "no", truth.pitch * kDeg, truth.roll * kDeg, truth.yaw * kDeg,
+                e["estimate"]["pitch_deg"].get<double>(), e["estimate"]["roll_deg"].get<double>(),
+                tilt.corner_px, tilt.aspect_pct, tilt.area_pct, full.corner_px);
+    std::fflush(stdout);
+  }
+  watch->stop();
+  std::printf("\n%d keystone update(s) in %.1f s (%d not printed).\n", updates, seconds, hidden);
+  if (!moving_px.empty()) {
+    std::sort(moving_px.begin(), moving_px.end());
+    std::printf(
+        "While the projector moves (t < %.1f s): corner error vs true pitch/roll median %.2f px, "
+        "max %.2f px\n  (the low-pass filter lags the motion; a still projector is what the "
+        "tolerances are for).\n",
+        trajectory, moving_px[moving_px.size() / 2], moving_px.back());
+  }
+  if (final_hold) {
+    std::printf(
+        "Held still at the end: the update at t = %.2f s, which stays on the wall, is off by "
+        "corner %.3f px, aspect %.4f %%, area %.4f %%\n"
+        "  (issue 4 tolerances: corner <= 0.5 px, aspect 0.1 %%, area 0.5 %%).\n",
+        final_time, final_hold->corner_px, final_hold->aspect_pct, final_hold->area_pct);
+  }
+
+  section("procamctl keystone");
+  std::fputs(ctl({"keystone"}).out.c_str(), stdout);
+  section("stop procamd (SIGTERM)");
+  const int status = daemon->stop();
+  std::printf("procamd exited with status %d\n", status);
+  std::error_code ec;
+  std::filesystem::remove_all(dir, ec);
+  return status == 0 && updates > 0 ? 0 : 1;
 }

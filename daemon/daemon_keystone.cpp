@@ -1,0 +1,509 @@
+// Auto keystone and what the outputs show (PROTOCOL.md: keystone, pattern,
+// content). Everything here runs on the loop thread; the keystone solve, the
+// six-position calibration of the virtual rig and frame rendering run on
+// compute_worker_ and post their results back.
+#include <cmath>
+#include <numbers>
+
+#include "daemon.hpp"
+#include "geometry/homography.hpp"
+#include "log.hpp"
+#include "request_args.hpp"
+#include "sim_keystone.hpp"
+#include "sim_rig.hpp"
+
+namespace procam::daemon {
+
+using nlohmann::json;
+namespace code = proto::code;
+
+namespace {
+
+constexpr double kDeg = 180.0 / std::numbers::pi;
+
+json quadJson(const std::array<Vec2, 4>& q) {
+  json a = json::array();
+  for (const auto& p : q) a.push_back({p.x(), p.y()});
+  return a;
+}
+
+json matJson(const Mat3& H) {
+  json rows = json::array();
+  for (int r = 0; r < 3; ++r) rows.push_back({H(r, 0), H(r, 1), H(r, 2)});
+  return rows;
+}
+
+// The content's corner pixel centres, top-left first, clockwise on screen.
+std::array<Vec2, 4> contentCorners(cv::Size s) {
+  return {Vec2(0, 0), Vec2(s.width - 1.0, 0), Vec2(s.width - 1.0, s.height - 1.0),
+          Vec2(0, s.height - 1.0)};
+}
+
+std::optional<cv::Size> outputMode(const DeviceEntry& e) {
+  uint32_t w = 0, h = 0;
+  double hz = 0;
+  const auto& raw = e.device.raw();
+  if (raw.ops.output->get_mode(raw.self, &w, &h, &hz) != PROCAM_OK || w < 2 || h < 2) {
+    return std::nullopt;
+  }
+  return cv::Size(static_cast<int>(w), static_cast<int>(h));
+}
+
+}  // namespace
+
+void Daemon::setupAutoKeystone() {
+  KeystoneRuntime& k = keystone_rt_;
+  // Policy and the virtual rig's default scene turn it on at start; a saved
+  // setting may too.
+  if (config_.auto_keystone || options_.sim_scene == kDefaultSimScene) {
+    settings_.auto_keystone = true;
+  }
+  DeviceEntry* tilt = devices_.firstUsable(PROCAM_FAMILY_TILT);
+  DeviceEntry* out = devices_.firstUsable(PROCAM_FAMILY_OUTPUT);
+  if (!tilt || !out) {
+    k.unavailable = !tilt ? "automatic keystone needs a tilt sensor; none is open"
+                          : "automatic keystone needs a projector output; none is open";
+    if (settings_.auto_keystone) warn(k.unavailable + "; it stays off");
+    settings_.auto_keystone = false;
+    return;
+  }
+  k.tilt_device = tilt->name;
+  watchTiltSensor();
+  auto rig = projectorFromRigFile(options_.state_dir, out->name);
+  if (!rig && rig.error().code != ErrorCode::kNotFound) warn(rig.error().message);
+  const std::string scene = tilt->description.property("SIM_SCENE");
+  if (tilt->description.subsystem == "sim" && !scene.empty()) {
+    // The virtual rig: intrinsics from the scene (rig.json wins when present),
+    // the accelerometer calibrated by posing the simulated projector.
+    k.unavailable = "calibrating the accelerometer (six positions)";
+    k.preparing = true;
+    std::optional<ProjectorModel> from_rig;
+    if (rig) from_rig = *rig;
+    compute_worker_->submit([this, scene, proj = out->name, sensor = tilt->name, from_rig] {
+      auto setup = simKeystoneSetup(scene, proj, sensor);
+      return [this, setup = std::move(setup), from_rig] {
+        keystone_rt_.preparing = false;
+        if (!setup) {
+          keystone_rt_.unavailable = "automatic keystone: " + setup.error().message;
+          warn(keystone_rt_.unavailable);
+          settings_.auto_keystone = false;
+          return;
+        }
+        keystone_rt_.calibration_rms_g = setup->calibration_rms_g;
+        logInfo("accelerometer: " + setup->mount.calibration_source + ", fit RMS " +
+                std::to_string(setup->calibration_rms_g * 1e3) + " mg");
+        useKeystoneInputs(from_rig ? *from_rig : setup->projector, setup->mount);
+      };
+    });
+    return;
+  }
+  if (!rig) {
+    k.unavailable = "automatic keystone needs the projector's intrinsics: " + rig.error().message +
+                    " (calibrate writes it)";
+    if (settings_.auto_keystone) warn(k.unavailable + "; it stays off");
+    settings_.auto_keystone = false;
+    return;
+  }
+  auto mount = mountFromConfig(config_.keystone);
+  if (!mount) {
+    k.unavailable = mount.error().message;
+    warn(k.unavailable);
+    settings_.auto_keystone = false;
+    return;
+  }
+  useKeystoneInputs(*rig, *mount);
+}
+
+void Daemon::useKeystoneInputs(ProjectorModel projector, TiltMount mount) {
+  KeystoneRuntime& k = keystone_rt_;
+  auto tracker = TiltTracker::create(config_.keystone, std::move(mount));
+  if (!tracker) {
+    k.unavailable = tracker.error().message;
+    warn("automatic keystone: " + k.unavailable);
+    settings_.auto_keystone = false;
+    return;
+  }
+  k.tracker = std::move(*tracker);
+  k.projector = std::move(projector);
+  k.unavailable.clear();
+  if (settings_.auto_keystone) {
+    if (auto ok = setAutoKeystone(true); !ok) warn(ok.error().message);
+  }
+}
+
+Result<void> Daemon::setAutoKeystone(bool enable) {
+  KeystoneRuntime& k = keystone_rt_;
+  if (enable && !k.tracker && !k.preparing) return fail(ErrorCode::kNotFound, k.unavailable);
+  settings_.auto_keystone = enable;
+  if (!enable || !k.tracker) {
+    stopTiltPolling();
+    k.down.reset();
+    k.estimate.reset();
+    k.solve_again = false;
+    return {};
+  }
+  if (k.listening) return {};
+  DeviceEntry* tilt = devices_.find(k.tilt_device);
+  if (!tilt || !tilt->usable()) {
+    return fail(ErrorCode::kNotFound, "tilt sensor '" + k.tilt_device + "' is not open");
+  }
+  k.tracker->reset();
+  // A sensor with a poll fd is read by the device manager when readable; the
+  // others by timer. Both arrive through the manager's onReading hook.
+  if (tilt->device.pollFd() < 0) {
+    const auto period =
+        std::chrono::nanoseconds(static_cast<int64_t>(1e9 / config_.keystone.poll_hz));
+    auto id = device_manager_->pollEvery(k.tilt_device, period);
+    if (!id) return tl::unexpected(id.error());
+    k.poll_timer = *id;
+  }
+  k.listening = true;
+  return {};
+}
+
+void Daemon::stopTiltPolling() {
+  KeystoneRuntime& k = keystone_rt_;
+  if (k.poll_timer >= 0) device_manager_->stopPolling(k.poll_timer);
+  k.poll_timer = -1;
+  k.listening = false;
+  if (k.tracker) k.tracker->reset();
+}
+
+void Daemon::watchTiltSensor() {
+  device_manager_->onReading([this](const DeviceEntry& e, const Reading& r) {
+    if (e.name != keystone_rt_.tilt_device || !keystone_rt_.listening) return;
+    if (const auto* s = std::get_if<procam_tilt_sample>(&r)) onTiltSample(*s);
+  });
+  device_manager_->onDeviceRemoved([this](const DeviceEntry& e) {
+    KeystoneRuntime& k = keystone_rt_;
+    if (e.name != k.tilt_device || !k.listening) return;
+    // Keep the setting and the last solution on the wall; resume when it is back.
+    stopTiltPolling();
+    warn("automatic keystone paused: tilt sensor '" + e.name + "' is gone");
+  });
+  device_manager_->onDeviceAdded([this](const DeviceEntry& e) {
+    KeystoneRuntime& k = keystone_rt_;
+    if (e.name != k.tilt_device || !settings_.auto_keystone || k.listening || !k.tracker) return;
+    if (auto ok = setAutoKeystone(true); !ok) warn("automatic keystone: " + ok.error().message);
+  });
+}
+
+void Daemon::onTiltSample(const procam_tilt_sample& sample) {
+  KeystoneRuntime& k = keystone_rt_;
+  if (!k.tracker) return;
+  if (auto down = k.tracker->add(sample)) {
+    k.down = *down;
+    k.down_time = static_cast<double>(sample.timestamp_ns) * 1e-9;
+    requestSolve();
+  }
+}
+
+void Daemon::requestSolve() {
+  KeystoneRuntime& k = keystone_rt_;
+  if (!k.down || !k.projector) return;
+  if (k.solving) {
+    k.solve_again = true;  // one solve at a time; the latest gravity wins
+    return;
+  }
+  const cv::Size content = currentSourceSize();
+  if (content.width < 1 || content.height < 1) return;
+  k.solving = true;
+  compute_worker_->submit(
+      [this, projector = *k.projector, down = *k.down, time = k.down_time, content] {
+        auto e = solveFromDown(projector, down, content.width, content.height);
+        if (e) e->sample_time = time;
+        return [this, e = std::move(e)] {
+          KeystoneRuntime& k = keystone_rt_;
+          k.solving = false;
+          if (settings_.auto_keystone) {
+            if (e) {
+              k.estimate = *e;
+              ++k.solves;
+              broadcast("keystone", keystoneJson());
+              refreshOutputs();
+            } else {
+              logDebug("keystone solve: " + e.error().message);
+            }
+          }
+          if (k.solve_again) {
+            k.solve_again = false;
+            requestSolve();
+          }
+        };
+      });
+}
+
+cv::Size Daemon::currentSourceSize() const {
+  auto* self = const_cast<Daemon*>(this);  // device queries do not change the set
+  FrameRequest r;
+  r.pattern = settings_.pattern;
+  r.content = keystone_rt_.content;
+  if (DeviceEntry* out = self->devices_.firstUsable(PROCAM_FAMILY_OUTPUT)) {
+    if (auto mode = outputMode(*out)) r.output_size = *mode;
+  }
+  return sourceSize(r);
+}
+
+std::optional<Mat3> Daemon::currentWarp(cv::Size content_size) const {
+  const KeystoneRuntime& k = keystone_rt_;
+  if (settings_.auto_keystone && k.estimate && k.estimate->content_width == content_size.width &&
+      k.estimate->content_height == content_size.height) {
+    return k.estimate->H;
+  }
+  if (settings_.keystone) {
+    std::array<Vec2, 4> corners;
+    for (int i = 0; i < 4; ++i) {
+      corners[i] = Vec2((*settings_.keystone)[i][0], (*settings_.keystone)[i][1]);
+    }
+    if (auto H = geom::homographyFrom4(contentCorners(content_size), corners)) {
+      return Mat3(*H / (*H)(2, 2));
+    }
+  }
+  return std::nullopt;
+}
+
+json Daemon::keystoneJson() const {
+  const KeystoneRuntime& k = keystone_rt_;
+  const bool auto_active = settings_.auto_keystone && k.estimate.has_value();
+  json j = {{"auto", settings_.auto_keystone},
+            {"mode", auto_active          ? "auto"
+                     : settings_.keystone ? "manual"
+                                          : "none"},
+            {"corners", nullptr},
+            {"homography", nullptr},
+            {"output_size", nullptr},
+            {"content_size", nullptr}};
+  if (!k.unavailable.empty()) j["auto_unavailable"] = k.unavailable;
+  if (settings_.keystone && !auto_active) {
+    json c = json::array();
+    for (const auto& p : *settings_.keystone) c.push_back({p[0], p[1]});
+    j["corners"] = c;
+  }
+  if (k.estimate) {
+    const auto& e = *k.estimate;
+    j["estimate"] = {{"pitch_deg", e.angles.pitch * kDeg},
+                     {"roll_deg", e.angles.roll * kDeg},
+                     {"down", {e.down.x(), e.down.y(), e.down.z()}},
+                     {"scale", e.scale},
+                     {"sample_time", e.sample_time},
+                     {"updates", k.solves}};
+  }
+  if (k.projector) {
+    j["projector"] = {
+        {"intrinsics",
+         {k.projector->K.fx, k.projector->K.fy, k.projector->K.cx, k.projector->K.cy}},
+        {"size", {k.projector->width, k.projector->height}},
+        {"source", k.projector->source}};
+  }
+  if (k.tracker) {
+    const auto& c = k.tracker->counts();
+    const Vec3& off = k.tracker->mount().calibration.offset;
+    j["tilt"] = {{"device", k.tilt_device},
+                 {"still", k.tracker->still()},
+                 {"accepted", c.accepted},
+                 {"rejected", c.rejected()},
+                 {"calibration",
+                  {{"source", k.tracker->mount().calibration_source},
+                   {"offset_g", {off.x(), off.y(), off.z()}}}}};
+    if (k.calibration_rms_g >= 0) j["tilt"]["calibration"]["rms_g"] = k.calibration_rms_g;
+  }
+  auto* self = const_cast<Daemon*>(this);
+  if (DeviceEntry* out = self->devices_.firstUsable(PROCAM_FAMILY_OUTPUT)) {
+    if (auto mode = outputMode(*out)) j["output_size"] = {mode->width, mode->height};
+  }
+  const cv::Size content = currentSourceSize();
+  if (content.width > 0 && content.height > 0) {
+    j["content_size"] = {content.width, content.height};
+    if (auto H = currentWarp(content)) {
+      j["homography"] = matJson(*H);
+      if (auto_active) {
+        std::array<Vec2, 4> c = contentCorners(content);
+        for (auto& p : c) p = (*H * p.homogeneous()).hnormalized();
+        j["corners"] = quadJson(c);
+      }
+    }
+  }
+  return j;
+}
+
+void Daemon::cmdKeystone(ClientId client, const proto::Request& req) {
+  RequestArgs args(req.body);
+  PROCAM_CHECK_KEYS(args, "action", "corners", "homography", "enable");
+  const std::string action = args.string("action").value_or("get");
+  if (!args.ok()) return errorTo(client, req, code::kBadArgument, args.error());
+  const json* corners = args.get("corners");
+  const json* homography = args.get("homography");
+  if (action == "get") {
+    if (corners || homography || args.get("enable")) {
+      return errorTo(client, req, code::kBadArgument, "keystone get takes no arguments");
+    }
+  } else if (action == "set") {
+    if (!corners == !homography) {
+      return errorTo(client, req, code::kBadArgument,
+                     "keystone set needs \"corners\": 4 [x, y] pairs (or null to clear), or "
+                     "\"homography\": 3 rows of 3 numbers");
+    }
+    Quad q{};
+    if (homography) {
+      // Stored as the corners it puts the content's corner pixels at.
+      Mat3 H;
+      bool ok = homography->is_array() && homography->size() == 3;
+      for (size_t r = 0; ok && r < 3; ++r) {
+        const json& row = (*homography)[r];
+        ok = row.is_array() && row.size() == 3;
+        for (size_t c = 0; ok && c < 3; ++c) {
+          ok = row[c].is_number();
+          if (ok) H(r, c) = row[c].get<double>();
+        }
+      }
+      if (!ok || !H.allFinite() || std::abs(H.determinant()) < 1e-12) {
+        return errorTo(client, req, code::kBadArgument,
+                       "\"homography\" must be 3 rows of 3 finite numbers, not singular");
+      }
+      const auto src = contentCorners(currentSourceSize());
+      for (int i = 0; i < 4; ++i) {
+        const Vec3 p = H * src[i].homogeneous();
+        if (!(p.z() > 0)) {
+          return errorTo(client, req, code::kBadArgument,
+                         "\"homography\" sends a content corner to or behind infinity");
+        }
+        q[i] = {p.x() / p.z(), p.y() / p.z()};
+      }
+    } else if (!corners->is_null()) {
+      if (!corners->is_array() || corners->size() != 4) {
+        return errorTo(client, req, code::kBadArgument, "\"corners\" must be 4 [x, y] pairs");
+      }
+      for (size_t i = 0; i < 4; ++i) {
+        const json& p = (*corners)[i];
+        if (!p.is_array() || p.size() != 2 || !p[0].is_number() || !p[1].is_number()) {
+          return errorTo(client, req, code::kBadArgument, "\"corners\" must be 4 [x, y] pairs");
+        }
+        q[i] = {p[0].get<double>(), p[1].get<double>()};
+      }
+    }
+    if (homography || !corners->is_null()) {
+      if (auto ok = validateQuad(q); !ok) {
+        return errorTo(client, req, code::kBadArgument, ok.error().message);
+      }
+      settings_.keystone = q;
+    } else {
+      settings_.keystone.reset();
+    }
+    // A manual correction replaces the automatic one.
+    if (settings_.auto_keystone) (void)setAutoKeystone(false);
+    broadcast("keystone", keystoneJson());
+    refreshOutputs();
+  } else if (action == "auto") {
+    auto enable = args.boolean("enable");
+    if (!args.ok() || !enable) {
+      return errorTo(client, req, code::kBadArgument, "keystone auto needs \"enable\": true|false");
+    }
+    if (auto ok = setAutoKeystone(*enable); !ok) {
+      return errorTo(client, req, code::kUnavailable, ok.error().message);
+    }
+    broadcast("keystone", keystoneJson());
+    refreshOutputs();
+  } else {
+    return errorTo(client, req, code::kBadArgument,
+                   "unknown keystone action '" + action + "' (get, set, auto)");
+  }
+  replyTo(client, req, "KEYSTONE", keystoneJson());
+}
+
+void Daemon::refreshOutputs(std::function<void(bool shown)> done) {
+  KeystoneRuntime& k = keystone_rt_;
+  if (done) k.frame_waiters.push_back(std::move(done));
+  if (k.rendering) {
+    k.render_again = true;  // after the frame in flight: the state changed since
+    return;
+  }
+  std::vector<std::pair<std::string, FrameRequest>> jobs;
+  for (auto& e : devices_.entries()) {
+    if (e.description.family != PROCAM_FAMILY_OUTPUT || !e.usable()) continue;
+    auto mode = outputMode(e);
+    if (!mode) continue;
+    FrameRequest r;
+    r.output_size = *mode;
+    r.pattern = settings_.pattern;
+    r.content = k.content;
+    r.homography = currentWarp(sourceSize(r));
+    jobs.emplace_back(e.name, std::move(r));
+  }
+  auto waiters = std::move(k.frame_waiters);
+  k.frame_waiters.clear();
+  if (jobs.empty()) {
+    for (auto& w : waiters) w(false);
+    return;
+  }
+  // A changed source size changes the auto solution's content: solve again.
+  if (settings_.auto_keystone && k.estimate) {
+    const cv::Size s = sourceSize(jobs.front().second);
+    if (s.width != k.estimate->content_width || s.height != k.estimate->content_height) {
+      requestSolve();
+    }
+  }
+  k.rendering = true;
+  compute_worker_->submit([this, jobs = std::move(jobs), waiters = std::move(waiters)]() mutable {
+    auto frames = std::make_shared<std::vector<std::pair<std::string, Result<OutputFrame>>>>();
+    for (auto& [name, request] : jobs) frames->emplace_back(name, renderOutputFrame(request));
+    return [this, frames, waiters = std::move(waiters)] {
+      KeystoneRuntime& k = keystone_rt_;
+      k.rendering = false;
+      bool shown = false;
+      for (auto& [name, frame] : *frames) {
+        if (!frame) {
+          warn("output '" + name + "': " + frame.error().message);
+          continue;
+        }
+        for (auto& e : devices_.entries()) {
+          if (e.name != name || !e.usable()) continue;
+          const auto& raw = e.device.raw();
+          procam_image image = rgbImage(frame->rgb);
+          char err[256] = {};
+          if (raw.ops.output->show(raw.self, &image, err, sizeof err - 1) == PROCAM_OK) {
+            shown = true;
+            k.shown[name] = frame->stats;
+          } else {
+            warn("output '" + name + "' could not show the frame: " + err);
+          }
+        }
+      }
+      ++k.frames;
+      for (auto& w : waiters) w(shown);
+      if (k.render_again) {
+        k.render_again = false;
+        refreshOutputs();
+      }
+    };
+  });
+}
+
+void Daemon::loadContentAtStart() {
+  if (settings_.content.empty()) return;
+  compute_worker_->submit([this, file = settings_.content] {
+    auto image = decodeContent(file);
+    return [this, file, image = std::move(image)] {
+      if (settings_.content != file) return;  // replaced meanwhile
+      if (!image) {
+        warn("saved content not shown: " + image.error().message);
+        return;
+      }
+      keystone_rt_.content = *image;
+      content_info_ = {(*image)->cols, (*image)->rows};
+      refreshOutputs();
+    };
+  });
+}
+
+json Daemon::outputsJson() const {
+  json list = json::array();
+  for (const auto& [name, st] : keystone_rt_.shown) {
+    list.push_back({{"name", name},
+                    {"source", st.source},
+                    {"lit_fraction", st.lit_fraction},
+                    {"mean_rgb", {st.mean_rgb[0], st.mean_rgb[1], st.mean_rgb[2]}}});
+  }
+  return {{"frames", keystone_rt_.frames}, {"shown", list}};
+}
+
+}  // namespace procam::daemon

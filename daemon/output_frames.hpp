@@ -1,0 +1,53 @@
+#pragma once
+// What a projector output shows: the alignment pattern (when one is chosen) or
+// the content image, pre-warped by the keystone homography through the CPU
+// reference renderer (pipelines/render), as an RGB8 frame. Pure: runs on a worker.
+#include <array>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+
+#include "core/error.hpp"
+#include "core/types.hpp"
+#include "procamd/procam_plugin.h"
+
+namespace procam::daemon {
+
+struct FrameRequest {
+  cv::Size output_size;
+  std::string pattern = "off";             // not "off": shown instead of the content
+  std::shared_ptr<const cv::Mat> content;  // CV_8UC4 RGBA; null: none
+  // Content pixels -> framebuffer pixels; none: the source is fitted into the
+  // frame, centred, aspect kept (identity when the sizes agree).
+  std::optional<Mat3> homography;
+};
+
+// A few numbers about a frame, reported in status so that a client can tell what
+// an output shows without reading it back.
+struct FrameStats {
+  std::string source;                // "pattern:NAME", "content" or "none"
+  double lit_fraction = 0;           // pixels with any channel above 0
+  std::array<double, 3> mean_rgb{};  // 0..255
+};
+
+struct OutputFrame {
+  cv::Mat rgb;  // CV_8UC3, R G B order, output size
+  FrameStats stats;
+};
+
+// The plugin ABI's view of an RGB8 frame (no copy: `rgb` must outlive it).
+procam_image rgbImage(const cv::Mat& rgb);
+
+// The size of the image the homography applies to: the output size for a
+// pattern or nothing, the content's size otherwise.
+cv::Size sourceSize(const FrameRequest& request);
+
+// Reads an image file as RGBA (grey and 16-bit images converted); kIo when it
+// cannot be read.
+Result<std::shared_ptr<const cv::Mat>> decodeContent(const std::string& path);
+
+// kInvalidInput for empty sizes or content of the wrong type; renderer errors.
+Result<OutputFrame> renderOutputFrame(const FrameRequest& request);
+
+}  // namespace procam::daemon
