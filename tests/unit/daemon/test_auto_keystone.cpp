@@ -1,0 +1,220 @@
+// Auto keystone's pieces and the output frames, without the daemon: the tilt
+// tracker (gate, calibration, filter, hysteresis), the solve from gravity, the
+// [keystone] configuration, rig.json intrinsics and frame rendering.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <opencv2/imgcodecs.hpp>
+
+#include "auto_keystone.hpp"
+#include "config.hpp"
+#include "keystone/keystone_solver.hpp"
+#include "output_frames.hpp"
+
+namespace procam::daemon {
+namespace {
+
+constexpr double kG = 9.80665;
+constexpr double kDeg = std::numbers::pi / 180;
+
+// The handheld scene's MPU-6050 mount: chip x right, y forward, z up.
+Mat3 handheldMount() {
+  Mat3 M;
+  M << 1, 0, 0, 0, 0, 1, 0, -1, 0;
+  return M;
+}
+
+// A still reading (m/s^2) for gravity `down` (projector frame) through the mount,
+// with a sensor offset (g).
+procam_tilt_sample reading(const Mat3& sensor_from_projector, const Vec3& down, const Vec3& offset,
+                           double t) {
+  const Vec3 f = sensor_from_projector * (-down) + offset;
+  procam_tilt_sample s{};
+  for (int i = 0; i < 3; ++i) s.specific_force[i] = f[i] * kG;
+  s.timestamp_ns = static_cast<uint64_t>(t * 1e9);
+  return s;
+}
+
+double angle(const Vec3& a, const Vec3& b) {
+  return std::atan2(a.cross(b).norm(), a.dot(b));
+}
+
+TEST(TiltTracker, CalibratedStillReadingsGiveTheTrueGravityAndFewUpdates) {
+  TiltMount mount;
+  mount.sensor_from_projector = handheldMount();
+  const Vec3 offset(0.05, -0.05, 0.05);  // the scene's bias, in g
+  mount.calibration.offset = offset;
+  auto tracker = TiltTracker::create(KeystoneConfig{}, mount);
+  ASSERT_TRUE(tracker) << tracker.error().message;
+  const Vec3 down =
+      keystone::rotationFromAngles({12 * kDeg, -7 * kDeg, 0}) * Vec3(0, 0, -1);  // world -Z
+  int published = 0;
+  std::optional<Vec3> last;
+  for (int k = 0; k < 2000; ++k) {  // 20 s at 100 Hz
+    // A few micro-g of zero-mean dither: identical readings would count as a
+    // stuck sensor (the sample gate).
+    const Vec3 dither = 1e-6 * Vec3((k * 7919) % 13 - 6, (k * 104729) % 11 - 5, (k * 31) % 7 - 3);
+    if (auto d =
+            tracker->add(reading(mount.sensor_from_projector, down, offset + dither, 0.01 * k))) {
+      ++published;
+      last = *d;
+    }
+  }
+  ASSERT_TRUE(last);
+  EXPECT_LT(angle(*last, down), 1e-6);
+  // The first sample, then refinements of the still hold after 2, 4, 8, 16 s.
+  EXPECT_LE(published, 6);
+  EXPECT_TRUE(tracker->still());
+  EXPECT_EQ(tracker->counts().accepted, 2000u);
+}
+
+TEST(TiltTracker, GarbageAndRepeatedSamplesAreDropped) {
+  auto tracker = TiltTracker::create(KeystoneConfig{}, TiltMount{});
+  ASSERT_TRUE(tracker);
+  const Vec3 down(0, 1, 0);
+  ASSERT_TRUE(tracker->add(reading(Mat3::Identity(), down, Vec3::Zero(), 1.0)));
+  // The same timestamp again (a timer faster than the sensor): ignored.
+  EXPECT_FALSE(tracker->add(reading(Mat3::Identity(), Vec3(1, 0, 0), Vec3::Zero(), 1.0)));
+  procam_tilt_sample nan = reading(Mat3::Identity(), down, Vec3::Zero(), 1.01);
+  nan.specific_force[0] = NAN;
+  EXPECT_FALSE(tracker->add(nan));
+  // |f| = 3 g: a shake, not gravity.
+  EXPECT_FALSE(tracker->add(reading(Mat3::Identity(), 3 * down, Vec3::Zero(), 1.02)));
+  EXPECT_EQ(tracker->counts().not_finite, 1u);
+  EXPECT_EQ(tracker->counts().bad_norm, 1u);
+}
+
+TEST(SolveFromDown, EqualsTheKeystoneSolveAtThatTilt) {
+  ProjectorModel p;
+  p.K = geom::Intrinsics{1400, 1400, 639.5, 359.5, 0};
+  p.width = 1280;
+  p.height = 720;
+  const keystone::Angles a{-15 * kDeg, 9 * kDeg, 0};
+  const Mat3 R = keystone::rotationFromAngles(a);
+  const Vec3 down = R * Vec3(0, 0, -1);
+  auto e = solveFromDown(p, down, 1920, 1080);
+  ASSERT_TRUE(e) << e.error().message;
+  keystone::KeystoneProblem problem{p.K, 1280, 720, R, 1920, 1080, {}};
+  auto truth = keystone::solveKeystone(problem);
+  ASSERT_TRUE(truth);
+  EXPECT_LT((e->H - truth->H).cwiseAbs().maxCoeff(), 1e-9 * truth->H.cwiseAbs().maxCoeff());
+  EXPECT_NEAR(e->angles.pitch, a.pitch, 1e-12);
+  EXPECT_NEAR(e->angles.roll, a.roll, 1e-12);
+  EXPECT_EQ(e->content_width, 1920);
+  // Tilted so far that part of the frame misses the wall: an error, not NaN.
+  const Vec3 up_steep = keystone::rotationFromAngles({89 * kDeg, 0, 0}) * Vec3(0, 0, -1);
+  EXPECT_FALSE(solveFromDown(p, up_steep, 1280, 720));
+}
+
+TEST(KeystoneConfigKeys, ParsedCheckedAndTheMountMustBeARotation) {
+  auto ok = parseConfig(
+      "[keystone]\ncutoff_hz = 5.0\nhysteresis_deg = 0.05\npoll_hz = 200\n"
+      "mount = [1, 0, 0, 0, 0, 1, 0, -1, 0]\naccel_offset_g = [0.01, 0.0, -0.02]\n",
+      "k.toml");
+  ASSERT_TRUE(ok) << ok.error().message;
+  EXPECT_EQ(ok->keystone.cutoff_hz, 5.0);
+  EXPECT_EQ(ok->keystone.hysteresis_deg, 0.05);
+  EXPECT_EQ(ok->keystone.poll_hz, 200.0);
+  auto mount = mountFromConfig(ok->keystone);
+  ASSERT_TRUE(mount);
+  EXPECT_EQ(mount->sensor_from_projector, handheldMount());
+  EXPECT_EQ(mount->calibration.offset, Vec3(0.01, 0.0, -0.02));
+
+  auto bad =
+      parseConfig("[keystone]\n\nhysteresis_deg = -1\nmount = [1, 2]\nspeed = 3\n", "k.toml");
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("k.toml:3: keystone.hysteresis_deg"), std::string::npos)
+      << bad.error().message;
+  EXPECT_NE(bad.error().message.find("keystone.mount: expected an array of 9 numbers"),
+            std::string::npos);
+  EXPECT_NE(bad.error().message.find("keystone.speed: unknown key"), std::string::npos);
+
+  KeystoneConfig skew;
+  skew.mount = std::array<double, 9>{1, 0, 0, 0, 1, 0, 0, 0.5, 1};
+  EXPECT_FALSE(mountFromConfig(skew));
+}
+
+struct TempDir {
+  std::filesystem::path path;
+  TempDir() {
+    char tmpl[] = "/tmp/procam-ak.XXXXXX";
+    path = ::mkdtemp(tmpl);
+  }
+  ~TempDir() { std::filesystem::remove_all(path); }
+};
+
+TEST(ProjectorFromRigFile, ReadsTheNamedProjectorsIntrinsics) {
+  TempDir dir;
+  EXPECT_EQ(projectorFromRigFile(dir.path, "proj").error().code, ErrorCode::kNotFound);
+  std::ofstream(dir.path / "rig.json")
+      << R"({"cameras": [], "projectors": [{"name": "proj", "width": 1920, "height": 1080,
+            "K": [2000, 0, 959.5, 0, 2010, 539.5, 0, 0, 1], "R": [1,0,0,0,1,0,0,0,1],
+            "t": [0, 0, 0]}]})";
+  auto p = projectorFromRigFile(dir.path, "proj");
+  ASSERT_TRUE(p) << p.error().message;
+  EXPECT_EQ(p->K.fx, 2000);
+  EXPECT_EQ(p->K.fy, 2010);
+  EXPECT_EQ(p->K.cx, 959.5);
+  EXPECT_EQ(p->width, 1920);
+  std::ofstream(dir.path / "rig.json") << R"({"projectors": [{"name": "proj", "K": [1, 2]}]})";
+  EXPECT_EQ(projectorFromRigFile(dir.path, "proj").error().code, ErrorCode::kParse);
+}
+
+TEST(OutputFrames, PatternsContentAndTheWarp) {
+  FrameRequest r;
+  r.output_size = cv::Size(64, 32);
+  r.pattern = "white";
+  auto white = renderOutputFrame(r);
+  ASSERT_TRUE(white) << white.error().message;
+  EXPECT_EQ(white->stats.source, "pattern:white");
+  EXPECT_DOUBLE_EQ(white->stats.lit_fraction, 1.0);
+  EXPECT_EQ(white->rgb.size(), r.output_size);
+
+  // Half size towards the origin, pixel edges to pixel edges: the top-left
+  // quarter (32 x 16 pixel centres) is lit.
+  Mat3 H;
+  H << 0.5, 0, -0.25, 0, 0.5, -0.25, 0, 0, 1;
+  r.homography = H;
+  auto quarter = renderOutputFrame(r);
+  ASSERT_TRUE(quarter);
+  EXPECT_DOUBLE_EQ(quarter->stats.lit_fraction, 0.25);
+
+  // A red 4x4 image in a 64x32 frame without a warp: fitted to 32x32, centred.
+  auto red = std::make_shared<cv::Mat>(4, 4, CV_8UC4, cv::Scalar(255, 0, 0, 255));
+  r.pattern = "off";
+  r.content = red;
+  r.homography.reset();
+  EXPECT_EQ(sourceSize(r), cv::Size(4, 4));
+  auto fitted = renderOutputFrame(r);
+  ASSERT_TRUE(fitted);
+  EXPECT_EQ(fitted->stats.source, "content");
+  EXPECT_DOUBLE_EQ(fitted->stats.lit_fraction, 0.5);
+  EXPECT_DOUBLE_EQ(fitted->stats.mean_rgb[0], 127.5);
+  EXPECT_DOUBLE_EQ(fitted->stats.mean_rgb[1], 0.0);
+  EXPECT_EQ(fitted->rgb.at<cv::Vec3b>(16, 32), cv::Vec3b(255, 0, 0));  // R G B
+  EXPECT_EQ(fitted->rgb.at<cv::Vec3b>(16, 8), cv::Vec3b(0, 0, 0));
+
+  r.content.reset();
+  auto none = renderOutputFrame(r);
+  ASSERT_TRUE(none);
+  EXPECT_EQ(none->stats.source, "none");
+  EXPECT_EQ(cv::countNonZero(none->rgb.reshape(1)), 0);
+}
+
+TEST(OutputFrames, DecodedContentIsRgba) {
+  TempDir dir;
+  const std::string png = (dir.path / "grey.png").string();
+  cv::imwrite(png, cv::Mat(3, 5, CV_8UC1, cv::Scalar(77)));
+  auto img = decodeContent(png);
+  ASSERT_TRUE(img) << img.error().message;
+  EXPECT_EQ((*img)->type(), CV_8UC4);
+  EXPECT_EQ((*img)->size(), cv::Size(5, 3));
+  EXPECT_EQ((*img)->at<cv::Vec4b>(1, 1), cv::Vec4b(77, 77, 77, 255));
+  EXPECT_EQ(decodeContent((dir.path / "none.png").string()).error().code, ErrorCode::kIo);
+}
+
+}  // namespace
+}  // namespace procam::daemon
