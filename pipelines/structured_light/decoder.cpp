@@ -39,7 +39,7 @@ struct Scratch {
   using U = std::make_unsigned_t<W>;
   std::vector<U> code, weak, bad;
   std::vector<W> min1, min2, firm, hi, lo;
-  std::vector<float> inv_contrast, sin_sum, cos_sum;
+  std::vector<float> inv_contrast, inv_linear_contrast, sin_sum, cos_sum;
   explicit Scratch(int n)
       : code(n),
         weak(n),
@@ -50,6 +50,7 @@ struct Scratch {
         hi(n),
         lo(n),
         inv_contrast(n),
+        inv_linear_contrast(n),
         sin_sum(n),
         cos_sum(n) {}
 };
@@ -82,12 +83,15 @@ class RowDecoder {
   using Rows = Scratch<W>;
 
  public:
+  // `linear`: code -> linear signal for the phase frames (empty: the identity).
   RowDecoder(const PatternSet& set, const std::vector<cv::Mat>& frames,
-             const DecodeOptions& options, double full_scale, Decoded& out)
+             const DecodeOptions& options, double full_scale, const std::vector<float>& linear,
+             Decoded& out)
       : set_(set),
         frames_(frames),
         o_(options),
         full_(static_cast<float>(full_scale)),
+        linear_(linear),
         out_(out),
         white_(findFrame(set, FrameKind::kWhite, Axis::kColumns, 0)),
         black_(findFrame(set, FrameKind::kBlack, Axis::kColumns, 0)),
@@ -119,6 +123,10 @@ class RowDecoder {
         if (b[x] >= saturated || (phase && w[x] >= saturated)) f |= kSaturated;
         flags[x] = f;
         s.inv_contrast[x] = contrast > 0 ? 1.0f / contrast : 0.0f;
+        if (phase) {
+          const float linear_contrast = linear_.empty() ? contrast : linear_[w[x]] - linear_[b[x]];
+          s.inv_linear_contrast[x] = linear_contrast > 0 ? 1.0f / linear_contrast : 0.0f;
+        }
         const float tol =
             static_cast<float>(o_.range_tolerance) * std::max(contrast, 0.0f) + tol_abs;
         s.hi[x] = static_cast<W>(std::lround(static_cast<float>(w[x]) + tol));
@@ -186,7 +194,8 @@ class RowDecoder {
       if (phase && f == 0) {
         // N-step phase: sum I_n cos(theta - delta_n) sin/cos(delta_n) = N/2 sin/cos(theta).
         const float sv = s.sin_sum[x], cv = s.cos_sum[x];
-        const float modulation = amplitude_scale * std::sqrt(sv * sv + cv * cv) * s.inv_contrast[x];
+        const float modulation =
+            amplitude_scale * std::sqrt(sv * sv + cv * cv) * s.inv_linear_contrast[x];
         if (modulation < o_.min_modulation) f |= kLowContrast;
         double wrapped = std::atan2(static_cast<double>(sv), static_cast<double>(cv)) / two_pi;
         if (wrapped < 0) wrapped += 1.0;
@@ -210,10 +219,19 @@ class RowDecoder {
     for (std::size_t n = 0; n < a.phase.size(); ++n) {
       const T* p = frames_[a.phase[n]].ptr<T>(y);
       const float sn = sin_[n], cn = cos_[n];
-      for (int x = 0; x < width; ++x) {
-        const float v = static_cast<float>(p[x]);
-        s.sin_sum[x] += v * sn;
-        s.cos_sum[x] += v * cn;
+      if (linear_.empty()) {
+        for (int x = 0; x < width; ++x) {
+          const float v = static_cast<float>(p[x]);
+          s.sin_sum[x] += v * sn;
+          s.cos_sum[x] += v * cn;
+        }
+      } else {
+        const float* lin = linear_.data();
+        for (int x = 0; x < width; ++x) {
+          const float v = lin[p[x]];
+          s.sin_sum[x] += v * sn;
+          s.cos_sum[x] += v * cn;
+        }
       }
     }
   }
@@ -222,11 +240,120 @@ class RowDecoder {
   const std::vector<cv::Mat>& frames_;
   const DecodeOptions& o_;
   float full_;
+  const std::vector<float>& linear_;
   Decoded& out_;
   int white_, black_;
   AxisFrames axes_[2];
   std::vector<float> sin_, cos_;
 };
+
+// The camera's response exponent g from the phase frames of one axis: with a
+// linear signal L = c^g (c the code over full scale), the N shifted sinusoids of a
+// pixel average to (L_white + L_black) / 2 whatever their phase, and the normalised
+// excess of that average decreases monotonically in g. Bisection on its median
+// over a sparse grid of well-lit, modulated pixels; 1 when it cannot be told.
+template <class T>
+double estimateResponseGamma(const std::vector<cv::Mat>& frames, int white, int black,
+                             const std::vector<int>& phase, double full, const DecodeOptions& o) {
+  const int n = static_cast<int>(phase.size());
+  const cv::Size size = frames[0].size();
+  const int stride = std::max(1, static_cast<int>(std::sqrt(size.area() / 3000.0)));
+  std::vector<float> logs;  // per pixel: log c_white, log c_black, log c_n ...
+  for (int y = stride / 2; y < size.height; y += stride) {
+    const T* w = frames[white].ptr<T>(y);
+    const T* b = frames[black].ptr<T>(y);
+    for (int x = stride / 2; x < size.width; x += stride) {
+      if (w[x] - static_cast<double>(b[x]) < 0.15 * full || w[x] >= o.saturation * full) continue;
+      double lo = w[x], hi = b[x];
+      for (int i : phase) {
+        const double v = frames[i].ptr<T>(y)[x];
+        lo = std::min(lo, v);
+        hi = std::max(hi, v);
+      }
+      if (hi - lo < 0.3 * (w[x] - static_cast<double>(b[x]))) continue;  // blurred out
+      auto lg = [full](double code) {
+        return static_cast<float>(std::log(std::max(code, 0.5) / full));
+      };
+      logs.push_back(lg(w[x]));
+      logs.push_back(lg(b[x]));
+      for (int i : phase) logs.push_back(lg(frames[i].ptr<T>(y)[x]));
+    }
+  }
+  const std::size_t per = static_cast<std::size_t>(n) + 2, pixels = logs.size() / per;
+  if (pixels < 50) return 1.0;
+  std::vector<double> excess(pixels);
+  auto medianExcess = [&](double g) {
+    for (std::size_t p = 0; p < pixels; ++p) {
+      const float* l = &logs[p * per];
+      const double lw = std::exp(g * l[0]), lb = std::exp(g * l[1]);
+      double mean = 0;
+      for (int i = 0; i < n; ++i) mean += std::exp(g * l[2 + i]);
+      excess[p] = (mean / n - 0.5 * (lw + lb)) / std::max(lw - lb, 1e-12);
+    }
+    std::nth_element(excess.begin(), excess.begin() + pixels / 2, excess.end());
+    return excess[pixels / 2];
+  };
+  double lo = 0.2, hi = 5.0;
+  if (medianExcess(lo) < 0 || medianExcess(hi) > 0) return 1.0;
+  for (int it = 0; it < 24; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (medianExcess(mid) > 0 ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+// Marks decoded pixels with fewer than `needed` consistent direct neighbours, and
+// (partial > 0) partly lit ones whose contrast is below `partial` of their
+// brightest neighbour's less `margin`; all read before any is dropped, so the
+// result does not depend on order.
+template <class T>
+void dropUnreliable(Decoded& d, const cv::Mat& white, const cv::Mat& black, float tol_u,
+                    float tol_v, int needed, float partial, float margin) {
+  const int w = d.u.cols, h = d.u.rows;
+  cv::Mat drop(d.u.size(), CV_8U, cv::Scalar(0));
+  cv::parallel_for_(cv::Range(0, h), [&](const cv::Range& rows) {
+    auto contrast = [&](int yy, int xx) {
+      return static_cast<float>(white.ptr<T>(yy)[xx]) - static_cast<float>(black.ptr<T>(yy)[xx]);
+    };
+    for (int y = rows.start; y < rows.end; ++y) {
+      const std::uint8_t* f = d.flags.ptr<std::uint8_t>(y);
+      const float* u = d.u.ptr<float>(y);
+      const float* v = d.v.ptr<float>(y);
+      std::uint8_t* out = drop.ptr<std::uint8_t>(y);
+      auto agrees = [&](int yy, int xx, int x) {
+        if (yy < 0 || yy >= h || xx < 0 || xx >= w) return 0;
+        if (d.flags.ptr<std::uint8_t>(yy)[xx] != 0) return 0;
+        return static_cast<int>(std::abs(d.u.ptr<float>(yy)[xx] - u[x]) <= tol_u &&
+                                std::abs(d.v.ptr<float>(yy)[xx] - v[x]) <= tol_v);
+      };
+      for (int x = 0; x < w; ++x) {
+        if (f[x] != 0) continue;
+        if (needed > 0) {
+          const int n =
+              agrees(y, x - 1, x) + agrees(y, x + 1, x) + agrees(y - 1, x, x) + agrees(y + 1, x, x);
+          if (n < needed) out[x] = kInconsistent;
+        }
+        if (partial > 0) {
+          float brightest = 0;
+          if (x > 0) brightest = std::max(brightest, contrast(y, x - 1));
+          if (x + 1 < w) brightest = std::max(brightest, contrast(y, x + 1));
+          if (y > 0) brightest = std::max(brightest, contrast(y - 1, x));
+          if (y + 1 < h) brightest = std::max(brightest, contrast(y + 1, x));
+          if (contrast(y, x) < partial * brightest - margin) out[x] |= kShadow;
+        }
+      }
+    }
+  });
+  for (int y = 0; y < h; ++y) {
+    const std::uint8_t* dr = drop.ptr<std::uint8_t>(y);
+    std::uint8_t* f = d.flags.ptr<std::uint8_t>(y);
+    float* u = d.u.ptr<float>(y);
+    float* v = d.v.ptr<float>(y);
+    float* c = d.confidence.ptr<float>(y);
+    for (int x = 0; x < w; ++x)
+      if (dr[x]) f[x] |= dr[x], u[x] = v[x] = -1.0f, c[x] = 0.0f;
+  }
+}
 
 }  // namespace
 
@@ -276,7 +403,32 @@ Result<Decoded> decode(const PatternSet& set, std::span<const cv::Mat> captures,
         }
     }
   }
+  // Phase frames through the inverse camera response (identity when ~linear).
+  std::vector<float> linear;
+  double gamma = 1.0;
+  if (set.phaseSteps() > 0) {
+    gamma = options.response_gamma;
+    if (!(gamma > 0)) {
+      const int white = findFrame(set, FrameKind::kWhite, Axis::kColumns, 0);
+      const int black = findFrame(set, FrameKind::kBlack, Axis::kColumns, 0);
+      std::vector<int> phase;
+      for (int i = 0; i < set.phaseSteps(); ++i)
+        phase.push_back(findFrame(set, FrameKind::kPhase, Axis::kColumns, i));
+      gamma =
+          depth == CV_8U
+              ? estimateResponseGamma<std::uint8_t>(frames, white, black, phase, full, options)
+              : estimateResponseGamma<std::uint16_t>(frames, white, black, phase, full, options);
+    }
+    if (std::abs(gamma - 1.0) > 0.03) {
+      linear.resize(depth == CV_8U ? 256 : 65536);
+      for (std::size_t c = 0; c < linear.size(); ++c)
+        linear[c] = static_cast<float>(full * std::pow(static_cast<double>(c) / full, gamma));
+    } else {
+      gamma = 1.0;
+    }
+  }
   Decoded out;
+  out.response_gamma = gamma;
   out.u.create(size, CV_32F);
   out.v.create(size, CV_32F);
   out.confidence.create(size, CV_32F);
@@ -284,10 +436,28 @@ Result<Decoded> decode(const PatternSet& set, std::span<const cv::Mat> captures,
   const int stripes = std::max(1, size.height / 8);
   if (depth == CV_8U) {
     cv::parallel_for_(cv::Range(0, size.height),
-                      RowDecoder<std::uint8_t>(set, frames, options, full, out), stripes);
+                      RowDecoder<std::uint8_t>(set, frames, options, full, linear, out), stripes);
   } else {
     cv::parallel_for_(cv::Range(0, size.height),
-                      RowDecoder<std::uint16_t>(set, frames, options, full, out), stripes);
+                      RowDecoder<std::uint16_t>(set, frames, options, full, linear, out), stripes);
+  }
+  if (options.min_consistent_neighbours > 0 || options.partial_contrast > 0) {
+    const bool phase = set.phaseSteps() > 0;
+    const double tol = options.neighbour_tolerance;
+    const auto tol_u = static_cast<float>(tol + (phase ? 0 : set.columns.cell));
+    const auto tol_v = static_cast<float>(tol + (phase ? 0 : set.rows.cell));
+    const cv::Mat& white =
+        frames[static_cast<std::size_t>(findFrame(set, FrameKind::kWhite, Axis::kColumns, 0))];
+    const cv::Mat& black =
+        frames[static_cast<std::size_t>(findFrame(set, FrameKind::kBlack, Axis::kColumns, 0))];
+    const auto partial = static_cast<float>(std::max(0.0, options.partial_contrast));
+    const auto margin = static_cast<float>(0.02 * full);
+    if (depth == CV_8U)
+      dropUnreliable<std::uint8_t>(out, white, black, tol_u, tol_v,
+                                   options.min_consistent_neighbours, partial, margin);
+    else
+      dropUnreliable<std::uint16_t>(out, white, black, tol_u, tol_v,
+                                    options.min_consistent_neighbours, partial, margin);
   }
   out.decoded = size.area() - cv::countNonZero(out.flags);
   return out;

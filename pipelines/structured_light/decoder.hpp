@@ -33,13 +33,35 @@ struct DecodeOptions {
   // 0: 255 for 8-bit captures; for 16-bit ones the smallest 2^b - 1 (b = 10, 12, 14,
   // 16) covering the white frame, as 10- and 12-bit sensors store codes in 16 bits.
   double full_scale = 0;
+  // The camera's response exponent g (code = full * linear^(1/g)) applied inverted
+  // to the phase frames before the phase computation: a sinusoid seen through a
+  // non-linear response gains harmonics, and with few shifts (N = 3) the second
+  // aliases onto the fundamental. 0: estimated from the captures (the linearised
+  // shifted frames of a pixel average to midway between its black and white);
+  // 1: linear. Gray bits compare a frame with its inverse and need no linearising.
+  double response_gamma = 0;
+  // A decoded pixel needs this many of its 4 direct neighbours decoded and within
+  // neighbour_tolerance projector pixels (plus one Gray cell without phase) on both
+  // axes; an isolated decode is a noise-flipped bit, not a surface (kInconsistent).
+  // 0: off.
+  int min_consistent_neighbours = 2;
+  double neighbour_tolerance = 4.0;
+  // Partly lit pixels (kShadow): white - black below this fraction of the largest
+  // of its 4 direct neighbours', less 2% of full scale for noise. A camera pixel
+  // straddling the edge of the lit area, a shadow or an occlusion mixes lit and
+  // unlit light, and its code or phase is that of the lit part's centroid, not of
+  // the pixel centre (up to a camera pixel off). Contrast varies smoothly across a
+  // surface, so this drops only such edges and the dark side of sharp albedo edges.
+  // 0: off.
+  double partial_contrast = 0.85;
 };
 
 struct Decoded {
-  cv::Mat u, v;        // CV_32F, projector pixel coordinates; -1 where undecoded
-  cv::Mat confidence;  // CV_32F in [0, 1]; 0 where undecoded
-  cv::Mat flags;       // CV_8U, DecodeFlag bits; 0 where decoded
-  int decoded = 0;     // pixels with flags == 0
+  cv::Mat u, v;               // CV_32F, projector pixel coordinates; -1 where undecoded
+  cv::Mat confidence;         // CV_32F in [0, 1]; 0 where undecoded
+  cv::Mat flags;              // CV_8U, DecodeFlag bits; 0 where decoded
+  int decoded = 0;            // pixels with flags == 0
+  double response_gamma = 1;  // the camera response exponent the phase frames were linearised with
 };
 
 // captures[i] shows set.frames[i]; all the same size, CV_8UC1/CV_16UC1 (3-channel

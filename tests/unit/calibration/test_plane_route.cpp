@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include "calibration/projector_calibration.hpp"
+#include "geometry/projection_matrix.hpp"
 #include "synthetic_rig.hpp"
 
 using namespace procam;
@@ -103,4 +104,52 @@ TEST(RouteB, OneOrientationOrParallelPlanesAreRejected) {
   EXPECT_TRUE(c.error().code == ErrorCode::kDegenerate ||
               c.error().code == ErrorCode::kNoConvergence)
       << c.error().message;
+}
+
+// Why route (b) fixes three intrinsics: with the camera frame as reference, for any
+// w the projector K'R' = KR + (Kt) w^T, t' = K'^-1 K t seeing the planes m_i' = m_i - w
+// (m_i . X = 1) reproduces every correspondence of every plane exactly, while K'
+// has skew, non-square pixels and a shifted c_x (plane_route.cpp).
+TEST(RouteB, BlankPlanesLeaveAThreeParameterFamilyOfIntrinsics) {
+  const auto projector = procam::testing::squarePixelProjector();
+  const auto camera = procam::testing::camera640();
+  // The projector in the camera frame: x_p = R x_c + t.
+  const Mat3 R = projector.pose.R * camera.pose.R.transpose();
+  const Vec3 t = projector.pose.t - R * camera.pose.t;
+  const Mat3 K = projector.K.matrix();
+  const Vec3 centre(0.0, 0.3, 0.5);
+  std::vector<geom::Plane> planes = {
+      planeThrough(centre, Eigen::AngleAxisd(0.44, Vec3::UnitZ()) * Vec3(0, -1, 0)),
+      planeThrough(centre, Eigen::AngleAxisd(-0.35, Vec3::UnitX()) * Vec3(0, -1, 0))};
+  for (const Vec3& w : {Vec3(0.03, -0.02, 0.01), Vec3(-0.05, 0.04, -0.03)}) {
+    Mat34 P;
+    P.leftCols<3>() = K * R + K * t * w.transpose();
+    P.col(3) = K * t;
+    auto alt = geom::decomposeProjectionMatrix(P);
+    ASSERT_TRUE(alt);
+    const Mat3 K2 = alt->K.matrix();
+    // Far outside what the route's tolerances would accept as the same projector.
+    EXPECT_GT(std::abs(alt->K.skew) + std::abs(alt->K.fx - alt->K.fy) +
+                  std::abs(alt->K.cx - projector.K.cx),
+              20.0);
+    double worst = 0;
+    int n = 0;
+    for (const geom::Plane& plane : planes) {
+      // Plane in the camera frame as m . x_c = 1.
+      const Vec3 n_c = camera.pose.R * plane.n;
+      const Vec3 m = n_c / (n_c.dot(camera.pose.t) - plane.d);
+      const Vec3 m2 = m - w;
+      for (int y = 0; y < projector.height; y += 64)
+        for (int x = 0; x < projector.width; x += 64) {
+          auto X = procam::testing::litPoint(projector, Vec2(x, y), plane);
+          ASSERT_TRUE(X);
+          const Vec3 ray = camera.pose.toDevice(*X);  // the camera sees X along this ray
+          const Vec3 seen = K2 * (alt->pose.R * (ray / m2.dot(ray)) + alt->pose.t);
+          worst = std::max(worst, (seen.hnormalized() - Vec2(x, y)).norm());
+          ++n;
+        }
+    }
+    EXPECT_GT(n, 200);
+    EXPECT_LT(worst, 1e-6);
+  }
 }

@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "calibration/projector_calibration.hpp"
-#include "rig_capture.hpp"
+#include "issue_scenes.hpp"
 #include "structured_light/decoder.hpp"
 #include "surface/projector_samples.hpp"
 #include "surface/stereo_points.hpp"
@@ -15,48 +15,16 @@ using namespace procam;
 
 namespace {
 
-// Half-resolution corner_stereo with the issue's camera: 8 bits, read noise 1 DN, no
-// shot noise, linear response; exposure and ambient set for white ~75% of full scale
-// and ambient 10% of white on the back wall.
 std::string cornerStereo() {
-  std::string t = procam::testing::sceneText("corner_stereo");
-  using procam::testing::edit;
-  EXPECT_TRUE(procam::testing::scaleDevice(t, 1280, 800, 0.5));
-  EXPECT_TRUE(procam::testing::scaleDevice(t, 1024, 768, 0.5));  // cam_left
-  EXPECT_TRUE(procam::testing::scaleDevice(t, 1024, 768, 0.5));  // cam_right
-  EXPECT_TRUE(edit(t, "bit_depth = 10", "bit_depth = 8"));
-  EXPECT_TRUE(edit(t, "read_noise_dn = 2.0", "read_noise_dn = 1.0"));
-  EXPECT_TRUE(edit(t, "full_well_e = 10000.0\n", ""));  // no shot noise
-  return procam::testing::withIssueLighting(t, "cam_left", "0.02", "bit_depth = 8");
+  std::string t = procam::testing::issueCornerStereo();
+  EXPECT_FALSE(t.empty());
+  return t;
 }
 
-// wall_oblique (projector at half, camera at quarter resolution) with the issue's
-// camera and a second camera (route a
-// needs a pair); `wall_yaw_deg` turns the wall about the vertical through its centre.
 std::string wallOblique(double wall_yaw_deg) {
-  std::string t = procam::testing::sceneText("wall_oblique");
-  using procam::testing::edit;
-  EXPECT_TRUE(procam::testing::scaleDevice(t, 1920, 1080, 0.5));
-  EXPECT_TRUE(procam::testing::scaleDevice(t, 1280, 960, 0.25));
-  EXPECT_TRUE(edit(t, "exposure = 1.0\n", ""));
-  EXPECT_TRUE(edit(t, "read_noise_dn = 0.8", "read_noise_dn = 1.0"));
-  EXPECT_TRUE(edit(t, "full_well_e = 12000.0\n", ""));  // no shot noise
-  const double a = wall_yaw_deg * M_PI / 180;
-  char normal[96];
-  std::snprintf(normal, sizeof normal, "normal = [%.6f, %.6f, 0.0]\nsize = [8.0, 4.0]", std::sin(a),
-                -std::cos(a));
-  EXPECT_TRUE(edit(t, "normal = [0.0, -1.0, 0.0]\nsize = [8.0, 4.0]", normal));
-  t += R"(
-[[cameras]]
-name = "cam2"
-resolution = [320, 240]
-intrinsics = { fx = 287.5, fy = 287.5, cx = 159.5, cy = 119.5 }
-pose = { position = [0.6, 0.3, 1.2], look_at = [-0.3, 3.0, 1.5] }
-bit_depth = 8
-read_noise_dn = 1.0
-supersamples = 4
-)";
-  return procam::testing::withIssueLighting(t, "cam", "0.02", "bit_depth = 8");
+  std::string t = procam::testing::issueWallOblique(wall_yaw_deg);
+  EXPECT_FALSE(t.empty());
+  return t;
 }
 
 sim::Scene parse(const std::string& text) {
@@ -128,17 +96,23 @@ TEST(RigAccuracy, SignalLevelsAreTheIssues) {
   EXPECT_NEAR(black_level / white_level, 0.1, 0.03);
 }
 
+// Gray alone <= 0.5 px, Gray + N-step phase <= 0.1 px for N = 3 and 8.
 TEST(RigAccuracy, CorrespondencesGrayAndGrayPhase) {
   const sim::Scene scene = parse(cornerStereo());
-  for (sl::Mode mode : {sl::Mode::kGray, sl::Mode::kGrayPhase}) {
-    const bool phase = mode == sl::Mode::kGrayPhase;
+  for (int steps : {0, 3, 8}) {
+    const bool phase = steps > 0;
+    const std::string what = phase ? "gray+" + std::to_string(steps) + "phase" : "gray";
     const sl::PatternSet set =
-        phase ? cornerPhaseSet() : *sl::makePatternSet({.width = 640, .height = 400});
+        steps == 8 ? cornerPhaseSet()
+                   : *sl::makePatternSet({.width = 640,
+                                          .height = 400,
+                                          .mode = phase ? sl::Mode::kGrayPhase : sl::Mode::kGray,
+                                          .phase_steps = std::max(steps, 3)});
     std::vector<cv::Mat> left;
-    if (phase) {
+    if (steps == 8) {
       left = cornerPhaseCaptures(scene, set).at("cam_left");
     } else {
-      auto captures = procam::testing::capture(scene, set, 3, {"cam_left"});
+      auto captures = procam::testing::capture(scene, set, 3 + steps, {"cam_left"});
       ASSERT_TRUE(captures) << captures.error().message;
       left = captures->at("cam_left");
     }
@@ -147,10 +121,12 @@ TEST(RigAccuracy, CorrespondencesGrayAndGrayPhase) {
     const AxisError e = correspondenceError(scene, "cam_left", *d);
     // A camera pixel here spans about two projector pixels, so the finest Gray stripes
     // are blurred away at many pixels, which the decoder then refuses (low contrast).
-    EXPECT_GT(e.pixels, (phase ? 0.9 : 0.5) * e.lit) << sl::toString(mode);
-    EXPECT_LE(e.rms, phase ? 0.1 : 0.5) << sl::toString(mode);
-    std::printf("[ figures  ] %s: %.4f projector px RMS per axis over %d of %d lit pixels\n",
-                sl::toString(mode), e.rms, e.pixels, e.lit);
+    EXPECT_GT(e.pixels, (phase ? 0.9 : 0.5) * e.lit) << what;
+    EXPECT_LE(e.rms, phase ? 0.1 : 0.5) << what;
+    std::printf(
+        "[ figures  ] %s: %.4f projector px RMS per axis over %d of %d lit pixels (camera "
+        "response exponent %.3f)\n",
+        what.c_str(), e.rms, e.pixels, e.lit, d->response_gamma);
   }
 }
 
