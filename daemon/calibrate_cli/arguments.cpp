@@ -6,6 +6,18 @@
 #include <cstdlib>
 
 namespace procam::cli {
+namespace {
+
+// Malformed command lines exit with 2 (main.cpp), every other error with 1.
+tl::unexpected<Error> usage(const std::string& message) {
+  return tl::unexpected(Error{ErrorCode::kInvalidInput, kCommandLine + message});
+}
+
+}  // namespace
+
+bool isCommandLineError(const Error& e) {
+  return e.message.rfind(kCommandLine, 0) == 0;
+}
 
 Result<Arguments> Arguments::parse(int argc, char** argv, int first) {
   Arguments a;
@@ -14,11 +26,10 @@ Result<Arguments> Arguments::parse(int argc, char** argv, int first) {
     const std::string word = argv[i];
     if (word.rfind("--", 0) == 0 && word.size() > 2) {
       current = word.substr(2);
-      if (a.values_.count(current))
-        return fail(ErrorCode::kInvalidInput, "option --" + current + " given twice");
+      if (a.values_.count(current)) return usage("option --" + current + " given twice");
       a.values_[current];
     } else if (current.empty()) {
-      return fail(ErrorCode::kInvalidInput, "unexpected argument '" + word + "'");
+      return usage("unexpected argument '" + word + "'");
     } else {
       a.values_[current].push_back(word);
     }
@@ -28,9 +39,8 @@ Result<Arguments> Arguments::parse(int argc, char** argv, int first) {
 
 Result<std::string> Arguments::one(const std::string& name) const {
   auto it = values_.find(name);
-  if (it == values_.end()) return fail(ErrorCode::kInvalidInput, "missing --" + name);
-  if (it->second.size() != 1)
-    return fail(ErrorCode::kInvalidInput, "--" + name + " takes one value");
+  if (it == values_.end()) return usage("missing --" + name);
+  if (it->second.size() != 1) return usage("--" + name + " takes one value");
   return it->second[0];
 }
 
@@ -50,7 +60,7 @@ Result<void> Arguments::only(const std::vector<std::string>& known) const {
   for (const auto& [name, v] : values_) {
     bool ok = false;
     for (const auto& k : known) ok |= k == name;
-    if (!ok) return fail(ErrorCode::kInvalidInput, "unknown option --" + name);
+    if (!ok) return usage("unknown option --" + name);
   }
   return {};
 }
@@ -59,7 +69,7 @@ Result<int> toInt(const std::string& text, const std::string& what) {
   int v = 0;
   auto [p, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
   if (ec != std::errc() || p != text.data() + text.size())
-    return fail(ErrorCode::kInvalidInput, what + ": '" + text + "' is not an integer");
+    return usage(what + ": '" + text + "' is not an integer");
   return v;
 }
 
@@ -67,7 +77,7 @@ Result<double> toDouble(const std::string& text, const std::string& what) {
   char* end = nullptr;
   const double v = std::strtod(text.c_str(), &end);
   if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v))
-    return fail(ErrorCode::kInvalidInput, what + ": '" + text + "' is not a number");
+    return usage(what + ": '" + text + "' is not a number");
   return v;
 }
 
@@ -75,7 +85,7 @@ Result<std::pair<int, int>> toSize(const std::string& text, const std::string& w
   int w = 0, h = 0, n = 0;
   if (std::sscanf(text.c_str(), "%dx%d%n", &w, &h, &n) != 2 || n != static_cast<int>(text.size()) ||
       w < 1 || h < 1)
-    return fail(ErrorCode::kInvalidInput, what + ": expected WIDTHxHEIGHT, got '" + text + "'");
+    return usage(what + ": expected WIDTHxHEIGHT, got '" + text + "'");
   return std::pair{w, h};
 }
 

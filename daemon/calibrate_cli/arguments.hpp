@@ -26,6 +26,10 @@ class Arguments {
   std::map<std::string, std::vector<std::string>> values_;
 };
 
+// Errors of the helpers here start with this: a malformed command line (exit 2).
+inline const std::string kCommandLine = "command line: ";
+bool isCommandLineError(const Error& e);
+
 Result<int> toInt(const std::string& text, const std::string& what);
 Result<double> toDouble(const std::string& text, const std::string& what);
 // "WxH"

@@ -49,7 +49,12 @@ Result<sl::Decoded> decodeDir(const sl::PatternSet& set, const std::string& dir,
   auto frames = readCaptures(set, dir);
   if (!frames) return tl::unexpected(frames.error());
   auto d = sl::decode(set, *frames);
-  if (d) progress("  " + std::to_string(d->decoded) + " camera pixels decoded");
+  if (!d) return d;
+  progress("  " + std::to_string(d->decoded) + " camera pixels decoded");
+  if (d->decoded == 0)
+    return fail(ErrorCode::kTooFewPoints, "no camera pixel of " + dir +
+                                              " could be decoded (projector not visible, or "
+                                              "captures in the wrong order?)");
   return d;
 }
 
@@ -191,6 +196,10 @@ Result<void> runSolve(const Arguments& a) {
                 "only " + std::to_string(points->world.size()) +
                     " projector nodes were seen by both cameras (need 20)");
   auto projector = calib::calibrateProjectorFromSurface(*points);
+  if (!projector && projector.error().code == ErrorCode::kCoplanar)
+    return fail(ErrorCode::kCoplanar, projector.error().message +
+                                          " (procam-calibrate solve-planes, with captures of "
+                                          "the plane at two or more orientations)");
   if (!projector) return asVoid(projector);
   // The surface from the points consistent with the calibrated projector.
   const surface::SurfacePoints kept = surface::keepPoints(*points, projector->inliers);

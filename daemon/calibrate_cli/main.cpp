@@ -53,6 +53,11 @@ int main(int argc, char** argv) {
       return 2;
     }
     auto r = c.run(*args);
+    if (!r && procam::cli::isCommandLineError(r.error())) {
+      std::fprintf(stderr, "procam-calibrate %s: %s\n%s", c.name, r.error().message.c_str(),
+                   kUsage);
+      return 2;
+    }
     if (!r) {
       std::fprintf(stderr, "procam-calibrate %s: error (%s): %s\n", c.name,
                    procam::toString(r.error().code), r.error().message.c_str());
