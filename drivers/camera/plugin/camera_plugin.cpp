@@ -6,6 +6,7 @@ extern "C" const procam_plugin_table* procam_camera_plugin_entry(void) {
   // Built on first call: the factories live in other translation units.
   static const procam_driver_factory factories[] = {
     kReplayFactory,
+    kV4l2Factory,
 #if PROCAM_CAMERA_ARAVIS
     kAravisFactory,
 #endif

@@ -1,0 +1,93 @@
+// The "v4l2" camera driver: V4l2Camera behind the plugin ABI.
+#include <cmath>
+#include <cstring>
+#include <exception>
+
+#include "camera/plugin/camera_device.hpp"
+#include "camera/plugin/camera_plugin.hpp"
+#include "camera/v4l2/v4l2_camera.hpp"
+
+namespace procam::camera::plugin {
+namespace {
+
+// udev (70-procamd.rules) tags V4L2 capture nodes PROCAM_ROLE=camera.
+int probe(const procam_device_desc* d) {
+  if (!d || d->family != PROCAM_FAMILY_CAMERA || descProperty(d, "PROCAM_ROLE") != "camera")
+    return 0;
+  const bool v4l2 = (d->subsystem && std::strcmp(d->subsystem, "video4linux") == 0) ||
+                    (d->devnode && std::strncmp(d->devnode, "/dev/video", 10) == 0);
+  return v4l2 ? 50 : 0;
+}
+
+CamResult<uint32_t> count(const CameraOptions& o, const char* key, uint32_t fallback) {
+  auto v = o.number(key);
+  if (!v) return tl::unexpected(v.error());
+  if (!*v) return fallback;
+  if (**v < 0 || **v > 65535 || std::floor(**v) != **v)
+    return camFail(Status::kInvalid,
+                   "v4l2 camera: option " + std::string(key) + " must be a whole number 0..65535");
+  return uint32_t(**v);
+}
+
+CamResult<V4l2Options> parse(const procam_device_desc* d, const CameraOptions& o) {
+  if (auto ok = o.onlyKnown({"device", "width", "height", "format", "fps", "buffers", "pixel",
+                             PROCAM_CAMERA_CONTROL_KEYS});
+      !ok)
+    return tl::unexpected(ok.error());
+  V4l2Options v;
+  v.device = o.text("device").value_or(d && d->devnode ? d->devnode : "");
+  if (v.device.empty())
+    return camFail(Status::kInvalid, "v4l2 camera: no device node: give the option device");
+  auto w = count(o, "width", 0);
+  auto h = count(o, "height", 0);
+  auto n = count(o, "buffers", 4);
+  auto fps = o.number("fps");
+  auto pixel = o.pixel();
+  for (auto* r : {&w, &h, &n})
+    if (!*r) return tl::unexpected(r->error());
+  if (!fps) return tl::unexpected(fps.error());
+  if (!pixel) return tl::unexpected(pixel.error());
+  if ((*w == 0) != (*h == 0))
+    return camFail(Status::kInvalid, "v4l2 camera: give both width and height, or neither");
+  v.width = *w;
+  v.height = *h;
+  v.buffers = *n;
+  v.fps = fps->value_or(0);
+  if (v.fps < 0) return camFail(Status::kInvalid, "v4l2 camera: fps must be > 0");
+  v.pixel = *pixel;
+  if (auto f = o.text("format")) {
+    v.fourcc = parseFourcc(*f);
+    if (!v.fourcc)
+      return camFail(Status::kInvalid, "v4l2 camera: option format: '" + *f +
+                                           "' is not one of GREY, Y16, YUYV, MJPG, RGB3, BGR3");
+  }
+  return v;
+}
+
+}  // namespace
+
+int createV4l2On(std::unique_ptr<V4l2Io> io, const procam_device_desc* d,
+                 const procam_config* config, procam_device* out, char* err, std::size_t len) {
+  try {
+    const CameraOptions o("v4l2", config);
+    auto v = parse(d, o);
+    if (!v) return report(err, len, v.error());
+    return finishCameraDevice(std::make_unique<V4l2Camera>(*v, std::move(io)), o, out, err, len);
+  } catch (const std::exception& e) {
+    return report(err, len, {Status::kInternal, e.what()});
+  }
+}
+
+namespace {
+
+int create(const procam_device_desc* d, const procam_config* config, procam_device* out, char* err,
+           std::size_t len) {
+  return createV4l2On(systemV4l2Io(), d, config, out, err, len);
+}
+
+}  // namespace
+
+const procam_driver_factory kV4l2Factory = {
+    PROCAM_FAMILY_CAMERA, "v4l2", "Video4Linux2 capture device (mmap streaming)", &probe, &create};
+
+}  // namespace procam::camera::plugin
