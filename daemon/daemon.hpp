@@ -89,6 +89,7 @@ class Daemon {
   std::optional<Mat3> currentWarp(cv::Size content_size) const;
   cv::Size currentSourceSize() const;
   void refreshOutputs(std::function<void(bool shown)> done = {});
+  bool calibrating() const;
   void loadContentAtStart();
   nlohmann::json outputsJson() const;
   Result<void> reloadConfig();

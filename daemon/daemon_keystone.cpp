@@ -410,6 +410,14 @@ void Daemon::cmdKeystone(ClientId client, const proto::Request& req) {
   replyTo(client, req, "KEYSTONE", keystoneJson());
 }
 
+bool Daemon::calibrating() const {
+  // The calibrate operation shows its own pattern frames on the outputs.
+  for (const auto& [id, op] : operations_) {
+    if (op.kind == "calibrate") return true;
+  }
+  return false;
+}
+
 void Daemon::refreshOutputs(std::function<void(bool shown)> done) {
   KeystoneRuntime& k = keystone_rt_;
   if (done) k.frame_waiters.push_back(std::move(done));
@@ -431,7 +439,7 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done) {
   }
   auto waiters = std::move(k.frame_waiters);
   k.frame_waiters.clear();
-  if (jobs.empty()) {
+  if (jobs.empty() || calibrating()) {
     for (auto& w : waiters) w(false);
     return;
   }
@@ -450,6 +458,8 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done) {
       KeystoneRuntime& k = keystone_rt_;
       k.rendering = false;
       bool shown = false;
+      // A calibration started meanwhile owns the outputs: its frames stay.
+      if (calibrating()) frames->clear();
       for (auto& [name, frame] : *frames) {
         if (!frame) {
           warn("output '" + name + "': " + frame.error().message);
