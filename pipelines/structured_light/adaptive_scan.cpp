@@ -90,7 +90,95 @@ Result<PlanarityTest> testPlanarity(const PatternSet& coarse, const Decoded& d,
   if (!fit) return tl::unexpected(fit.error());
   t.H = fit->H;
   t.rms_px = fit->rms;
-  t.tolerance_px = o.planar_tolerance * std::min(coarse.columns.cell, coarse.rows.cell);
+  // A block's camera centroid is not the image of its centre: perspective (and lens
+  // distortion) weight its pixels unevenly, a second-order bias that grows with the
+  // block and the obliquity. Refine: map every undistorted pixel of a kept block
+  // through H, weighted by the projector area it covers (|det J_H| ~ 1/w^3), so the
+  // weighted mean is the block centre for the true H; the camera point is H^-1 of
+  // that mean, and H is refitted to those points.
+  std::vector<int> kept(blocks.size(), -1);
+  std::vector<double> areas;  // projector pixels of each kept block
+  for (int j = 0; j < by; ++j)
+    for (int i = 0; i < bx; ++i) {
+      const BlockSum& b = blocks[static_cast<std::size_t>(j) * bx + i];
+      if (b.touches_border || b.count < 0.6 * median || b.count < 4) continue;
+      kept[static_cast<std::size_t>(j) * bx + i] = static_cast<int>(areas.size());
+      areas.push_back(static_cast<double>(std::min(
+                          coarse.columns.cell, coarse.columns.extent - i * coarse.columns.cell)) *
+                      std::min(coarse.rows.cell, coarse.rows.extent - j * coarse.rows.cell));
+    }
+  struct Pixel {
+    Vec2 p;
+    int block;
+  };
+  std::vector<Pixel> pixels;
+  for (int y = 0; y < h; ++y) {
+    const float* u = d.u.ptr<float>(y);
+    const float* v = d.v.ptr<float>(y);
+    const std::uint8_t* f = d.flags.ptr<std::uint8_t>(y);
+    for (int x = 0; x < w; ++x) {
+      if (f[x] != 0) continue;
+      const int i = std::clamp(static_cast<int>(u[x]) / coarse.columns.cell, 0, bx - 1);
+      const int j = std::clamp(static_cast<int>(v[x]) / coarse.rows.cell, 0, by - 1);
+      const int b = kept[static_cast<std::size_t>(j) * bx + i];
+      if (b < 0) continue;
+      pixels.push_back({o.undistort ? o.undistort(Vec2(x, y)) : Vec2(x, y), b});
+    }
+  }
+  // Blocks partly hidden (cut by the edge of the surface or an occluder) have
+  // centres no weighting can recover: a block keeps its place in the fit only with
+  // at least 90% of the camera pixels H predicts for it (its projector area over
+  // |det J_H|).
+  std::vector<int> seen(t.camera.size(), 0);
+  for (const Pixel& px : pixels) ++seen[static_cast<std::size_t>(px.block)];
+  const Points2 all_projector = t.projector;
+  Points2 all_camera = t.camera;
+  for (int round = 0; round < 3; ++round) {
+    std::vector<Vec3> sums(all_camera.size(), Vec3::Zero());  // weighted x, y and weight
+    for (const Pixel& px : pixels) {
+      const Vec3 q = t.H * px.p.homogeneous();
+      if (std::abs(q.z()) < 1e-12) continue;
+      const double weight = 1.0 / std::abs(q.z() * q.z() * q.z());
+      sums[static_cast<std::size_t>(px.block)] +=
+          Vec3(weight * q.x() / q.z(), weight * q.y() / q.z(), weight);
+    }
+    const Mat3 Hinv = t.H.inverse();
+    const double det = std::abs(t.H.determinant());
+    Points2 camera, projector;
+    for (std::size_t b = 0; b < sums.size(); ++b) {
+      auto c = sums[b].z() > 0 ? geom::applyHomography(Hinv, sums[b].head<2>() / sums[b].z())
+                               : std::optional<Vec2>();
+      if (c) all_camera[b] = *c;
+      const double w = std::abs((t.H * all_camera[b].homogeneous()).z());
+      const double expected = areas[b] * w * w * w / std::max(det, 1e-300);
+      if (seen[b] < 0.9 * expected) continue;
+      camera.push_back(all_camera[b]);
+      projector.push_back(all_projector[b]);
+    }
+    if (camera.size() < 8) break;
+    auto refit = geom::fitHomography(camera, projector);
+    if (!refit) break;
+    t.camera = std::move(camera);
+    t.projector = std::move(projector);
+    t.H = refit->H;
+    t.rms_px = refit->rms;
+  }
+  // The camera locates a block only to a fraction of its own pixel: the tolerance is
+  // at least camera_tolerance_px camera pixels at the projector-per-camera-pixel
+  // scale sqrt|det J_H| of the median block.
+  std::vector<double> scales;
+  const double det = std::abs(t.H.determinant());
+  for (const Vec2& c : t.camera) {
+    const double w = std::abs((t.H * c.homogeneous()).z());
+    if (w > 0) scales.push_back(std::sqrt(det / (w * w * w)));
+  }
+  double scale = 0;
+  if (!scales.empty()) {
+    std::nth_element(scales.begin(), scales.begin() + scales.size() / 2, scales.end());
+    scale = scales[scales.size() / 2];
+  }
+  t.tolerance_px = std::max(o.planar_tolerance * std::min(coarse.columns.cell, coarse.rows.cell),
+                            o.camera_tolerance_px * scale);
   t.planar = t.rms_px <= t.tolerance_px;
   return t;
 }

@@ -23,6 +23,10 @@ struct AdaptiveOptions {
   // fraction of the block size, RMS in projector pixels (block centroids are biased
   // by perspective to second order, so this is not a pixel-level test).
   double planar_tolerance = 0.015;
+  // ... and at least this many camera pixels (a coarse camera sees a block's centre
+  // only to a fraction of its pixel), converted at the view's projector-per-camera
+  // pixel scale.
+  double camera_tolerance_px = 0.35;
   DecodeOptions decode;
   // Camera pixel -> undistorted pixel (lens distortion breaks the homography);
   // identity when empty.
