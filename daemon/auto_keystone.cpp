@@ -90,6 +90,68 @@ void TiltTracker::reset() {
   filter_.reset();
   last_ns_.reset();
   still_ = false;
+  raw_sum_.setZero();
+  raw_count_ = 0;
+}
+
+void TiltTracker::setCalibration(const keystone::AccelCalibration& calibration,
+                                 std::string source) {
+  mount_.calibration = calibration;
+  mount_.calibration_source = std::move(source);
+  reset();
+}
+
+std::optional<std::pair<Vec3, long>> TiltTracker::stillMean() const {
+  if (!still_ || raw_count_ == 0) return std::nullopt;
+  return std::pair<Vec3, long>(raw_sum_ / double(raw_count_), raw_count_);
+}
+
+namespace {
+constexpr const char* kPoseNames[6] = {"+x", "-x", "+y", "-y", "+z", "-z"};
+}
+
+Result<std::string> SixPositionCollector::add(const Vec3& mean_g) {
+  if (!mean_g.allFinite() || mean_g.norm() < 0.5) {
+    return fail(ErrorCode::kInvalidInput, "the reading is not a still 1 g");
+  }
+  Eigen::Index axis = 0;
+  mean_g.cwiseAbs().maxCoeff(&axis);
+  const Vec3 u = mean_g.normalized();
+  if (std::abs(u[axis]) < std::cos(10.0 * std::numbers::pi / 180.0)) {
+    return fail(ErrorCode::kInvalidInput,
+                "no sensor axis is within 10 degrees of vertical: hold one straight up or down");
+  }
+  const int slot = 2 * static_cast<int>(axis) + (u[axis] > 0 ? 0 : 1);
+  poses_[slot] = mean_g;
+  return std::string(kPoseNames[slot]);
+}
+
+std::vector<std::string> SixPositionCollector::filled() const {
+  std::vector<std::string> out;
+  for (int i = 0; i < 6; ++i) {
+    if (poses_[i]) out.emplace_back(kPoseNames[i]);
+  }
+  return out;
+}
+
+std::vector<std::string> SixPositionCollector::missing() const {
+  std::vector<std::string> out;
+  for (int i = 0; i < 6; ++i) {
+    if (!poses_[i]) out.emplace_back(kPoseNames[i]);
+  }
+  return out;
+}
+
+Result<keystone::CalibrationFit> SixPositionCollector::solve() const {
+  if (const auto m = missing(); !m.empty()) {
+    std::string list;
+    for (const auto& name : m) list += (list.empty() ? "" : ", ") + name;
+    return fail(ErrorCode::kTooFewPoints,
+                "six-position calibration still needs the holds with " + list + " up");
+  }
+  std::vector<Vec3> readings;
+  for (const auto& p : poses_) readings.push_back(*p);
+  return keystone::calibrateSixPosition(readings);
 }
 
 std::optional<Vec3> TiltTracker::add(const procam_tilt_sample& s) {
@@ -100,9 +162,17 @@ std::optional<Vec3> TiltTracker::add(const procam_tilt_sample& s) {
   raw.timestamp_ns = s.timestamp_ns;
   if (!gate_.check(raw)) return std::nullopt;
   last_ns_ = s.timestamp_ns;
-  const Vec3 g = mount_.calibration.apply(raw.specific_force / tilt::kStandardGravity);
-  auto out = filter_.update(g, static_cast<double>(s.timestamp_ns) * 1e-9);
+  const Vec3 raw_g = raw.specific_force / tilt::kStandardGravity;
+  auto out =
+      filter_.update(mount_.calibration.apply(raw_g), static_cast<double>(s.timestamp_ns) * 1e-9);
   if (!out) return std::nullopt;  // only non-finite input, which the gate already refused
+  if (!out->still) {
+    raw_sum_.setZero();
+    raw_count_ = 0;
+  } else {
+    raw_sum_ += raw_g;
+    ++raw_count_;
+  }
   still_ = out->still;
   if (!out->changed) return std::nullopt;
   // downFromSpecificForce takes the sensor -> projector rotation.

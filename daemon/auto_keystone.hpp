@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "config.hpp"
 #include "core/error.hpp"
@@ -52,6 +54,11 @@ class TiltTracker {
   // or a refinement of a still hold), else nullopt.
   std::optional<Vec3> add(const procam_tilt_sample& sample);
   void reset();
+  void setCalibration(const keystone::AccelCalibration& calibration, std::string source);
+
+  // The mean raw reading (sensor frame, g, before calibration) of the current
+  // still hold and how many samples it averages; nullopt while moving.
+  std::optional<std::pair<Vec3, long>> stillMean() const;
 
   const tilt::SampleCounts& counts() const { return gate_.counts(); }
   bool still() const { return still_; }
@@ -66,6 +73,27 @@ class TiltTracker {
   tilt::SampleGate gate_;
   std::optional<uint64_t> last_ns_;
   bool still_ = false;
+  Vec3 raw_sum_ = Vec3::Zero();  // raw readings (g) of the current still hold
+  long raw_count_ = 0;
+};
+
+// The six still holds of keystone::calibrateSixPosition, one per sensor axis
+// pointing up or down, collected one at a time (a real rig: the user turns the
+// projector; the virtual rig: the scene is posed).
+class SixPositionCollector {
+ public:
+  // A still mean (sensor frame, g, uncalibrated). The pose it fills ("+x" ...
+  // "-z": the axis pointing up); kInvalidInput when no axis is within 10
+  // degrees of vertical.
+  Result<std::string> add(const Vec3& mean_g);
+  std::vector<std::string> filled() const;
+  std::vector<std::string> missing() const;
+  // kTooFewPoints naming the missing poses; the fit's own errors.
+  Result<keystone::CalibrationFit> solve() const;
+  void clear() { poses_ = {}; }
+
+ private:
+  std::array<std::optional<Vec3>, 6> poses_;  // +x, -x, +y, -y, +z, -z
 };
 
 // One keystone solution for the content size in use.

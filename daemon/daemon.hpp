@@ -85,6 +85,7 @@ class Daemon {
   void watchTiltSensor();
   void stopTiltPolling();
   void onTiltSample(const procam_tilt_sample& sample);
+  void accelCalibrationStep(ClientId client, const proto::Request& req, const std::string& action);
   void requestSolve();
   std::optional<Mat3> currentWarp(cv::Size content_size) const;
   cv::Size currentSourceSize() const;

@@ -4,6 +4,7 @@
 // compute_worker_ and post their results back.
 #include <cmath>
 #include <numbers>
+#include <sstream>
 
 #include "daemon.hpp"
 #include "geometry/homography.hpp"
@@ -403,11 +404,70 @@ void Daemon::cmdKeystone(ClientId client, const proto::Request& req) {
     }
     broadcast("keystone", keystoneJson());
     refreshOutputs();
+  } else if (action.starts_with("accel-")) {
+    if (corners || homography || args.get("enable")) {
+      return errorTo(client, req, code::kBadArgument, "keystone " + action + " takes no arguments");
+    }
+    return accelCalibrationStep(client, req, action);
   } else {
     return errorTo(client, req, code::kBadArgument,
-                   "unknown keystone action '" + action + "' (get, set, auto)");
+                   "unknown keystone action '" + action +
+                       "' (get, set, auto, accel-sample, accel-solve, accel-reset)");
   }
   replyTo(client, req, "KEYSTONE", keystoneJson());
+}
+
+// The six-position accelerometer calibration of a real rig, one still hold at
+// a time (PROTOCOL.md, "Auto keystone").
+void Daemon::accelCalibrationStep(ClientId client, const proto::Request& req,
+                                  const std::string& action) {
+  KeystoneRuntime& k = keystone_rt_;
+  json cal = json::object();
+  if (action == "accel-reset") {
+    k.accel_holds.clear();
+  } else if (action == "accel-sample") {
+    if (!k.tracker || !k.listening) {
+      return errorTo(client, req, code::kUnavailable,
+                     "accel-sample reads the tilt sensor of auto keystone: turn it on first");
+    }
+    const auto mean = k.tracker->stillMean();
+    const long needed = static_cast<long>(std::ceil(config_.keystone.poll_hz));
+    if (!mean || mean->second < needed) {
+      return errorTo(client, req, code::kUnavailable,
+                     "hold the projector still for a second, then sample again");
+    }
+    auto pose = k.accel_holds.add(mean->first);
+    if (!pose) return errorTo(client, req, code::kBadArgument, pose.error().message);
+    cal["pose"] = *pose;
+    cal["samples"] = mean->second;
+    cal["mean_g"] = {mean->first.x(), mean->first.y(), mean->first.z()};
+  } else if (action == "accel-solve") {
+    auto fit = k.accel_holds.solve();
+    if (!fit) return errorTo(client, req, code::kBadArgument, fit.error().message);
+    if (!k.tracker) return errorTo(client, req, code::kUnavailable, k.unavailable);
+    k.tracker->setCalibration(fit->calibration, "six-position calibration (keystone accel-solve)");
+    k.calibration_rms_g = fit->rms;
+    k.accel_holds.clear();
+    const Vec3& o = fit->calibration.offset;
+    const Vec3& g = fit->calibration.scale;
+    cal["offset_g"] = {o.x(), o.y(), o.z()};
+    cal["scale"] = {g.x(), g.y(), g.z()};
+    cal["rms_g"] = fit->rms;
+    std::ostringstream toml;
+    toml.precision(9);
+    toml << "[keystone]\naccel_offset_g = [" << o.x() << ", " << o.y() << ", " << o.z()
+         << "]\naccel_scale = [" << g.x() << ", " << g.y() << ", " << g.z() << "]\n";
+    cal["config"] = toml.str();  // to keep it: procamd.toml
+  } else {
+    return errorTo(
+        client, req, code::kBadArgument,
+        "unknown keystone action '" + action + "' (accel-sample, accel-solve, accel-reset)");
+  }
+  cal["filled"] = k.accel_holds.filled();
+  cal["missing"] = k.accel_holds.missing();
+  json body = keystoneJson();
+  body["accel_calibration"] = cal;
+  replyTo(client, req, "KEYSTONE", body);
 }
 
 bool Daemon::calibrating() const {

@@ -23,8 +23,9 @@ struct KeystoneRuntime {
   std::string unavailable = "no tilt sensor and projector intrinsics yet";
   bool preparing = false;  // the virtual rig's accelerometer calibration is running
   double calibration_rms_g = -1;
-  bool listening = false;  // samples of tilt_device feed the tracker
-  int poll_timer = -1;     // DeviceManager::pollEvery id, for sensors without a poll fd
+  SixPositionCollector accel_holds;  // keystone accel-sample / accel-solve
+  bool listening = false;            // samples of tilt_device feed the tracker
+  int poll_timer = -1;               // DeviceManager::pollEvery id, for sensors without a poll fd
 
   // The last published gravity and the solution made from it.
   std::optional<Vec3> down;

@@ -2,7 +2,6 @@
 
 #ifdef PROCAM_HAVE_SIM
 #include <sstream>
-#include <vector>
 
 #include "sim/scene_library.hpp"
 #include "sim/sensors.hpp"
@@ -82,21 +81,24 @@ Result<SimKeystoneSetup> simKeystoneSetup(const std::string& scene_name,
   out.projector.source = "scene '" + scene_name + "'";
   out.mount.sensor_from_projector = t->sensor_from_projector;
 
-  std::vector<Vec3> readings;
+  SixPositionCollector holds;
+  int hold = 0;
   const double unit = t->report_in_g ? 1.0 : sim::kStandardGravity;
   for (int axis = 0; axis < 3; ++axis) {
     for (double sign : {1.0, -1.0}) {
       auto posed = sim::Scene::parse(posedScene(*p, *t, axis, sign), "six-position pose", {});
       if (!posed) return tl::unexpected(posed.error());
-      const uint64_t seed = 1000 + static_cast<uint64_t>(readings.size());
+      const uint64_t seed = 1000 + static_cast<uint64_t>(hold++);
       auto series = sim::sampleTiltSeries(*posed, t->name, 0.0, kHoldSeconds, seed);
       if (!series) return tl::unexpected(series.error());
       Vec3 sum = Vec3::Zero();
       for (const auto& s : *series) sum += s.value;
-      readings.push_back(sum / (unit * static_cast<double>(series->size())));
+      if (auto pose = holds.add(sum / (unit * static_cast<double>(series->size()))); !pose) {
+        return tl::unexpected(pose.error());
+      }
     }
   }
-  auto fit = keystone::calibrateSixPosition(readings);
+  auto fit = holds.solve();
   if (!fit) return tl::unexpected(fit.error());
   out.mount.calibration = fit->calibration;
   out.mount.calibration_source = "six-position calibration on the virtual rig";

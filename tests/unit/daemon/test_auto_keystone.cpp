@@ -87,6 +87,51 @@ TEST(TiltTracker, GarbageAndRepeatedSamplesAreDropped) {
   EXPECT_EQ(tracker->counts().bad_norm, 1u);
 }
 
+TEST(SixPositionCollector, SixHoldsRecoverOffsetAndGain) {
+  keystone::AccelCalibration truth;
+  truth.offset = Vec3(0.03, -0.02, 0.05);
+  truth.scale = Vec3(1.02, 0.97, 1.01);
+  SixPositionCollector holds;
+  const char* names[6] = {"+x", "-x", "+y", "-y", "+z", "-z"};
+  for (int i = 0; i < 6; ++i) {
+    const Vec3 up = (i % 2 ? -1.0 : 1.0) * Vec3::Unit(i / 2);
+    // Held 3 degrees off vertical: still accepted.
+    const Vec3 f = Eigen::AngleAxisd(3 * kDeg, Vec3::Unit((i / 2 + 1) % 3)) * up;
+    auto pose = holds.add(truth.scale.cwiseProduct(f) + truth.offset);
+    ASSERT_TRUE(pose) << pose.error().message;
+    EXPECT_EQ(*pose, names[i]);
+    if (i == 4) {
+      EXPECT_EQ(holds.missing(), std::vector<std::string>({"-z"}));
+      EXPECT_EQ(holds.solve().error().code, ErrorCode::kTooFewPoints);
+    }
+  }
+  auto fit = holds.solve();
+  ASSERT_TRUE(fit) << fit.error().message;
+  EXPECT_LT((fit->calibration.offset - truth.offset).norm(), 1e-6);
+  EXPECT_LT((fit->calibration.scale - truth.scale).norm(), 1e-6);
+  // 45 degrees from every axis: not a hold of the procedure.
+  EXPECT_FALSE(holds.add(Vec3(1, 1, 0).normalized()));
+}
+
+TEST(TiltTracker, StillMeanIsTheRawReading) {
+  TiltMount mount;
+  mount.calibration.offset = Vec3(0.1, 0, 0);  // applied to the filter, not to the mean
+  auto tracker = TiltTracker::create(KeystoneConfig{}, mount);
+  ASSERT_TRUE(tracker);
+  const Vec3 raw(0.1, 0.2, 0.98);
+  for (int k = 0; k < 100; ++k) {
+    const Vec3 dither = 1e-6 * Vec3(k % 3 - 1, 0, 0);
+    procam_tilt_sample s{};
+    for (int i = 0; i < 3; ++i) s.specific_force[i] = (raw + dither)[i] * kG;
+    s.timestamp_ns = static_cast<uint64_t>(k * 1e7);
+    tracker->add(s);
+  }
+  auto mean = tracker->stillMean();
+  ASSERT_TRUE(mean);
+  EXPECT_LT((mean->first - raw).norm(), 1e-6);
+  EXPECT_GT(mean->second, 50);
+}
+
 TEST(SolveFromDown, EqualsTheKeystoneSolveAtThatTilt) {
   ProjectorModel p;
   p.K = geom::Intrinsics{1400, 1400, 639.5, 359.5, 0};
