@@ -9,15 +9,6 @@ namespace procam::daemon {
 using nlohmann::json;
 namespace code = proto::code;
 
-namespace {
-
-// Present in the protocol; answered with "unavailable" until the pipeline
-// behind them is part of the build.
-constexpr const char* kNoCalibration =
-    "calibration needs the structured-light pipeline, which this procamd does not include";
-
-}  // namespace
-
 bool Daemon::replyTo(ClientId client, const proto::Request& req, const std::string& cls,
                      json body) {
   return server_->send(client, proto::reply(cls, req.id, std::move(body)));
@@ -107,7 +98,7 @@ json Daemon::statusJson() const {
           {"operations", ops},
           {"log_level", logLevelName(logLevel())},
           {"outputs", outputsJson()},
-          {"capabilities", {{"calibrate", false}, {"auto_keystone", true}, {"render", true}}},
+          {"capabilities", {{"calibrate", true}, {"auto_keystone", true}, {"render", true}}},
           {"warnings", warnings_}};
 }
 
@@ -145,10 +136,6 @@ void Daemon::cmdWatch(ClientId client, const proto::Request& req) {
            {"events",
             {"device-added", "device-removed", "progress", "finished", "keystone", "pattern",
              "content", "config", "warning"}}});
-}
-
-void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
-  errorTo(client, req, code::kUnavailable, kNoCalibration);
 }
 
 void Daemon::cmdCancel(ClientId client, const proto::Request& req) {

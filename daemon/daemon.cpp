@@ -27,6 +27,7 @@ gid_t lookupGroup(const std::string& name) {
 Daemon::Daemon(DaemonOptions options) : options_(std::move(options)) {}
 
 Daemon::~Daemon() {
+  for (auto& [id, op] : operations_) op.cancelled->store(true);  // a running job stops early
   server_.reset();
   compute_worker_.reset();
   io_worker_.reset();

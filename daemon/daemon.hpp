@@ -80,6 +80,7 @@ class Daemon {
   nlohmann::json contentJson() const;
   // daemon_keystone.cpp: auto keystone and what the outputs show.
   void setupAutoKeystone();
+  void probeKeystoneInputs();
   void useKeystoneInputs(ProjectorModel projector, TiltMount mount);
   Result<void> setAutoKeystone(bool enable);
   void watchTiltSensor();
@@ -113,6 +114,14 @@ class Daemon {
   std::map<ClientId, nlohmann::json> watchers_;  // client -> its watch request id
   std::map<std::string, Operation> operations_;
   uint64_t next_operation_ = 1;
+  // The running calibrate operation (commands_calibrate.cpp).
+  struct Calibration {
+    std::string op;  // empty: none runs
+    std::vector<std::string> devices;
+    std::string removed;  // why a device it used went away (udev, lost)
+    bool hooked = false;  // onDeviceRemoved registered
+  };
+  Calibration calibration_;
   struct ContentInfo {
     int width = 0, height = 0;
   };

@@ -27,6 +27,7 @@ inline constexpr const char* kUnavailable = "unavailable";  // not built / no de
 inline constexpr const char* kNotFound = "not-found";
 inline constexpr const char* kBusy = "busy";
 inline constexpr const char* kCancelled = "cancelled";
+inline constexpr const char* kFailed = "failed";  // the operation ran but found no result
 inline constexpr const char* kForbidden = "forbidden";
 inline constexpr const char* kIo = "io-error";
 inline constexpr const char* kConfig = "config-error";

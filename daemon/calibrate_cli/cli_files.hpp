@@ -10,6 +10,7 @@
 #include "calibration/projector_calibration.hpp"
 #include "core/error.hpp"
 #include "geometry/camera_model.hpp"
+#include "rig_file.hpp"
 #include "structured_light/decoder.hpp"
 #include "structured_light/pattern_set.hpp"
 
@@ -27,20 +28,12 @@ Result<std::vector<cv::Mat>> readCaptures(const sl::PatternSet& set, const fs::p
 // 3-channel PFM: u, v, confidence; rows bottom to top, little-endian; -1 undecoded.
 Result<void> writeCorrespondencePfm(const sl::Decoded& decoded, const fs::path& file);
 
-struct NamedCamera {
-  std::string name;
-  geom::CameraModel model;
-  double rms_px = -1;  // written when >= 0
-};
-struct NamedProjector {
-  std::string name;
-  int width = 0, height = 0;
-  calib::ProjectorCalibration calibration;
-};
+using rig::cameraJson;
+using rig::NamedCamera;
+using rig::NamedProjector;
+using rig::projectorJson;
 
 Result<std::vector<NamedCamera>> readCameras(const fs::path& file);
-nlohmann::json cameraJson(const NamedCamera& c);
-nlohmann::json projectorJson(const NamedProjector& p);
 
 Result<void> writeText(const fs::path& file, const std::string& text);
 Result<nlohmann::json> readJson(const fs::path& file);

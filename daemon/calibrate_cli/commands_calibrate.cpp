@@ -5,10 +5,10 @@
 
 #include "calibration/camera_calibration.hpp"
 #include "calibration/projector_calibration.hpp"
+#include "calibration/stereo_route.hpp"
 #include "cli_files.hpp"
 #include "commands.hpp"
 #include "surface/projector_samples.hpp"
-#include "surface/stereo_points.hpp"
 #include "surface/surface_model.hpp"
 
 namespace procam::cli {
@@ -58,13 +58,6 @@ Result<sl::Decoded> decodeDir(const sl::PatternSet& set, const std::string& dir,
   return d;
 }
 
-// Neighbourhood for inverting the decoded map: Gray-only correspondences are cell
-// centres, so it spans several cells; phase-shifted ones are continuous.
-double radiusFor(const sl::PatternSet& set) {
-  if (set.options.mode == sl::Mode::kGrayPhase) return 2.0;
-  return std::max({2.0, static_cast<double>(set.columns.cell), static_cast<double>(set.rows.cell)});
-}
-
 Result<int> stepOption(const Arguments& a) {
   if (auto s = a.optional("step")) return toInt(*s, "--step");
   return 8;
@@ -72,11 +65,7 @@ Result<int> stepOption(const Arguments& a) {
 
 Result<void> writeRig(const fs::path& out, const std::vector<NamedCamera>& cameras,
                       const NamedProjector& projector, const nlohmann::json& surface) {
-  nlohmann::json j;
-  j["cameras"] = nlohmann::json::array();
-  for (const auto& c : cameras) j["cameras"].push_back(cameraJson(c));
-  j["projectors"] = nlohmann::json::array({projectorJson(projector)});
-  if (!surface.is_null()) j["surface"] = surface;
+  const nlohmann::json j = rig::rigJson(cameras, projector, surface);
   progress("projector '" + projector.name + "': fx " + std::to_string(projector.calibration.K.fx) +
            ", fy " + std::to_string(projector.calibration.K.fy) + ", reprojection RMS " +
            std::to_string(projector.calibration.rms_px) + " px; writing " + out.string());
@@ -171,56 +160,33 @@ Result<void> runSolve(const Arguments& a) {
     return fail(ErrorCode::kInvalidInput, *cameras_file + " holds one camera; solve needs two");
   auto set = readSequence(*patterns);
   if (!set) return asVoid(set);
-  const int pw = set->options.width, ph = set->options.height;
-  std::vector<surface::ProjectorSamples> samples;
+  calib::DecodedView views[2];
   for (std::size_t i = 0; i < 2; ++i) {
     auto d = decodeDir(*set, dirs[i], i, 2);
     if (!d) return asVoid(d);
-    const auto& cam = (*cameras)[i].model;
-    if (d->u.cols != cam.width || d->u.rows != cam.height)
-      return fail(ErrorCode::kInvalidInput,
-                  "captures in " + dirs[i] + " are " + std::to_string(d->u.cols) + "x" +
-                      std::to_string(d->u.rows) + " but camera '" + (*cameras)[i].name + "' is " +
-                      std::to_string(cam.width) + "x" + std::to_string(cam.height));
-    auto s = surface::sampleProjectorGrid(*d, pw, ph, {.step = *step, .radius = radiusFor(*set)});
-    if (!s) return asVoid(s);
-    samples.push_back(std::move(*s));
+    views[i] = {(*cameras)[i].name, (*cameras)[i].model, std::move(*d)};
   }
-  auto points =
-      surface::triangulateStereo((*cameras)[0].model, samples[0], (*cameras)[1].model, samples[1]);
-  if (!points) return asVoid(points);
-  progress("triangulated " + std::to_string(points->world.size()) + " projector nodes (every " +
-           std::to_string(*step) + " px)");
-  if (points->world.size() < 20)
-    return fail(ErrorCode::kTooFewPoints,
-                "only " + std::to_string(points->world.size()) +
-                    " projector nodes were seen by both cameras (need 20)");
-  auto projector = calib::calibrateProjectorFromSurface(*points);
-  if (!projector && projector.error().code == ErrorCode::kCoplanar)
-    return fail(ErrorCode::kCoplanar, projector.error().message +
+  auto route = calib::solveStereoRoute(*set, views[0], views[1], *step);
+  if (!route && route.error().code == ErrorCode::kCoplanar)
+    return fail(ErrorCode::kCoplanar, route.error().message +
                                           " (procam-calibrate solve-planes, with captures of "
                                           "the plane at two or more orientations)");
-  if (!projector) return asVoid(projector);
-  // The surface from the points consistent with the calibrated projector.
-  const surface::SurfacePoints kept = surface::keepPoints(*points, projector->inliers);
-  progress(std::to_string(kept.world.size()) + " points consistent with the projector");
-  auto model = surface::buildSurface(kept);
-  if (!model) return asVoid(model);
-  nlohmann::json surf;
-  if (model->planar) {
-    surf = {{"plane", {model->plane.n.x(), model->plane.n.y(), model->plane.n.z(), model->plane.d}},
-            {"rms_m", model->plane_rms}};
-  } else {
-    const std::string ply =
-        a.optional("surface-out").value_or(fs::path(*out).replace_extension(".ply").string());
-    progress("surface is not planar (" + std::to_string(model->inlier_fraction * 100) +
-             "% on the best plane): mesh of " + std::to_string(model->mesh.faces.size()) +
+  if (!route) return asVoid(route);
+  progress("triangulated " + std::to_string(route->triangulated) + " projector nodes (every " +
+           std::to_string(*step) + " px), " + std::to_string(route->consistent) +
+           " consistent with the projector");
+  const surface::SurfaceModel& model = route->surface;
+  std::string ply;
+  if (!model.planar) {
+    ply = a.optional("surface-out").value_or(fs::path(*out).replace_extension(".ply").string());
+    progress("surface is not planar (" + std::to_string(model.inlier_fraction * 100) +
+             "% on the best plane): mesh of " + std::to_string(model.mesh.faces.size()) +
              " triangles -> " + ply);
-    if (auto w = writeText(ply, surface::toPly(model->mesh)); !w) return w;
-    surf = {{"mesh", ply}};
+    if (auto w = writeText(ply, surface::toPly(model.mesh)); !w) return w;
   }
-  NamedProjector p{a.optional("name").value_or("projector"), pw, ph, *projector};
-  return writeRig(*out, *cameras, p, surf);
+  NamedProjector p{a.optional("name").value_or("projector"), set->options.width,
+                   set->options.height, route->projector};
+  return writeRig(*out, *cameras, p, rig::surfaceJson(model, ply));
 }
 
 Result<void> runSolvePlanes(const Arguments& a) {
@@ -268,7 +234,7 @@ Result<void> runSolvePlanes(const Arguments& a) {
     auto d = decodeDir(*set, dirs[i], i, dirs.size());
     if (!d) return asVoid(d);
     auto s = surface::sampleProjectorGrid(*d, o.projector_width, o.projector_height,
-                                          {.step = *step, .radius = radiusFor(*set)});
+                                          {.step = *step, .radius = calib::sampleRadius(*set)});
     if (!s) return asVoid(s);
     views.push_back({s->camera, s->projector});
   }

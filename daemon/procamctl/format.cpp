@@ -63,6 +63,27 @@ std::string contentText(const json& c) {
   return s;
 }
 
+std::string calibrateText(const json& r) {
+  if (r.value("state", "") == "started") {
+    return "calibration " + scalar(r["operation"]) + ": " + scalar(r["frames"]) +
+           " pattern frames on " + scalar(r["output"]) + ", cameras " + pairList(r["cameras"]) +
+           " (" + scalar(r["mode"]) + ")\n";
+  }
+  const json& p = r["projector"];
+  std::string out =
+      field("projector", scalar(p["name"]) + " " + scalar(p["width"]) + "x" + scalar(p["height"]));
+  char k[160];
+  std::snprintf(k, sizeof k, "fx %.2f  fy %.2f  cx %.2f  cy %.2f", p["K"][0].get<double>(),
+                p["K"][4].get<double>(), p["K"][2].get<double>(), p["K"][5].get<double>());
+  out += field("intrinsics", k);
+  out += field("position", pairList(r["position"]) + " m");
+  out += field("reprojection", scalar(r["reprojection_rms_px"]) + " px RMS over " +
+                                   scalar(p["points"]) + " points");
+  out += field("surface", scalar(r["surface_type"]));
+  out += field("written", scalar(r["path"]));
+  return out;
+}
+
 }  // namespace
 
 std::string progressBar(double fraction, int width, const std::string& stage) {
@@ -134,6 +155,7 @@ std::string formatReply(const json& r) {
   if (cls == "SAVE") return "saved " + scalar(r["path"]) + " (" + scalar(r["bytes"]) + " bytes)\n";
   if (cls == "RELOAD") return "reloaded " + scalar(r["config"]) + "\n";
   if (cls == "LOG-LEVEL") return "log level " + scalar(r["level"]) + "\n";
+  if (cls == "CALIBRATE") return calibrateText(r);
   if (cls == "CANCEL") return "cancelled " + pairList(r["cancelled"]) + "\n";
   if (cls == "WATCH") {
     return r.value("enabled", false) ? "watching: " + pairList(r["events"]) + "\n"

@@ -19,7 +19,9 @@ constexpr const char* kUsage =
     "commands:\n"
     "  version | status | devices | save | reload\n"
     "  watch                          stream events until interrupted\n"
-    "  calibrate                      run a calibration with a progress bar\n"
+    "  calibrate [KEY=VALUE ...]      run a calibration with a progress bar; keys: mode,\n"
+    "                                 step, phase_steps, grid, settle_frames, output,\n"
+    "                                 cameras=A,B (daemon/PROTOCOL.md)\n"
     "  cancel [OPERATION]\n"
     "  keystone [get]\n"
     "  keystone set X,Y X,Y X,Y X,Y   corners: top-left top-right bottom-right bottom-left\n"
@@ -144,21 +146,56 @@ int runWatch(const Options& o, procam::ctl::Client& c) {
   }
 }
 
+// calibrate's KEY=VALUE arguments: integers as numbers, cameras=A,B as a list.
+json calibrateRequest(const std::vector<std::string>& a) {
+  json r = {{"cmd", "calibrate"}};
+  for (const std::string& kv : a) {
+    const size_t eq = kv.find('=');
+    if (eq == std::string::npos || eq == 0) usage("calibrate takes KEY=VALUE arguments");
+    const std::string key = kv.substr(0, eq), value = kv.substr(eq + 1);
+    char* end = nullptr;
+    const long n = std::strtol(value.c_str(), &end, 10);
+    if (key == "cameras") {
+      const size_t comma = value.find(',');
+      if (comma == std::string::npos) usage("cameras=A,B names two cameras");
+      r[key] = {value.substr(0, comma), value.substr(comma + 1)};
+    } else if (!value.empty() && *end == '\0') {
+      r[key] = n;
+    } else {
+      r[key] = value;
+    }
+  }
+  return r;
+}
+
 // Sends a request that starts an operation and follows its progress events
-// until the reply (and, for asynchronous starts, the finished event) arrives.
+// until the reply arrives. An operation that answers at once with "state":
+// "started" (calibrate) is followed until its second, final reply.
 int runOperation(const Options& o, procam::ctl::Client& c, const json& request) {
   const bool tty = !o.json && ::isatty(STDERR_FILENO);
   bool bar_shown = false;
   auto on_event = [&](const json& e) {
     if (o.json) return print(o, e, true);
     if (e.value("event", "") != "progress" || !tty) return;
-    std::fprintf(
-        stderr, "\r%s",
-        procam::ctl::progressBar(e.value("fraction", 0.0), 30, e.value("stage", "")).c_str());
+    std::string stage = e.value("stage", "");
+    if (e.contains("captures") && stage == "capturing") {
+      stage += " " + e["capture"].dump() + "/" + e["captures"].dump();
+    }
+    std::fprintf(stderr, "\r%s\033[K",
+                 procam::ctl::progressBar(e.value("fraction", 0.0), 30, stage).c_str());
     bar_shown = true;
   };
   // Long operations: no reply timeout, the daemon reports progress.
   auto reply = c.call(request, std::chrono::milliseconds(-1), on_event);
+  if (reply && reply->value("state", "") == "started") {
+    print(o, *reply, false);
+    const json id = (*reply)["id"];
+    for (;;) {
+      reply = c.next(std::chrono::milliseconds(-1));
+      if (!reply || (reply->value("class", "") != "EVENT" && (*reply)["id"] == id)) break;
+      if (reply->value("class", "") == "EVENT") on_event(*reply);
+    }
+  }
   if (bar_shown) std::fputs("\n", stderr);
   if (!reply) return fail(reply.error());
   print(o, *reply, false);
@@ -197,12 +234,13 @@ int main(int argc, char** argv) {
   const std::vector<std::string> args(argv + i, argv + argc);
   json request;
   if (cmd != "watch" && cmd != "calibrate") request = buildRequest(cmd, args);
-  if ((cmd == "watch" || cmd == "calibrate") && !args.empty()) usage(cmd + " takes no arguments");
+  if (cmd == "calibrate") request = calibrateRequest(args);
+  if (cmd == "watch" && !args.empty()) usage(cmd + " takes no arguments");
 
   auto client = procam::ctl::Client::connect(o.socket, o.timeout);
   if (!client) return fail(client.error());
   if (cmd == "watch") return runWatch(o, *client);
-  if (cmd == "calibrate") return runOperation(o, *client, {{"cmd", "calibrate"}});
+  if (cmd == "calibrate") return runOperation(o, *client, request);
   if (cmd == "content" && request.value("action", "") == "load") {
     return runOperation(o, *client, request);
   }

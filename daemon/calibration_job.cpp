@@ -1,0 +1,185 @@
+#include "calibration_job.hpp"
+
+#include <chrono>
+#include <opencv2/imgproc.hpp>
+#include <thread>
+
+#include "output_frames.hpp"
+#include "protocol.hpp"
+#include "structured_light/decoder.hpp"
+
+namespace procam::daemon {
+
+namespace code = proto::code;
+using nlohmann::json;
+
+namespace {
+
+// An integer argument in [lo, hi]; false (with `error` set) when present and wrong.
+bool integerArg(const json& request, const char* key, int lo, int hi, int& out,
+                std::string& error) {
+  auto it = request.find(key);
+  if (it == request.end()) return true;
+  if (!it->is_number_integer() || it->get<int64_t>() < lo || it->get<int64_t>() > hi) {
+    error = std::string("\"") + key + "\" must be an integer from " + std::to_string(lo) + " to " +
+            std::to_string(hi);
+    return false;
+  }
+  out = it->get<int>();
+  return true;
+}
+
+CalibrationFailure deviceFailure(const char* family, const std::string& name, int rc,
+                                 const char* what, const char* reason) {
+  const std::string why = reason[0] ? reason : "no reason given";
+  if (rc == PROCAM_ENODEV) {
+    return {
+        code::kCancelled,
+        "calibration cancelled: " + std::string(family) + " '" + name + "' is gone (" + why + ")",
+        name, rc};
+  }
+  return {code::kIo, std::string(family) + " '" + name + "' failed to " + what + ": " + why, name,
+          rc};
+}
+
+// The driver's frame as a single-channel image the decoder takes (a copy: the
+// driver's buffer is reused by the next capture).
+cv::Mat toGray(const procam_image& img) {
+  const int w = static_cast<int>(img.width), h = static_cast<int>(img.height);
+  switch (img.format) {
+    case PROCAM_PIXEL_GRAY8:
+      return cv::Mat(h, w, CV_8UC1, img.data, img.stride).clone();
+    case PROCAM_PIXEL_GRAY16:
+      return cv::Mat(h, w, CV_16UC1, img.data, img.stride).clone();
+    case PROCAM_PIXEL_RGB8: {
+      cv::Mat gray;
+      cv::cvtColor(cv::Mat(h, w, CV_8UC3, img.data, img.stride), gray, cv::COLOR_RGB2GRAY);
+      return gray;
+    }
+  }
+  return {};
+}
+
+// Waits `seconds`, waking every 20 ms to honour a cancel; false when cancelled.
+bool settle(double seconds, const CalibrationHooks& hooks) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (std::chrono::steady_clock::now() < end) {
+    if (hooks.cancelled()) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return !hooks.cancelled();
+}
+
+}  // namespace
+
+tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const json& request) {
+  CalibrationArgs a;
+  static const char* const kKeys[] = {"mode",          "step",   "phase_steps", "grid",
+                                      "settle_frames", "output", "cameras"};
+  for (const auto& [key, value] : request.items()) {
+    if (key == "cmd" || key == "id") continue;
+    bool known = false;
+    for (const char* k : kKeys) known = known || key == k;
+    if (!known) return tl::unexpected("unknown argument \"" + key + "\" for calibrate");
+  }
+  std::string error;
+  if (auto it = request.find("mode"); it != request.end()) {
+    auto mode = it->is_string() ? sl::parseMode(it->get<std::string>()) : Result<sl::Mode>{};
+    if (!it->is_string() || !mode) {
+      return tl::unexpected(std::string("\"mode\" must be \"gray\" or \"gray+phase\""));
+    }
+    a.mode = *mode;
+  }
+  if (!integerArg(request, "step", 1, 256, a.step, error) ||
+      !integerArg(request, "phase_steps", 3, 64, a.phase_steps, error) ||
+      !integerArg(request, "grid", 1, 1024, a.grid, error) ||
+      !integerArg(request, "settle_frames", 0, 600, a.settle_frames, error)) {
+    return tl::unexpected(error);
+  }
+  if (request.contains("phase_steps") && a.mode != sl::Mode::kGrayPhase) {
+    return tl::unexpected(std::string("\"phase_steps\" needs \"mode\": \"gray+phase\""));
+  }
+  if (auto it = request.find("output"); it != request.end()) {
+    if (!it->is_string() || it->get<std::string>().empty()) {
+      return tl::unexpected(std::string("\"output\" must be a device name"));
+    }
+    a.output = it->get<std::string>();
+  }
+  if (auto it = request.find("cameras"); it != request.end()) {
+    const bool pair = it->is_array() && it->size() == 2 && (*it)[0].is_string() &&
+                      (*it)[1].is_string() && (*it)[0] != (*it)[1];
+    if (!pair) {
+      return tl::unexpected(std::string("\"cameras\" must name two different cameras"));
+    }
+    a.cameras = {(*it)[0].get<std::string>(), (*it)[1].get<std::string>()};
+  }
+  return a;
+}
+
+tl::expected<CalibrationOutcome, CalibrationFailure> runCalibration(const CalibrationPlan& plan,
+                                                                    const CalibrationHooks& hooks) {
+  const CalibrationFailure cancelled{code::kCancelled, "calibration cancelled"};
+  const int total = plan.captures();
+  const auto& out_raw = plan.output.device->raw();
+  std::vector<std::vector<cv::Mat>> captures(plan.cameras.size());
+  char err[256];
+  int done = 0;
+  for (std::size_t f = 0; f < plan.set.frames.size(); ++f) {
+    if (hooks.cancelled()) return tl::unexpected(cancelled);
+    cv::Mat rgb;
+    cv::cvtColor(sl::renderFrame(plan.set, f), rgb, cv::COLOR_GRAY2RGB);
+    procam_image frame = rgbImage(rgb);
+    err[0] = '\0';
+    if (int rc = out_raw.ops.output->show(out_raw.self, &frame, err, sizeof err - 1);
+        rc != PROCAM_OK) {
+      return tl::unexpected(deviceFailure("output", plan.output.name, rc, "show a pattern", err));
+    }
+    // The frame reaches the screen within a few refreshes (seed §4.1.1 assumes a
+    // static projected image per capture).
+    if (!settle(plan.settle_frames / plan.refresh_hz, hooks)) return tl::unexpected(cancelled);
+    for (std::size_t c = 0; c < plan.cameras.size(); ++c) {
+      const CalibrationCamera& cam = plan.cameras[c];
+      const auto& raw = cam.device.device->raw();
+      procam_image img{};
+      err[0] = '\0';
+      if (int rc = raw.ops.camera->capture(raw.self, 5000, &img, err, sizeof err - 1);
+          rc != PROCAM_OK) {
+        return tl::unexpected(deviceFailure("camera", cam.device.name, rc, "capture", err));
+      }
+      cv::Mat gray = toGray(img);
+      if (gray.empty()) {
+        return tl::unexpected(CalibrationFailure{
+            code::kIo, "camera '" + cam.device.name + "' returned an unknown pixel format"});
+      }
+      captures[c].push_back(std::move(gray));
+      ++done;
+      hooks.progress({0.9 * done / total, "capturing", done});
+      if (hooks.cancelled()) return tl::unexpected(cancelled);
+    }
+  }
+  CalibrationOutcome outcome;
+  std::vector<calib::DecodedView> views;
+  for (std::size_t c = 0; c < plan.cameras.size(); ++c) {
+    hooks.progress({0.9 + 0.05 * c / plan.cameras.size(), "decoding", total});
+    auto d = sl::decode(plan.set, captures[c]);
+    if (!d) {
+      return tl::unexpected(CalibrationFailure{
+          code::kFailed, "camera '" + plan.cameras[c].device.name + "': " + d.error().message});
+    }
+    if (d->decoded == 0) {
+      return tl::unexpected(CalibrationFailure{
+          code::kFailed, "camera '" + plan.cameras[c].device.name +
+                             "' decoded no pixel: it does not see the projected patterns"});
+    }
+    outcome.decoded.push_back(d->decoded);
+    views.push_back({plan.cameras[c].device.name, plan.cameras[c].model, std::move(*d)});
+    if (hooks.cancelled()) return tl::unexpected(cancelled);
+  }
+  hooks.progress({0.95, "solving", total});
+  auto route = calib::solveStereoRoute(plan.set, views[0], views[1], plan.grid);
+  if (!route) return tl::unexpected(CalibrationFailure{code::kFailed, route.error().message});
+  outcome.route = std::move(*route);
+  return outcome;
+}
+
+}  // namespace procam::daemon

@@ -1,0 +1,278 @@
+// The calibrate operation (PROTOCOL.md): chooses the devices, runs the
+// structured-light capture and route (a) on the compute worker, and writes
+// rig.json (and surface.ply for a non-planar surface) through StateFile.
+#include <algorithm>
+
+#include "calibration_job.hpp"
+#include "daemon.hpp"
+#include "device_manager.hpp"
+#include "log.hpp"
+#include "rig_file.hpp"
+
+#ifdef PROCAM_HAVE_SIM
+#include "sim/scene_library.hpp"
+#endif
+
+namespace procam::daemon {
+
+using nlohmann::json;
+namespace code = proto::code;
+
+namespace {
+
+constexpr const char* kRigFile = "rig.json";
+constexpr const char* kMeshFile = "surface.ply";
+
+using Failure = CalibrationFailure;
+
+StateFile rigFile(const std::string& state_dir) {
+  return StateFile(state_dir, kRigFile, [](std::string_view text) -> Result<void> {
+    auto j = json::parse(text, nullptr, false);
+    if (j.is_discarded() || !j.is_object() || !j.contains("projectors") ||
+        !j["projectors"].is_array()) {
+      return fail(ErrorCode::kParse, "not a rig.json document (an object with \"projectors\")");
+    }
+    return {};
+  });
+}
+
+StateFile meshFile(const std::string& state_dir) {
+  return StateFile(state_dir, kMeshFile, [](std::string_view text) -> Result<void> {
+    if (text.substr(0, 4) != "ply\n") return fail(ErrorCode::kParse, "not an ASCII PLY file");
+    return {};
+  });
+}
+
+// A camera's K, distortion and pose. On the virtual rig: the scene's truth (the
+// pose at time 0; the mock camera renders with exactly this model). Elsewhere: the
+// camera of that name in the state directory's rig.json, as procam-calibrate
+// camera/stereo (or an earlier calibrate) wrote it.
+tl::expected<geom::CameraModel, Failure> cameraModel(const DeviceEntry& e,
+                                                     const std::string& state_dir) {
+  if (e.description.subsystem == "sim") {
+#ifdef PROCAM_HAVE_SIM
+    auto scene = sim::resolveScene(e.description.property("SIM_SCENE"));
+    if (!scene) return tl::unexpected(Failure{code::kUnavailable, scene.error().message});
+    const sim::SceneState state = scene->at(0);
+    if (const auto* c = state.camera(e.description.property("SIM_DEVICE"))) return c->model;
+#endif
+    return tl::unexpected(
+        Failure{code::kUnavailable, "no scene truth for virtual camera '" + e.name + "'"});
+  }
+  const StateFile rig = rigFile(state_dir);
+  auto loaded = rig.read();
+  if (!loaded) {
+    return tl::unexpected(Failure{
+        code::kUnavailable, "camera '" + e.name + "' is not calibrated: " + loaded.error().message +
+                                " (calibrate the cameras with procam-calibrate stereo and put "
+                                "them in " +
+                                rig.path() + ")"});
+  }
+  auto cameras = rig::camerasFromJson(json::parse(loaded->contents), rig.path());
+  if (cameras) {
+    for (const auto& c : *cameras) {
+      if (c.name == e.name) return c.model;
+    }
+  }
+  return tl::unexpected(Failure{
+      code::kUnavailable,
+      "camera '" + e.name + "' is not calibrated: " + rig.path() + " has no camera of that name"});
+}
+
+// The devices and camera models of a run; everything but the capture itself.
+tl::expected<CalibrationPlan, Failure> makePlan(DeviceSet& devices, const CalibrationArgs& args,
+                                                const std::string& state_dir) {
+  auto pick = [&](procam_family family, const std::string& name,
+                  const std::vector<const DeviceEntry*>& taken) -> const DeviceEntry* {
+    for (const auto& e : devices.entries()) {
+      if (e.description.family != family || !e.usable()) continue;
+      if (!name.empty() ? e.name == name
+                        : std::find(taken.begin(), taken.end(), &e) == taken.end()) {
+        return &e;
+      }
+    }
+    return nullptr;
+  };
+  const DeviceEntry* out = pick(PROCAM_FAMILY_OUTPUT, args.output, {});
+  if (!out) {
+    return tl::unexpected(Failure{
+        code::kUnavailable, args.output.empty() ? "calibration needs a projector output"
+                                                : "no usable output named '" + args.output + "'"});
+  }
+  std::vector<const DeviceEntry*> cams;
+  for (int i = 0; i < 2; ++i) {
+    const std::string name = args.cameras.empty() ? "" : args.cameras[i];
+    const DeviceEntry* c = pick(PROCAM_FAMILY_CAMERA, name, cams);
+    if (!c) {
+      return tl::unexpected(Failure{code::kUnavailable,
+                                    name.empty()
+                                        ? "calibration (route a) needs two calibrated cameras; " +
+                                              std::to_string(cams.size()) + " usable camera(s) open"
+                                        : "no usable camera named '" + name + "'"});
+    }
+    cams.push_back(c);
+  }
+  CalibrationPlan plan;
+  uint32_t w = 0, h = 0;
+  const auto& raw = out->device.raw();
+  if (raw.ops.output->get_mode(raw.self, &w, &h, &plan.refresh_hz) != PROCAM_OK || w < 2 || h < 2) {
+    return tl::unexpected(Failure{code::kUnavailable, "output '" + out->name + "' has no mode"});
+  }
+  if (!(plan.refresh_hz > 0)) plan.refresh_hz = 60;
+  sl::PatternOptions po;
+  po.width = static_cast<int>(w);
+  po.height = static_cast<int>(h);
+  po.mode = args.mode;
+  po.step = args.step;
+  po.phase_steps = args.phase_steps;
+  auto set = sl::makePatternSet(po);
+  if (!set) return tl::unexpected(Failure{code::kBadArgument, set.error().message});
+  plan.set = std::move(*set);
+  plan.grid = args.grid;
+  plan.settle_frames = args.settle_frames;
+  plan.output = {out->name, out->device.share()};
+  for (const DeviceEntry* c : cams) {
+    auto model = cameraModel(*c, state_dir);
+    if (!model) return tl::unexpected(model.error());
+    plan.cameras.push_back({{c->name, c->device.share()}, *model});
+  }
+  return plan;
+}
+
+json positionJson(const geom::Pose& pose) {
+  const Vec3 c = pose.center();
+  return {c.x(), c.y(), c.z()};
+}
+
+}  // namespace
+
+void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
+  auto args = parseCalibrationArgs(req.body);
+  if (!args) return errorTo(client, req, code::kBadArgument, args.error());
+  if (!calibration_.op.empty()) {
+    return errorTo(client, req, code::kBusy,
+                   "calibration " + calibration_.op + " is running; wait for it or cancel it");
+  }
+  auto made = makePlan(devices_, *args, options_.state_dir);
+  if (!made) return errorTo(client, req, made.error().code, made.error().message);
+  auto plan = std::make_shared<const CalibrationPlan>(std::move(*made));
+
+  const std::string op_id = "op-" + std::to_string(next_operation_++);
+  auto cancelled = std::make_shared<std::atomic<bool>>(false);
+  operations_[op_id] = Operation{"calibrate", client, req.id, cancelled};
+  calibration_ = {op_id, {plan->output.name}, "", calibration_.hooked};
+  for (const auto& c : plan->cameras) calibration_.devices.push_back(c.device.name);
+  if (!calibration_.hooked) {
+    // A device the run uses was unplugged or lost: stop between two frames.
+    device_manager_->onDeviceRemoved([this](const DeviceEntry& e) {
+      const auto& used = calibration_.devices;
+      if (calibration_.op.empty() || std::find(used.begin(), used.end(), e.name) == used.end()) {
+        return;
+      }
+      if (auto it = operations_.find(calibration_.op); it != operations_.end()) {
+        calibration_.removed =
+            "calibration cancelled: " + std::string(plugins::familyName(e.description.family)) +
+            " '" + e.name + "' went away" + (e.error.empty() ? "" : " (" + e.error + ")");
+        it->second.cancelled->store(true);
+      }
+    });
+    calibration_.hooked = true;
+  }
+  server_->hold(client);
+  json cameras = json::array();
+  for (const auto& c : plan->cameras) cameras.push_back(c.device.name);
+  const int captures = plan->captures();
+  replyTo(client, req, "CALIBRATE",
+          {{"operation", op_id},
+           {"state", "started"},
+           {"output", plan->output.name},
+           {"cameras", cameras},
+           {"mode", sl::toString(plan->set.options.mode)},
+           {"frames", plan->set.frames.size()},
+           {"captures", captures}});
+  logInfo("calibration " + op_id + ": " + std::to_string(plan->set.frames.size()) +
+          " pattern frames on '" + plan->output.name + "'");
+  auto progress = [op_id, captures](const CalibrationProgress& p) {
+    return json{{"operation", op_id}, {"kind", "calibrate"},  {"fraction", p.fraction},
+                {"stage", p.stage},   {"capture", p.capture}, {"captures", captures}};
+  };
+  operationEvent(client, "progress", progress({0, "starting", 0}));
+
+  compute_worker_->submit([this, client, req, op_id, cancelled, plan, progress] {
+    CalibrationHooks hooks;
+    hooks.cancelled = [cancelled] { return cancelled->load(); };
+    hooks.progress = [this, client, op_id, progress](const CalibrationProgress& p) {
+      loop_->post([this, client, op_id, body = progress(p)] {
+        if (operations_.count(op_id)) operationEvent(client, "progress", body);
+      });
+    };
+    auto result = runCalibration(*plan, hooks);
+    return [this, client, req, op_id, cancelled, plan, result, progress] {
+      auto finish = [this, client, req, op_id](const json& reply, const Failure* failure) {
+        operations_.erase(op_id);
+        calibration_.op.clear();
+        json finished = {{"operation", op_id}, {"kind", "calibrate"}, {"ok", failure == nullptr}};
+        if (failure) {
+          finished["error"] = failure->message;
+          logWarning("calibration " + op_id + ": " + failure->message);
+          errorTo(client, req, failure->code, failure->message);
+        } else {
+          replyTo(client, req, "CALIBRATE", reply);
+        }
+        operationEvent(client, "finished", finished);
+        server_->release(client);  // after the reply: a half-closed client may close now
+        // The device manager closes a lost device and retries it.
+        if (failure && failure->rc == PROCAM_ENODEV) {
+          device_manager_->report(failure->device, failure->rc, failure->message);
+        }
+        refreshOutputs();  // what the outputs showed before the pattern frames
+      };
+      if (!result || cancelled->load()) {
+        Failure f = result ? Failure{code::kCancelled, "calibration cancelled"} : result.error();
+        if (f.code == code::kCancelled && !calibration_.removed.empty()) {
+          f.message = calibration_.removed;
+        }
+        return finish({}, &f);
+      }
+      // From here on the result is written: a cancel no longer finds the operation.
+      operations_.erase(op_id);
+      operationEvent(client, "progress", progress({0.98, "writing", plan->captures()}));
+      const calib::StereoRouteResult& route = result->route;
+      std::vector<rig::NamedCamera> cameras;
+      for (const auto& c : plan->cameras) cameras.push_back({c.device.name, c.model, -1});
+      const rig::NamedProjector projector{plan->output.name, plan->set.options.width,
+                                          plan->set.options.height, route.projector};
+      const json surface = rig::surfaceJson(route.surface, kMeshFile);
+      const std::string text = rig::rigJson(cameras, projector, surface).dump(2) + "\n";
+      const std::string mesh = route.surface.planar ? "" : surface::toPly(route.surface.mesh);
+      json reply = {{"operation", op_id},
+                    {"state", "done"},
+                    {"projector", rig::projectorJson(projector)},
+                    {"position", positionJson(route.projector.pose)},
+                    {"reprojection_rms_px", route.projector.rms_px},
+                    {"surface", surface},
+                    {"surface_type", route.surface.planar ? "plane" : "mesh"},
+                    {"triangulated", route.triangulated},
+                    {"decoded", result->decoded}};
+      // fsync may block: the I/O worker writes the mesh first, then rig.json
+      // (the previous versions stay as .bak).
+      io_worker_->submit([dir = options_.state_dir, text, mesh, reply, finish] {
+        Result<void> ok;
+        if (!mesh.empty()) ok = meshFile(dir).write(mesh);
+        const StateFile rig = rigFile(dir);
+        if (ok) ok = rig.write(text);
+        return [ok, reply, finish, path = rig.path()]() mutable {
+          if (!ok) {
+            const Failure f{code::kIo, "rig.json not written: " + ok.error().message};
+            return finish({}, &f);
+          }
+          reply["path"] = path;
+          logInfo("calibration written to " + path);
+          finish(reply, nullptr);
+        };
+      });
+    };
+  });
+}
+
+}  // namespace procam::daemon

@@ -1,0 +1,40 @@
+#pragma once
+// Route (a) from decoded structured light (seed §4.1.1): two calibrated cameras
+// decode the same pattern set; each decoded map is inverted on a projector grid,
+// the nodes both cameras see are triangulated, the projector's 3x4 matrix is fitted
+// to them and the display surface is modelled from the points consistent with it.
+// Shared by procam-calibrate (files) and procamd (live captures).
+#include <string>
+
+#include "calibration/projector_calibration.hpp"
+#include "geometry/camera_model.hpp"
+#include "structured_light/decoder.hpp"
+#include "structured_light/pattern_set.hpp"
+#include "surface/surface_model.hpp"
+
+namespace procam::calib {
+
+struct DecodedView {
+  std::string name;  // names the camera in error messages
+  geom::CameraModel camera;
+  sl::Decoded decoded;
+};
+
+struct StereoRouteResult {
+  ProjectorCalibration projector;
+  surface::SurfaceModel surface;
+  std::size_t triangulated = 0;  // projector nodes seen by both cameras
+  std::size_t consistent = 0;    // of those, kept by the projector fit
+};
+
+// Inverse-map neighbourhood for a pattern set: Gray-only correspondences are cell
+// centres, so it spans several cells; phase-shifted ones are continuous.
+double sampleRadius(const sl::PatternSet& set);
+
+// `step`: projector pixels between grid nodes. kInvalidInput when a decoded map's
+// size is not its camera's; kTooFewPoints below 20 triangulated nodes; the errors of
+// calibrateProjectorFromSurface (kCoplanar for a planar scene) and buildSurface.
+Result<StereoRouteResult> solveStereoRoute(const sl::PatternSet& set, const DecodedView& a,
+                                           const DecodedView& b, int step);
+
+}  // namespace procam::calib

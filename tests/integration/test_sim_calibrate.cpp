@@ -1,0 +1,348 @@
+// The calibrate operation on the virtual rig, over the socket only: corner_stereo
+// (two walls at 90 degrees, one projector, a stereo pair) at half resolution, so
+// that the ray-cast captures take seconds.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "daemon_harness.hpp"
+#include "unit/calibration/rig_capture.hpp"
+
+namespace procam::itest {
+namespace {
+
+// Projector 640x400 and cameras 512x384 (corner_stereo's scaled by 1/2, intrinsics
+// with them), as in tests/unit/calibration/test_rig_accuracy.cpp.
+
+std::string sceneFile(const TempDir& dir) {
+  std::string t = procam::testing::sceneText("corner_stereo");
+  EXPECT_TRUE(procam::testing::scaleDevice(t, 1280, 800, 0.5));  // proj
+  EXPECT_TRUE(procam::testing::scaleDevice(t, 1024, 768, 0.5));  // cam_left
+  EXPECT_TRUE(procam::testing::scaleDevice(t, 1024, 768, 0.5));  // cam_right
+  dir.write("corner_small.toml", t);
+  return dir.file("corner_small.toml");
+}
+
+geom::CameraModel projectorTruth(const std::string& scene_file) {
+  auto scene = sim::Scene::load(scene_file);
+  EXPECT_TRUE(scene) << scene.error().message;
+  return scene->at(0).projectors.at(0).model;
+}
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The request the tests run: Gray code + 3-step phase, nodes every 8 projector
+// pixels, no settle wait (the mock output shows a frame at once).
+json calibrateRequest(int id) {
+  return {{"cmd", "calibrate"}, {"id", id},  {"mode", "gray+phase"},
+          {"phase_steps", 3},   {"grid", 8}, {"settle_frames", 0}};
+}
+
+struct CalibrateRun {
+  json started;                // the first CALIBRATE reply
+  std::vector<json> progress;  // progress events of the operation, in order
+  std::optional<json> finished;
+  std::optional<json> reply;  // the final CALIBRATE or ERROR
+};
+
+// Reads until the final reply to `id` (and the finished event) arrive.
+void follow(Connection& c, int id, CalibrateRun& run, std::chrono::milliseconds timeout = 90s) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < deadline && !(run.reply && run.finished)) {
+    auto msg = c.next(std::chrono::duration_cast<std::chrono::milliseconds>(
+        deadline - std::chrono::steady_clock::now()));
+    if (!msg) break;
+    if ((*msg)["class"] == "EVENT") {
+      if ((*msg)["event"] == "progress") run.progress.push_back(*msg);
+      if ((*msg)["event"] == "finished") run.finished = *msg;
+    } else if ((*msg)["id"] == id) {
+      run.reply = *msg;
+    }
+  }
+}
+
+// A rig.json from an earlier calibration; returns its bytes.
+std::string writePreviousRig(const TempDir& dir) {
+  std::filesystem::create_directories(dir.path() + "/state");
+  const std::string previous = R"({"cameras": [], "projectors": [{"name": "old"}]})"
+                               "\n";
+  dir.write("state/rig.json", previous);
+  return previous;
+}
+
+DaemonProcess::Launch sim(const std::string& scene) {
+  return DaemonProcess::Launch{{"--sim", scene}, {}, -1, true};
+}
+
+// Waits for the operation's progress event with at least `captures` captures done.
+bool waitForCaptures(Connection& c, CalibrateRun& run, int captures) {
+  while (auto msg = c.next(60s)) {
+    if ((*msg)["class"] != "EVENT" || (*msg)["event"] != "progress") continue;
+    run.progress.push_back(*msg);
+    if (static_cast<int>((*msg)["capture"]) >= captures) return true;
+  }
+  return false;
+}
+
+TEST(SimCalibrate, WritesRigJsonWithTheProjectorsIntrinsics) {
+  TempDir dir;
+  const std::string scene = sceneFile(dir);
+  DaemonProcess d(dir, sim(scene));
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  auto started = c.call(calibrateRequest(1));
+  CalibrateRun run;
+  ASSERT_TRUE(started);
+  ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
+  EXPECT_EQ((*started)["state"], "started");
+  const std::string op = (*started)["operation"];
+  const int captures = (*started)["captures"];
+  // gray+phase with 3 steps on 640x400 (Gray cell 8 px): white, black, 7 column and
+  // 6 row Gray bits with their inverses, 3 phase frames per axis; two cameras.
+  EXPECT_EQ((*started)["frames"], 34);
+  EXPECT_EQ(captures, 68);
+  follow(c, 1, run);
+  ASSERT_TRUE(run.reply) << d.log();
+  ASSERT_EQ((*run.reply)["class"], "CALIBRATE") << run.reply->dump();
+  ASSERT_TRUE(run.finished);
+  EXPECT_EQ((*run.finished)["ok"], true);
+  EXPECT_EQ((*run.finished)["operation"], op);
+
+  // Progress: one event per capture, in order, then decoding, solving, writing.
+  int last_capture = 0;
+  double last_fraction = 0;
+  std::set<std::string> stages;
+  for (const json& e : run.progress) {
+    EXPECT_EQ(e["operation"], op);
+    EXPECT_GE(e["fraction"].get<double>(), last_fraction);
+    EXPECT_GE(static_cast<int>(e["capture"]), last_capture);
+    last_fraction = e["fraction"];
+    last_capture = e["capture"];
+    stages.insert(e["stage"].get<std::string>());
+  }
+  EXPECT_EQ(last_capture, captures);
+  EXPECT_EQ(stages,
+            (std::set<std::string>{"starting", "capturing", "decoding", "solving", "writing"}));
+
+  // rig.json in the state directory, against the scene's truth, with the
+  // structured-light issue's route (a) tolerances on corner_stereo: focal 0.5%,
+  // principal point 2 px, position 2 mm, rotation 0.05 degrees, reprojection RMS
+  // <= 0.15 px.
+  const std::string path = (*run.reply)["path"];
+  EXPECT_EQ(path, dir.path() + "/state/rig.json");
+  const json rig = json::parse(readFile(path));
+  ASSERT_EQ(rig["projectors"].size(), 1u);
+  const json& p = rig["projectors"][0];
+  EXPECT_EQ(p["name"], "proj");
+  EXPECT_EQ(p["width"], 640);
+  EXPECT_EQ(p, (*run.reply)["projector"]);
+  const geom::CameraModel truth = projectorTruth(scene);
+  const double fx = p["K"][0], fy = p["K"][4], cx = p["K"][2], cy = p["K"][5];
+  EXPECT_NEAR(fx, truth.K.fx, 0.005 * truth.K.fx);
+  EXPECT_NEAR(fy, truth.K.fy, 0.005 * truth.K.fy);
+  EXPECT_NEAR(cx, truth.K.cx, 2.0);
+  EXPECT_NEAR(cy, truth.K.cy, 2.0);
+  Mat3 R;
+  for (int i = 0; i < 9; ++i) R(i / 3, i % 3) = p["R"][i];
+  const Vec3 t(p["t"][0], p["t"][1], p["t"][2]);
+  const Vec3 position = -R.transpose() * t;
+  const double position_mm = (position - truth.pose.center()).norm() * 1000;
+  const double rotation_deg = Eigen::AngleAxisd(R.transpose() * truth.pose.R).angle() * 180 / M_PI;
+  EXPECT_LT(position_mm, 2.0);
+  EXPECT_LT(rotation_deg, 0.05);
+  const double rms = (*run.reply)["reprojection_rms_px"];
+  EXPECT_LE(rms, 0.15);
+  // Two walls: a mesh, written beside rig.json.
+  EXPECT_EQ((*run.reply)["surface_type"], "mesh");
+  EXPECT_EQ(rig["surface"], json({{"mesh", "surface.ply"}}));
+  EXPECT_EQ(readFile(dir.path() + "/state/surface.ply").substr(0, 4), "ply\n");
+  EXPECT_EQ(rig["cameras"].size(), 2u);
+  std::printf(
+      "[ figures  ] fx %.2f (truth %.2f, %.3f%%), fy %.2f (%.3f%%), cx %.2f (%+.2f px), "
+      "cy %.2f (%+.2f px), position %.2f mm, rotation %.4f deg, RMS %.3f px, %d nodes\n",
+      fx, truth.K.fx, 100 * (fx - truth.K.fx) / truth.K.fx, fy,
+      100 * (fy - truth.K.fy) / truth.K.fy, cx, cx - truth.K.cx, cy, cy - truth.K.cy, position_mm,
+      rotation_deg, rms, static_cast<int>((*run.reply)["triangulated"]));
+
+  // The daemon is free again.
+  auto status = c.call({{"cmd", "status"}});
+  ASSERT_TRUE(status);
+  EXPECT_EQ((*status)["operations"], json::array());
+}
+
+TEST(SimCalibrate, CancelMidRunKeepsThePreviousRigJson) {
+  TempDir dir;
+  const std::string scene = sceneFile(dir);
+  const std::string previous = writePreviousRig(dir);
+  DaemonProcess d(dir, sim(scene));
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  auto started = c.call(calibrateRequest(1));
+  ASSERT_TRUE(started);
+  ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
+  const std::string op = (*started)["operation"];
+  CalibrateRun run;
+  ASSERT_TRUE(waitForCaptures(c, run, 4));
+  ASSERT_TRUE(c.send({{"cmd", "cancel"}, {"id", 2}, {"operation", op}}));
+  std::optional<json> cancel_reply;
+  while (auto msg = c.next(30s)) {
+    if ((*msg)["class"] == "EVENT") {
+      if ((*msg)["event"] == "finished") run.finished = *msg;
+    } else if ((*msg)["id"] == 2) {
+      cancel_reply = *msg;
+    } else if ((*msg)["id"] == 1) {
+      run.reply = *msg;
+    }
+    if (cancel_reply && run.reply && run.finished) break;
+  }
+  ASSERT_TRUE(cancel_reply);
+  EXPECT_EQ((*cancel_reply)["cancelled"], json::array({op}));
+  ASSERT_TRUE(run.reply);
+  EXPECT_EQ((*run.reply)["class"], "ERROR");
+  EXPECT_EQ((*run.reply)["code"], "cancelled");
+  ASSERT_TRUE(run.finished);
+  EXPECT_EQ((*run.finished)["ok"], false);
+  // Stopped between frames, long before the last capture.
+  EXPECT_LT(static_cast<int>(run.progress.back()["capture"]),
+            static_cast<int>((*started)["captures"]));
+  EXPECT_EQ(readFile(dir.path() + "/state/rig.json"), previous);
+  EXPECT_FALSE(std::filesystem::exists(dir.path() + "/state/surface.ply"));
+  // A new calibration may start at once.
+  auto again = c.call(calibrateRequest(3));
+  ASSERT_TRUE(again);
+  EXPECT_EQ((*again)["class"], "CALIBRATE") << again->dump();
+}
+
+// A camera unplugged mid-run (the mock drivers' PROCAM_SIM_UNPLUG window opens 4 s
+// after the daemon started, a few frames into the run) cancels the operation with
+// an error naming it; the device manager then lists it lost.
+TEST(SimCalibrate, CameraGoneMidRunCancelsNamingIt) {
+  TempDir dir;
+  const std::string scene = sceneFile(dir);
+  const std::string previous = writePreviousRig(dir);
+  DaemonProcess d(dir, {{"--sim", scene}, {"PROCAM_SIM_UNPLUG=cam_right@4-1000"}, -1, true});
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  auto started = c.call(calibrateRequest(1));
+  ASSERT_TRUE(started);
+  ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
+  CalibrateRun run;
+  follow(c, 1, run, 60s);
+  ASSERT_TRUE(run.reply) << d.log();
+  EXPECT_EQ((*run.reply)["class"], "ERROR");
+  EXPECT_EQ((*run.reply)["code"], "cancelled");
+  EXPECT_NE((*run.reply)["message"].get<std::string>().find("'cam_right'"), std::string::npos)
+      << run.reply->dump();
+  ASSERT_TRUE(run.finished);
+  EXPECT_EQ((*run.finished)["ok"], false);
+  EXPECT_EQ(readFile(dir.path() + "/state/rig.json"), previous);
+  EXPECT_FALSE(std::filesystem::exists(dir.path() + "/state/surface.ply"));
+  auto devices = c.call({{"cmd", "devices"}});
+  ASSERT_TRUE(devices);
+  std::map<std::string, std::string> state;
+  for (const auto& e : (*devices)["devices"]) state[e["name"]] = e["state"];
+  EXPECT_EQ(state["cam_right"], "lost");
+  EXPECT_EQ(state["cam_left"], "open");
+}
+
+TEST(SimCalibrate, SecondCalibrateWhileOneRunsIsBusy) {
+  TempDir dir;
+  DaemonProcess d(dir, sim(sceneFile(dir)));
+  ASSERT_TRUE(d.started()) << d.log();
+  std::optional<Connection> first;
+  first.emplace(d.socketPath());
+  auto started = first->call(calibrateRequest(1));
+  ASSERT_TRUE(started);
+  ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
+  const std::string op = (*started)["operation"];
+  Connection second(d.socketPath());
+  auto busy = second.call(calibrateRequest(7));
+  ASSERT_TRUE(busy);
+  EXPECT_EQ((*busy)["class"], "ERROR");
+  EXPECT_EQ((*busy)["code"], "busy");
+  EXPECT_EQ((*busy)["id"], 7);
+  EXPECT_NE((*busy)["message"].get<std::string>().find(op), std::string::npos);
+  // The second client's connection stays usable; the first operation still runs.
+  auto status = second.call({{"cmd", "status"}});
+  ASSERT_TRUE(status);
+  EXPECT_EQ((*status)["operations"], json::array({{{"operation", op}, {"kind", "calibrate"}}}));
+  // Closing the owner's connection cancels its operation.
+  first.reset();
+  EXPECT_TRUE(eventually(
+      [&] {
+        auto s = second.call({{"cmd", "status"}});
+        return s && (*s)["operations"].empty();
+      },
+      30s));
+}
+
+TEST(SimCalibrate, MalformedArgumentsAreRefused) {
+  TempDir dir;
+  DaemonProcess d(dir, sim(sceneFile(dir)));
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  const std::vector<json> bad = {
+      {{"mode", "stripes"}},
+      {{"mode", 3}},
+      {{"step", 0}},
+      {{"step", "2"}},
+      {{"step", 1.5}},
+      {{"grid", -8}},
+      {{"settle_frames", 100000}},
+      {{"phase_steps", 2}},
+      {{"mode", "gray"}, {"phase_steps", 4}},
+      {{"cameras", {"cam_left"}}},
+      {{"cameras", {"cam_left", "cam_left"}}},
+      {{"cameras", "cam_left"}},
+      {{"output", ""}},
+      {{"speed", "fast"}},
+  };
+  int id = 100;
+  for (json args : bad) {
+    args["cmd"] = "calibrate";
+    args["id"] = ++id;
+    auto r = c.call(args);
+    ASSERT_TRUE(r) << args.dump();
+    EXPECT_EQ((*r)["class"], "ERROR") << args.dump();
+    EXPECT_EQ((*r)["code"], "bad-argument") << args.dump() << " -> " << r->dump();
+    EXPECT_EQ((*r)["id"], id);
+  }
+  // Devices that do not exist: unavailable, naming them.
+  auto r = c.call({{"cmd", "calibrate"}, {"cameras", {"cam_left", "cam_nope"}}});
+  ASSERT_TRUE(r);
+  EXPECT_EQ((*r)["code"], "unavailable");
+  EXPECT_NE((*r)["message"].get<std::string>().find("cam_nope"), std::string::npos);
+  r = c.call({{"cmd", "calibrate"}, {"output", "beamer"}});
+  ASSERT_TRUE(r);
+  EXPECT_EQ((*r)["code"], "unavailable");
+  auto status = c.call({{"cmd", "status"}});
+  ASSERT_TRUE(status);
+  EXPECT_EQ((*status)["operations"], json::array());
+  EXPECT_FALSE(std::filesystem::exists(dir.path() + "/state/rig.json"));
+}
+
+// The handheld rig has one camera: route (a) is unavailable there.
+TEST(SimCalibrate, OneCameraIsUnavailable) {
+  TempDir dir;
+  DaemonProcess d(dir, sim("handheld"));
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  auto r = c.call({{"cmd", "calibrate"}});
+  ASSERT_TRUE(r);
+  EXPECT_EQ((*r)["class"], "ERROR");
+  EXPECT_EQ((*r)["code"], "unavailable");
+  EXPECT_NE((*r)["message"].get<std::string>().find("two"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace procam::itest
