@@ -53,12 +53,18 @@ std::optional<cv::Size> outputMode(const DeviceEntry& e) {
 }  // namespace
 
 void Daemon::setupAutoKeystone() {
-  KeystoneRuntime& k = keystone_rt_;
   // Policy and the virtual rig's default scene turn it on at start; a saved
   // setting may too.
   if (config_.auto_keystone || options_.sim_scene == kDefaultSimScene) {
     settings_.auto_keystone = true;
   }
+  probeKeystoneInputs();
+}
+
+// Finds the tilt sensor, the output and the intrinsics; again on `auto on`
+// while they are missing (a rig.json written by calibrate, a sensor plugged in).
+void Daemon::probeKeystoneInputs() {
+  KeystoneRuntime& k = keystone_rt_;
   DeviceEntry* tilt = devices_.firstUsable(PROCAM_FAMILY_TILT);
   DeviceEntry* out = devices_.firstUsable(PROCAM_FAMILY_OUTPUT);
   if (!tilt || !out) {
@@ -69,7 +75,8 @@ void Daemon::setupAutoKeystone() {
     return;
   }
   k.tilt_device = tilt->name;
-  watchTiltSensor();
+  if (!k.hooked) watchTiltSensor();
+  k.hooked = true;
   auto rig = projectorFromRigFile(options_.state_dir, out->name);
   if (!rig && rig.error().code != ErrorCode::kNotFound) warn(rig.error().message);
   const std::string scene = tilt->description.property("SIM_SCENE");
@@ -134,6 +141,7 @@ void Daemon::useKeystoneInputs(ProjectorModel projector, TiltMount mount) {
 
 Result<void> Daemon::setAutoKeystone(bool enable) {
   KeystoneRuntime& k = keystone_rt_;
+  if (enable && !k.tracker && !k.preparing) probeKeystoneInputs();
   if (enable && !k.tracker && !k.preparing) return fail(ErrorCode::kNotFound, k.unavailable);
   settings_.auto_keystone = enable;
   if (!enable || !k.tracker) {

@@ -4,6 +4,7 @@
 // keystone::solveKeystone (issue 4's tolerances: corner <= 0.5 px, aspect within
 // 0.1 %, area within 0.5 % of the largest).
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cmath>
 #include <opencv2/imgcodecs.hpp>
@@ -235,6 +236,25 @@ TEST(SimKeystone, SixPositionCalibrationStepsOverTheSocket) {
   auto reset = c.call({{"cmd", "keystone"}, {"action", "accel-reset"}});
   ASSERT_TRUE(reset);
   EXPECT_TRUE((*reset)["accel_calibration"]["filled"].empty());
+}
+
+TEST(SimKeystone, IntrinsicsOfRigJsonWinOverTheScene) {
+  TempDir dir;
+  ::mkdir(dir.file("state").c_str(), 0750);
+  dir.write("state/rig.json",
+            R"({"cameras": [], "projectors": [{"name": "proj", "width": 1280, "height": 720,
+                "K": [1500, 0, 640, 0, 1490, 360, 0, 0, 1], "R": [1,0,0,0,1,0,0,0,1],
+                "t": [0, 0, 0]}]})");
+  DaemonProcess d(dir, sim("handheld"));
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  json k;
+  ASSERT_TRUE(eventually([&] {
+    k = *c.call({{"cmd", "keystone"}});
+    return k.contains("projector");
+  }));
+  EXPECT_EQ(k["projector"]["intrinsics"], json({1500.0, 1490.0, 640.0, 360.0}));
+  EXPECT_EQ(k["projector"]["source"], dir.file("state/rig.json"));
 }
 
 json outputStats(Connection& c) {
