@@ -421,6 +421,8 @@ CamResult<void> V4l2Camera::setControl(Control control, double value) {
       // V4L2_CID_EXPOSURE_ABSOLUTE counts 100 µs units.
       return setCtrl(V4L2_CID_EXPOSURE_ABSOLUTE, std::llround(value * 1e4), control);
     case Control::kAutoExposure: {
+      // A camera without automatic exposure is already manual.
+      if (value == 0 && !hasCtrl(V4L2_CID_EXPOSURE_AUTO)) return {};
       if (value == 0) return setCtrl(V4L2_CID_EXPOSURE_AUTO, V4L2_EXPOSURE_MANUAL, control);
       // UVC cameras often offer only aperture priority as their automatic mode.
       auto ok = setCtrl(V4L2_CID_EXPOSURE_AUTO, V4L2_EXPOSURE_AUTO, control);

@@ -1,0 +1,297 @@
+#include "camera/aravis/aravis_camera.hpp"
+
+#include <arv.h>
+
+#include <cmath>
+#include <ctime>
+#include <thread>
+
+namespace procam::camera {
+namespace {
+
+// The message of a GError, which is freed.
+std::string take(GError*& error) {
+  std::string m = error && error->message ? error->message : "unknown error";
+  g_clear_error(&error);
+  return m;
+}
+
+std::optional<SourceFormat> sourceOf(ArvPixelFormat f) {
+  switch (f) {
+    case ARV_PIXEL_FORMAT_MONO_8:
+      return SourceFormat::kGrey;
+    case ARV_PIXEL_FORMAT_MONO_16:
+      return SourceFormat::kY16;
+    case ARV_PIXEL_FORMAT_RGB_8_PACKED:
+      return SourceFormat::kRgb24;
+    case ARV_PIXEL_FORMAT_BGR_8_PACKED:
+      return SourceFormat::kBgr24;
+    case ARV_PIXEL_FORMAT_YUV_422_YUYV_PACKED:
+      return SourceFormat::kYuyv;
+    default:
+      return std::nullopt;
+  }
+}
+
+uint32_t bytesPerPixel(SourceFormat f) {
+  return f == SourceFormat::kGrey                                ? 1
+         : (f == SourceFormat::kY16 || f == SourceFormat::kYuyv) ? 2
+                                                                 : 3;
+}
+
+void onControlLost(ArvDevice*, gpointer flag) {
+  static_cast<std::atomic<bool>*>(flag)->store(true);  // from Aravis' heartbeat thread
+}
+
+// Aravis stamps buffers with the host's real-time clock on arrival; the pipeline's
+// timestamps are CLOCK_MONOTONIC, so shift by the clocks' current offset.
+uint64_t toMonotonic(uint64_t realtime_ns) {
+  timespec rt{};
+  clock_gettime(CLOCK_REALTIME, &rt);
+  const uint64_t now_rt = uint64_t(rt.tv_sec) * 1'000'000'000ull + uint64_t(rt.tv_nsec);
+  const uint64_t now_mono = monotonicNs();
+  const uint64_t age = now_rt > realtime_ns ? now_rt - realtime_ns : 0;
+  return age < now_mono ? now_mono - age : now_mono;
+}
+
+}  // namespace
+
+AravisCamera::AravisCamera(AravisOptions options) : options_(std::move(options)) {}
+
+AravisCamera::~AravisCamera() {
+  stop();
+}
+
+CamResult<void> AravisCamera::start() {
+  stop();
+  if (options_.buffers < 2)
+    return camFail(Status::kInvalid, name() + ": at least 2 stream buffers are needed");
+  GError* error = nullptr;
+  camera_ = arv_camera_new(options_.id.empty() ? nullptr : options_.id.c_str(), &error);
+  if (!camera_) return camFail(Status::kNoDevice, name() + ": cannot open: " + take(error));
+  lost_ = false;
+  g_signal_connect(arv_camera_get_device(camera_), "control-lost", G_CALLBACK(onControlLost),
+                   &lost_);
+  auto ok = configure();
+  if (!ok) stop();
+  return ok;
+}
+
+CamResult<void> AravisCamera::configure() {
+  GError* error = nullptr;
+  auto failed = [&](Status s, const std::string& what) {
+    return camFail(s, name() + ": " + what + ": " + take(error));
+  };
+  // Acquisition may still run from a previous client that vanished.
+  arv_camera_stop_acquisition(camera_, &error);
+  g_clear_error(&error);
+  if (options_.width > 0 && options_.height > 0) {
+    arv_camera_set_region(camera_, 0, 0, int(options_.width), int(options_.height), &error);
+    if (error) return failed(Status::kNotSupported, "region");
+  }
+  if (!options_.pixel_format.empty()) {
+    arv_camera_set_pixel_format_from_string(camera_, options_.pixel_format.c_str(), &error);
+    if (error) return failed(Status::kNotSupported, "pixel format " + options_.pixel_format);
+  }
+  if (arv_camera_is_gv_device(camera_)) {
+    if (options_.packet_size > 0)
+      arv_camera_gv_set_packet_size(camera_, options_.packet_size, &error);
+    else
+      arv_camera_gv_auto_packet_size(camera_, &error);
+    if (error) return failed(Status::kIo, "packet size");
+  }
+  if (options_.fps > 0) {
+    arv_camera_set_frame_rate(camera_, options_.fps, &error);
+    if (error) return failed(Status::kNotSupported, "frame rate");
+  }
+  int x = 0, y = 0, w = 0, h = 0;
+  arv_camera_get_region(camera_, &x, &y, &w, &h, &error);
+  if (error) return failed(Status::kIo, "reading the region");
+  if (options_.width > 0 && (uint32_t(w) != options_.width || uint32_t(h) != options_.height))
+    return camFail(Status::kNotSupported, name() + ": asked for " + std::to_string(options_.width) +
+                                              "x" + std::to_string(options_.height) +
+                                              ", the camera set " + std::to_string(w) + "x" +
+                                              std::to_string(h));
+  const ArvPixelFormat pf = arv_camera_get_pixel_format(camera_, &error);
+  if (error) return failed(Status::kIo, "reading the pixel format");
+  const auto src = sourceOf(pf);
+  if (!src)
+    return camFail(Status::kNotSupported,
+                   name() + ": pixel format 0x" + std::to_string(pf) +
+                       " cannot be converted (use Mono8, Mono16, RGB8Packed, BGR8Packed, YUV422)");
+  source_ = *src;
+  const procam_pixel_format pixel = options_.pixel.value_or(naturalPixel(source_));
+  if (pixel == PROCAM_PIXEL_GRAY16 && source_ != SourceFormat::kY16)
+    return camFail(Status::kNotSupported, name() + ": gray16 needs a Mono16 stream");
+  format_ = {uint32_t(w), uint32_t(h), pixel};
+
+  stream_ = arv_camera_create_stream(camera_, nullptr, nullptr, &error);
+  if (!stream_) return failed(Status::kIo, "creating the stream");
+  const guint payload = arv_camera_get_payload(camera_, &error);
+  if (error) return failed(Status::kIo, "reading the payload size");
+  for (unsigned i = 0; i < options_.buffers; ++i)
+    arv_stream_push_buffer(stream_, arv_buffer_new_allocate(payload));
+  arv_camera_set_acquisition_mode(camera_, ARV_ACQUISITION_MODE_CONTINUOUS, &error);
+  if (error) return failed(Status::kIo, "acquisition mode");
+  arv_camera_start_acquisition(camera_, &error);
+  if (error) return failed(Status::kIo, "starting acquisition");
+  failed_ = 0;
+  return {};
+}
+
+void AravisCamera::releaseHeld() {
+  if (!held_) return;
+  frame_.image.release();
+  if (stream_)
+    arv_stream_push_buffer(stream_, held_);
+  else
+    g_object_unref(held_);
+  held_ = nullptr;
+}
+
+void AravisCamera::stop() {
+  releaseHeld();
+  if (camera_ && stream_ && !lost_) {
+    GError* error = nullptr;
+    arv_camera_stop_acquisition(camera_, &error);
+    g_clear_error(&error);
+  }
+  if (lost_ && camera_) {
+    // Releasing a gone GigE camera waits out Aravis' register timeouts (about 10 s here);
+    // the daemon closes lost devices on its loop thread, so let that happen elsewhere.
+    std::thread([stream = stream_, camera = camera_] {
+      if (stream) g_object_unref(stream);
+      g_object_unref(camera);
+    }).detach();
+    stream_ = nullptr;
+    camera_ = nullptr;
+  }
+  g_clear_object(&stream_);
+  g_clear_object(&camera_);
+}
+
+CamResult<void> AravisCamera::checkAlive() const {
+  if (lost_) return camFail(Status::kNoDevice, name() + ": control lost (the camera is gone)");
+  GError* error = nullptr;
+  arv_camera_get_payload(camera_, &error);
+  if (error) {
+    lost_ = true;  // stop() then skips the commands a gone camera would time out on
+    return camFail(Status::kNoDevice, name() + ": the camera no longer answers: " + take(error));
+  }
+  return {};
+}
+
+CamResult<const Frame*> AravisCamera::capture(int timeout_ms) {
+  if (!stream_) return camFail(Status::kInvalid, name() + ": not streaming");
+  releaseHeld();
+  if (lost_) return tl::unexpected(checkAlive().error());
+  ArvBuffer* b = timeout_ms == 0
+                     ? arv_stream_try_pop_buffer(stream_)
+                     : arv_stream_timeout_pop_buffer(
+                           stream_, guint64(timeout_ms < 0 ? 3'600'000 : timeout_ms) * 1000u);
+  if (!b) {
+    if (timeout_ms == 0) {
+      if (lost_) return tl::unexpected(checkAlive().error());
+      return camFail(Status::kAgain, name() + ": no frame waiting");
+    }
+    // Silence: either a slow camera or a gone one; ask it something.
+    if (auto alive = checkAlive(); !alive) return tl::unexpected(alive.error());
+    return camFail(Status::kTimeout,
+                   name() + ": no frame within " + std::to_string(timeout_ms) + " ms");
+  }
+  held_ = b;
+  if (arv_buffer_get_status(b) != ARV_BUFFER_STATUS_SUCCESS) {
+    ++failed_;
+    const int status = int(arv_buffer_get_status(b));
+    releaseHeld();
+    return camFail(Status::kIo, name() + ": frame incomplete (Aravis buffer status " +
+                                    std::to_string(status) + ")");
+  }
+  std::size_t size = 0;
+  const auto* data = static_cast<const uint8_t*>(arv_buffer_get_image_data(b, &size));
+  const uint32_t w = uint32_t(arv_buffer_get_image_width(b));
+  const uint32_t h = uint32_t(arv_buffer_get_image_height(b));
+  const SourceImage src{source_, data, size, w, h, w * bytesPerPixel(source_)};
+  if (auto ok = convertFrame(src, format_.pixel, true, storage_, frame_); !ok) {
+    releaseHeld();
+    return camFail(ok.error().status, name() + ": " + ok.error().message);
+  }
+  frame_.sequence = arv_buffer_get_frame_id(b);
+  const uint64_t sys = arv_buffer_get_system_timestamp(b);
+  frame_.timestamp_ns = sys ? toMonotonic(sys) : monotonicNs();
+  return &frame_;
+}
+
+CamResult<double> AravisCamera::exposure() const {
+  if (!camera_) return camFail(Status::kInvalid, name() + ": not open");
+  GError* error = nullptr;
+  const double us = arv_camera_get_exposure_time(camera_, &error);
+  if (error) return camFail(Status::kIo, name() + ": reading exposure: " + take(error));
+  return us * 1e-6;
+}
+
+CamResult<void> AravisCamera::setControl(Control control, double value) {
+  if (!camera_) return camFail(Status::kInvalid, name() + ": not open");
+  if (!std::isfinite(value))
+    return camFail(Status::kInvalid, name() + ": " + toString(control) + " must be finite");
+  GError* error = nullptr;
+  auto io = [&](const char* what) {
+    return camFail(Status::kIo, name() + ": " + what + ": " + take(error));
+  };
+  auto inRange = [&](double v, double lo, double hi, const char* unit) -> CamResult<void> {
+    if (v >= lo && v <= hi) return {};
+    return camFail(Status::kInvalid, name() + ": " + toString(control) + " " + std::to_string(v) +
+                                         " " + unit + " outside the camera's range [" +
+                                         std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  };
+  switch (control) {
+    case Control::kAutoExposure: {
+      const bool available = arv_camera_is_exposure_auto_available(camera_, &error);
+      g_clear_error(&error);
+      if (!available) {
+        if (value == 0) return {};  // no automatic exposure: already manual
+        return unsupported(name(), control);
+      }
+      arv_camera_set_exposure_time_auto(camera_, value == 0 ? ARV_AUTO_OFF : ARV_AUTO_CONTINUOUS,
+                                        &error);
+      if (error) return io("ExposureAuto");
+      return {};
+    }
+    case Control::kExposure: {
+      const bool available = arv_camera_is_exposure_time_available(camera_, &error);
+      g_clear_error(&error);
+      if (!available) return unsupported(name(), control);
+      double lo = 0, hi = 0;
+      arv_camera_get_exposure_time_bounds(camera_, &lo, &hi, &error);
+      if (error) return io("exposure bounds");
+      const double us = value * 1e6;
+      if (auto ok = inRange(us, lo, hi, "us"); !ok) return ok;
+      arv_camera_set_exposure_time(camera_, us, &error);
+      if (error) return io("ExposureTime");
+      return {};
+    }
+    case Control::kGain: {
+      const bool available = arv_camera_is_gain_available(camera_, &error);
+      g_clear_error(&error);
+      if (!available) return unsupported(name(), control);
+      if (arv_camera_is_gain_auto_available(camera_, &error)) {
+        arv_camera_set_gain_auto(camera_, ARV_AUTO_OFF, &error);
+        if (error) return io("GainAuto");
+      }
+      g_clear_error(&error);
+      double lo = 0, hi = 0;
+      arv_camera_get_gain_bounds(camera_, &lo, &hi, &error);
+      if (error) return io("gain bounds");
+      if (auto ok = inRange(value, lo, hi, "dB"); !ok) return ok;
+      arv_camera_set_gain(camera_, value, &error);
+      if (error) return io("Gain");
+      return {};
+    }
+    case Control::kWhiteBalance:  // GenICam has balance ratios, not a colour temperature
+    case Control::kPowerLine:
+      return unsupported(name(), control);
+  }
+  return unsupported(name(), control);
+}
+
+}  // namespace procam::camera

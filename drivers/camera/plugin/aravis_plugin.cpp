@@ -1,0 +1,88 @@
+// The "aravis" camera driver: AravisCamera behind the plugin ABI.
+#include <cmath>
+#include <cstring>
+#include <exception>
+
+#include "camera/aravis/aravis_camera.hpp"
+#include "camera/plugin/camera_device.hpp"
+#include "camera/plugin/camera_plugin.hpp"
+
+namespace procam::camera::plugin {
+namespace {
+
+// GigE Vision cameras are not udev devices: they are configured (driver "aravis", or
+// an ARAVIS_ID property). USB3 Vision cameras are: interface class EF/05/00.
+int probe(const procam_device_desc* d) {
+  if (!d || d->family != PROCAM_FAMILY_CAMERA) return 0;
+  if ((d->subsystem && std::strcmp(d->subsystem, "aravis") == 0) ||
+      !descProperty(d, "ARAVIS_ID").empty())
+    return 60;
+  return descProperty(d, "ID_USB_INTERFACES").find(":ef0500:") != std::string::npos ? 60 : 0;
+}
+
+CamResult<std::optional<int>> whole(const CameraOptions& o, const char* key, int lo, int hi) {
+  auto v = o.number(key);
+  if (!v) return tl::unexpected(v.error());
+  if (!*v) return std::optional<int>();
+  if (**v < lo || **v > hi || std::floor(**v) != **v)
+    return camFail(Status::kInvalid, "aravis camera: option " + std::string(key) +
+                                         " must be a whole number " + std::to_string(lo) + ".." +
+                                         std::to_string(hi));
+  return std::optional<int>(int(**v));
+}
+
+CamResult<AravisOptions> parse(const procam_device_desc* d, const CameraOptions& o) {
+  if (auto ok = o.onlyKnown({"id", "width", "height", "pixel_format", "packet_size", "fps",
+                             "buffers", "pixel", PROCAM_CAMERA_CONTROL_KEYS});
+      !ok)
+    return tl::unexpected(ok.error());
+  AravisOptions a;
+  if (auto id = o.text("id"))
+    a.id = *id;
+  else if (auto prop = descProperty(d, "ARAVIS_ID"); !prop.empty())
+    a.id = prop;
+  else if (d && d->name)
+    a.id = d->name;
+  if (a.id.empty())
+    return camFail(Status::kInvalid, "aravis camera: no camera id: give the option id");
+  auto w = whole(o, "width", 1, 65535);
+  auto h = whole(o, "height", 1, 65535);
+  auto packet = whole(o, "packet_size", 576, 65535);
+  auto buffers = whole(o, "buffers", 2, 256);
+  auto fps = o.number("fps");
+  auto pixel = o.pixel();
+  for (auto* r : {&w, &h, &packet, &buffers})
+    if (!*r) return tl::unexpected(r->error());
+  if (!fps) return tl::unexpected(fps.error());
+  if (!pixel) return tl::unexpected(pixel.error());
+  if (w->has_value() != h->has_value())
+    return camFail(Status::kInvalid, "aravis camera: give both width and height, or neither");
+  a.width = uint32_t(w->value_or(0));
+  a.height = uint32_t(h->value_or(0));
+  a.packet_size = packet->value_or(0);
+  a.buffers = unsigned(buffers->value_or(8));
+  a.fps = fps->value_or(0);
+  a.pixel_format = o.text("pixel_format").value_or("");
+  a.pixel = *pixel;
+  return a;
+}
+
+int create(const procam_device_desc* d, const procam_config* config, procam_device* out, char* err,
+           std::size_t len) {
+  try {
+    const CameraOptions o("aravis", config);
+    auto a = parse(d, o);
+    if (!a) return report(err, len, a.error());
+    return finishCameraDevice(std::make_unique<AravisCamera>(*a), o, out, err, len);
+  } catch (const std::exception& e) {
+    return report(err, len, {Status::kInternal, e.what()});
+  }
+}
+
+}  // namespace
+
+const procam_driver_factory kAravisFactory = {PROCAM_FAMILY_CAMERA, "aravis",
+                                              "GigE Vision / USB3 Vision camera (libaravis)",
+                                              &probe, &create};
+
+}  // namespace procam::camera::plugin
