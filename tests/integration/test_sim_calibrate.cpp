@@ -55,10 +55,11 @@ struct CalibrateRun {
   std::optional<json> reply;  // the final CALIBRATE or ERROR
 };
 
-// Reads until the final reply to `id` (and the finished event) arrive.
+// Reads until the final reply to `id` (none for id < 0: a watcher) and the
+// finished event arrive.
 void follow(Connection& c, int id, CalibrateRun& run, std::chrono::milliseconds timeout = 90s) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (std::chrono::steady_clock::now() < deadline && !(run.reply && run.finished)) {
+  while (std::chrono::steady_clock::now() < deadline && !(run.finished && (run.reply || id < 0))) {
     auto msg = c.next(std::chrono::duration_cast<std::chrono::milliseconds>(
         deadline - std::chrono::steady_clock::now()));
     if (!msg) break;
@@ -99,6 +100,8 @@ TEST(SimCalibrate, WritesRigJsonWithTheProjectorsIntrinsics) {
   const std::string scene = sceneFile(dir);
   DaemonProcess d(dir, sim(scene));
   ASSERT_TRUE(d.started()) << d.log();
+  Connection watcher(d.socketPath());
+  ASSERT_TRUE(watcher.call({{"cmd", "watch"}}));
   Connection c(d.socketPath());
   auto started = c.call(calibrateRequest(1));
   CalibrateRun run;
@@ -119,10 +122,11 @@ TEST(SimCalibrate, WritesRigJsonWithTheProjectorsIntrinsics) {
   EXPECT_EQ((*run.finished)["operation"], op);
 
   // Progress: one event per capture, in order, then decoding, solving, writing.
-  int last_capture = 0;
+  int last_capture = 0, capturing = 0;
   double last_fraction = 0;
   std::set<std::string> stages;
   for (const json& e : run.progress) {
+    capturing += e["stage"] == "capturing";
     EXPECT_EQ(e["operation"], op);
     EXPECT_GE(e["fraction"].get<double>(), last_fraction);
     EXPECT_GE(static_cast<int>(e["capture"]), last_capture);
@@ -131,6 +135,13 @@ TEST(SimCalibrate, WritesRigJsonWithTheProjectorsIntrinsics) {
     stages.insert(e["stage"].get<std::string>());
   }
   EXPECT_EQ(last_capture, captures);
+  EXPECT_EQ(capturing, captures);
+  // A watcher sees the same events.
+  CalibrateRun watched;
+  follow(watcher, -1, watched, 10s);
+  ASSERT_TRUE(watched.finished);
+  EXPECT_EQ((*watched.finished)["ok"], true);
+  EXPECT_EQ(watched.progress.size(), run.progress.size());
   EXPECT_EQ(stages,
             (std::set<std::string>{"starting", "capturing", "decoding", "solving", "writing"}));
 
