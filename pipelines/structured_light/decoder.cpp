@@ -312,35 +312,57 @@ void dropUnreliable(Decoded& d, const cv::Mat& white, const cv::Mat& black, floa
   const int w = d.u.cols, h = d.u.rows;
   cv::Mat drop(d.u.size(), CV_8U, cv::Scalar(0));
   cv::parallel_for_(cv::Range(0, h), [&](const cv::Range& rows) {
-    auto contrast = [&](int yy, int xx) {
-      return static_cast<float>(white.ptr<T>(yy)[xx]) - static_cast<float>(black.ptr<T>(yy)[xx]);
+    // Rows y-1, y, y+1 padded by one pixel each side: out-of-image neighbours are
+    // undecoded with zero contrast, so the inner loop has no bounds tests.
+    const int pw = w + 2;
+    std::vector<float> contrast(3 * static_cast<std::size_t>(pw)), u(contrast.size()),
+        v(contrast.size());
+    std::vector<std::uint8_t> ok(contrast.size());
+    auto load = [&](int y, int slot) {
+      float* c = contrast.data() + slot * pw;
+      float* uu = u.data() + slot * pw;
+      float* vv = v.data() + slot * pw;
+      std::uint8_t* o = ok.data() + slot * pw;
+      std::fill(c, c + pw, 0.0f);
+      std::fill(o, o + pw, std::uint8_t{0});
+      if (y < 0 || y >= h) return;
+      const T* wh = white.ptr<T>(y);
+      const T* bl = black.ptr<T>(y);
+      const std::uint8_t* f = d.flags.ptr<std::uint8_t>(y);
+      const float* su = d.u.ptr<float>(y);
+      const float* sv = d.v.ptr<float>(y);
+      for (int x = 0; x < w; ++x) {
+        c[x + 1] = static_cast<float>(wh[x]) - static_cast<float>(bl[x]);
+        o[x + 1] = f[x] == 0;
+        uu[x + 1] = su[x];
+        vv[x + 1] = sv[x];
+      }
     };
     for (int y = rows.start; y < rows.end; ++y) {
-      const std::uint8_t* f = d.flags.ptr<std::uint8_t>(y);
-      const float* u = d.u.ptr<float>(y);
-      const float* v = d.v.ptr<float>(y);
+      load(y - 1, 0);
+      load(y, 1);
+      load(y + 1, 2);
       std::uint8_t* out = drop.ptr<std::uint8_t>(y);
-      auto agrees = [&](int yy, int xx, int x) {
-        if (yy < 0 || yy >= h || xx < 0 || xx >= w) return 0;
-        if (d.flags.ptr<std::uint8_t>(yy)[xx] != 0) return 0;
-        return static_cast<int>(std::abs(d.u.ptr<float>(yy)[xx] - u[x]) <= tol_u &&
-                                std::abs(d.v.ptr<float>(yy)[xx] - v[x]) <= tol_v);
-      };
+      const float* c = contrast.data() + pw + 1;  // row y, x = 0
+      const float* uc = u.data() + pw + 1;
+      const float* vc = v.data() + pw + 1;
+      const std::uint8_t* oc = ok.data() + pw + 1;
       for (int x = 0; x < w; ++x) {
-        if (f[x] != 0) continue;
+        if (!oc[x]) continue;
+        std::uint8_t flag = 0;
         if (needed > 0) {
-          const int n =
-              agrees(y, x - 1, x) + agrees(y, x + 1, x) + agrees(y - 1, x, x) + agrees(y + 1, x, x);
-          if (n < needed) out[x] = kInconsistent;
+          int n = 0;
+          for (const int off : {-1, 1, -pw, pw})
+            n += oc[x + off] && std::abs(uc[x + off] - uc[x]) <= tol_u &&
+                 std::abs(vc[x + off] - vc[x]) <= tol_v;
+          if (n < needed) flag |= kInconsistent;
         }
         if (partial > 0) {
-          float brightest = 0;
-          if (x > 0) brightest = std::max(brightest, contrast(y, x - 1));
-          if (x + 1 < w) brightest = std::max(brightest, contrast(y, x + 1));
-          if (y > 0) brightest = std::max(brightest, contrast(y - 1, x));
-          if (y + 1 < h) brightest = std::max(brightest, contrast(y + 1, x));
-          if (contrast(y, x) < partial * brightest - margin) out[x] |= kShadow;
+          const float brightest =
+              std::max(std::max(c[x - 1], c[x + 1]), std::max(c[x - pw], c[x + pw]));
+          if (c[x] < partial * brightest - margin) flag |= kShadow;
         }
+        out[x] = flag;
       }
     }
   });
