@@ -20,17 +20,6 @@ int probe(const procam_device_desc* d) {
   return descProperty(d, "ID_USB_INTERFACES").find(":ef0500:") != std::string::npos ? 60 : 0;
 }
 
-CamResult<std::optional<int>> whole(const CameraOptions& o, const char* key, int lo, int hi) {
-  auto v = o.number(key);
-  if (!v) return tl::unexpected(v.error());
-  if (!*v) return std::optional<int>();
-  if (**v < lo || **v > hi || std::floor(**v) != **v)
-    return camFail(Status::kInvalid, "aravis camera: option " + std::string(key) +
-                                         " must be a whole number " + std::to_string(lo) + ".." +
-                                         std::to_string(hi));
-  return std::optional<int>(int(**v));
-}
-
 CamResult<AravisOptions> parse(const procam_device_desc* d, const CameraOptions& o) {
   if (auto ok = o.onlyKnown({"id", "width", "height", "pixel_format", "packet_size", "fps",
                              "buffers", "pixel", PROCAM_CAMERA_CONTROL_KEYS});
@@ -45,10 +34,10 @@ CamResult<AravisOptions> parse(const procam_device_desc* d, const CameraOptions&
     a.id = d->name;
   if (a.id.empty())
     return camFail(Status::kInvalid, "aravis camera: no camera id: give the option id");
-  auto w = whole(o, "width", 1, 65535);
-  auto h = whole(o, "height", 1, 65535);
-  auto packet = whole(o, "packet_size", 576, 65535);
-  auto buffers = whole(o, "buffers", 2, 256);
+  auto w = o.whole("width", 1, 65535);
+  auto h = o.whole("height", 1, 65535);
+  auto packet = o.whole("packet_size", 576, 65535);
+  auto buffers = o.whole("buffers", 2, 256);
   auto fps = o.number("fps");
   auto pixel = o.pixel();
   for (auto* r : {&w, &h, &packet, &buffers})
@@ -69,14 +58,9 @@ CamResult<AravisOptions> parse(const procam_device_desc* d, const CameraOptions&
 
 int create(const procam_device_desc* d, const procam_config* config, procam_device* out, char* err,
            std::size_t len) {
-  try {
-    const CameraOptions o("aravis", config);
-    auto a = parse(d, o);
-    if (!a) return report(err, len, a.error());
-    return finishCameraDevice(std::make_unique<AravisCamera>(*a), o, out, err, len);
-  } catch (const std::exception& e) {
-    return report(err, len, {Status::kInternal, e.what()});
-  }
+  return createCamera<AravisOptions>(
+      "aravis", d, config, out, err, len, &parse,
+      [](AravisOptions o) { return std::make_unique<AravisCamera>(std::move(o)); });
 }
 
 }  // namespace

@@ -57,6 +57,18 @@ CamResult<std::optional<double>> CameraOptions::number(const char* key) const {
   return std::optional<double>(v);
 }
 
+CamResult<std::optional<int>> CameraOptions::whole(const char* key, int lo, int hi) const {
+  auto v = number(key);
+  if (!v) return tl::unexpected(v.error());
+  if (!*v) return std::optional<int>();
+  if (**v < lo || **v > hi || std::floor(**v) != **v)
+    return tl::unexpected(
+        bad(key, *text(key),
+            ("a whole number " + std::to_string(lo) + ".." + std::to_string(hi)).c_str())
+            .error());
+  return std::optional<int>(int(**v));
+}
+
 CamResult<std::optional<bool>> CameraOptions::flag(const char* key) const {
   const auto t = text(key);
   if (!t) return std::optional<bool>();

@@ -4,6 +4,8 @@
 // Camera behind procam_camera_ops. Nothing here throws.
 #include <procamd/procam_plugin.h>
 
+#include <exception>
+#include <functional>
 #include <initializer_list>
 #include <memory>
 #include <optional>
@@ -23,8 +25,9 @@ class CameraOptions {
   // kInvalid naming the first key not in `known`.
   CamResult<void> onlyKnown(std::initializer_list<const char*> known) const;
   std::optional<std::string> text(const char* key) const;
-  CamResult<std::optional<double>> number(const char* key) const;  // finite
-  CamResult<std::optional<bool>> flag(const char* key) const;      // true/false/1/0/yes/no
+  CamResult<std::optional<double>> number(const char* key) const;              // finite
+  CamResult<std::optional<int>> whole(const char* key, int lo, int hi) const;  // lo..hi
+  CamResult<std::optional<bool>> flag(const char* key) const;  // true/false/1/0/yes/no
   // "gray8" / "gray16" / "rgb8" under key "pixel".
   CamResult<std::optional<procam_pixel_format>> pixel() const;
   const std::string& driver() const { return driver_; }
@@ -51,5 +54,22 @@ std::string descProperty(const procam_device_desc* d, const char* key);
 // to Camera::capture; set_exposure turns auto exposure off first.
 int finishCameraDevice(std::unique_ptr<Camera> camera, const CameraOptions& options,
                        procam_device* out, char* err, std::size_t len);
+
+// A driver's create(): options parsed by `parse`, the camera made by `make`, then
+// finishCameraDevice(). Every error becomes a status and a reason; nothing throws.
+template <class Options>
+int createCamera(const char* driver, const procam_device_desc* d, const procam_config* config,
+                 procam_device* out, char* err, std::size_t len,
+                 CamResult<Options> (*parse)(const procam_device_desc*, const CameraOptions&),
+                 const std::function<std::unique_ptr<Camera>(Options)>& make) {
+  try {
+    const CameraOptions o(driver, config);
+    auto parsed = parse(d, o);
+    if (!parsed) return report(err, len, parsed.error());
+    return finishCameraDevice(make(std::move(*parsed)), o, out, err, len);
+  } catch (const std::exception& e) {
+    return report(err, len, {Status::kInternal, e.what()});
+  }
+}
 
 }  // namespace procam::camera::plugin

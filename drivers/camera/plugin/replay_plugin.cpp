@@ -46,14 +46,9 @@ CamResult<ReplayOptions> parse(const procam_device_desc* d, const CameraOptions&
 
 int create(const procam_device_desc* d, const procam_config* config, procam_device* out, char* err,
            std::size_t len) {
-  try {
-    const CameraOptions o("replay", config);
-    auto r = parse(d, o);
-    if (!r) return report(err, len, r.error());
-    return finishCameraDevice(std::make_unique<ReplayCamera>(*r), o, out, err, len);
-  } catch (const std::exception& e) {
-    return report(err, len, {Status::kInternal, e.what()});
-  }
+  return createCamera<ReplayOptions>(
+      "replay", d, config, out, err, len, &parse,
+      [](ReplayOptions o) { return std::make_unique<ReplayCamera>(std::move(o)); });
 }
 
 }  // namespace

@@ -19,16 +19,6 @@ int probe(const procam_device_desc* d) {
   return v4l2 ? 50 : 0;
 }
 
-CamResult<uint32_t> count(const CameraOptions& o, const char* key, uint32_t fallback) {
-  auto v = o.number(key);
-  if (!v) return tl::unexpected(v.error());
-  if (!*v) return fallback;
-  if (**v < 0 || **v > 65535 || std::floor(**v) != **v)
-    return camFail(Status::kInvalid,
-                   "v4l2 camera: option " + std::string(key) + " must be a whole number 0..65535");
-  return uint32_t(**v);
-}
-
 CamResult<V4l2Options> parse(const procam_device_desc* d, const CameraOptions& o) {
   if (auto ok = o.onlyKnown({"device", "width", "height", "format", "fps", "buffers", "pixel",
                              PROCAM_CAMERA_CONTROL_KEYS});
@@ -38,20 +28,20 @@ CamResult<V4l2Options> parse(const procam_device_desc* d, const CameraOptions& o
   v.device = o.text("device").value_or(d && d->devnode ? d->devnode : "");
   if (v.device.empty())
     return camFail(Status::kInvalid, "v4l2 camera: no device node: give the option device");
-  auto w = count(o, "width", 0);
-  auto h = count(o, "height", 0);
-  auto n = count(o, "buffers", 4);
+  auto w = o.whole("width", 1, 65535);
+  auto h = o.whole("height", 1, 65535);
+  auto n = o.whole("buffers", 4, 64);
   auto fps = o.number("fps");
   auto pixel = o.pixel();
   for (auto* r : {&w, &h, &n})
     if (!*r) return tl::unexpected(r->error());
   if (!fps) return tl::unexpected(fps.error());
   if (!pixel) return tl::unexpected(pixel.error());
-  if ((*w == 0) != (*h == 0))
+  if (w->has_value() != h->has_value())
     return camFail(Status::kInvalid, "v4l2 camera: give both width and height, or neither");
-  v.width = *w;
-  v.height = *h;
-  v.buffers = *n;
+  v.width = uint32_t(w->value_or(0));
+  v.height = uint32_t(h->value_or(0));
+  v.buffers = unsigned(n->value_or(4));
   v.fps = fps->value_or(0);
   if (v.fps < 0) return camFail(Status::kInvalid, "v4l2 camera: fps must be > 0");
   v.pixel = *pixel;
@@ -68,14 +58,10 @@ CamResult<V4l2Options> parse(const procam_device_desc* d, const CameraOptions& o
 
 int createV4l2On(std::unique_ptr<V4l2Io> io, const procam_device_desc* d,
                  const procam_config* config, procam_device* out, char* err, std::size_t len) {
-  try {
-    const CameraOptions o("v4l2", config);
-    auto v = parse(d, o);
-    if (!v) return report(err, len, v.error());
-    return finishCameraDevice(std::make_unique<V4l2Camera>(*v, std::move(io)), o, out, err, len);
-  } catch (const std::exception& e) {
-    return report(err, len, {Status::kInternal, e.what()});
-  }
+  return createCamera<V4l2Options>(
+      "v4l2", d, config, out, err, len, &parse, [&io](V4l2Options o) -> std::unique_ptr<Camera> {
+        return std::make_unique<V4l2Camera>(std::move(o), std::move(io));
+      });
 }
 
 namespace {
