@@ -1,11 +1,11 @@
 #include "output_frames.hpp"
 
 #include <algorithm>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "content/still_sources.hpp"
+#include "content/test_pattern.hpp"
 #include "render/cpu_renderer.hpp"
-#include "test_pattern.hpp"
 
 namespace procam::daemon {
 
@@ -52,26 +52,11 @@ procam_image rgbImage(const cv::Mat& rgb) {
 }
 
 Result<std::shared_ptr<const cv::Mat>> decodeContent(const std::string& path) {
-  cv::Mat image;
-  try {
-    image = cv::imread(path, cv::IMREAD_UNCHANGED);
-    if (image.empty()) return fail(ErrorCode::kIo, "cannot read an image from " + path);
-    if (image.depth() == CV_16U) image.convertTo(image, CV_8U, 1.0 / 257.0);
-    if (image.depth() != CV_8U) return fail(ErrorCode::kIo, path + ": unsupported pixel type");
-    if (image.cols < 2 || image.rows < 2) {
-      return fail(ErrorCode::kIo, path + ": the image must be at least 2x2 pixels");
-    }
-    static const int kToRgba[] = {0, cv::COLOR_GRAY2RGBA, 0, cv::COLOR_BGR2RGBA,
-                                  cv::COLOR_BGRA2RGBA};
-    if (image.channels() != 1 && image.channels() != 3 && image.channels() != 4) {
-      return fail(ErrorCode::kIo, path + ": unsupported channel count");
-    }
-    cv::Mat rgba;
-    cv::cvtColor(image, rgba, kToRgba[image.channels()]);
-    return std::make_shared<const cv::Mat>(std::move(rgba));
-  } catch (const cv::Exception& e) {
-    return fail(ErrorCode::kIo, path + ": " + e.what());
-  }
+  auto source = content::openStillImage(path);
+  if (!source) return tl::unexpected(source.error());
+  content::Frame frame;
+  if (auto r = (*source)->read(frame); !r) return tl::unexpected(r.error());
+  return std::make_shared<const cv::Mat>(content::toRgba(frame));
 }
 
 cv::Size sourceSize(const FrameRequest& r) {
@@ -86,7 +71,8 @@ Result<OutputFrame> renderOutputFrame(const FrameRequest& r) {
   OutputFrame out;
   cv::Mat source;
   if (showsPattern(r)) {
-    RgbImage p = renderTestPattern(r.pattern, r.output_size.width, r.output_size.height);
+    content::RgbImage p =
+        content::renderTestPattern(r.pattern, r.output_size.width, r.output_size.height);
     cv::cvtColor(cv::Mat(p.height, p.width, CV_8UC3, p.pixels.data()), source, cv::COLOR_RGB2RGBA);
     out.stats.source = "pattern:" + r.pattern;
   } else if (r.content) {

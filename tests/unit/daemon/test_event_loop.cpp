@@ -8,7 +8,6 @@
 #include <thread>
 
 #include "event_loop.hpp"
-#include "test_pattern.hpp"
 #include "worker_pool.hpp"
 
 namespace procam::daemon {
@@ -100,20 +99,6 @@ TEST(WorkerPool, ResultsArePostedBackToTheLoop) {
   }
   std::sort(results.begin(), results.end());
   EXPECT_EQ(results, (std::vector<int>{0, 1, 4, 9, 16, 25, 36, 49, 64, 81}));
-}
-
-TEST(TestPattern, GridCrosshairAndFlatFields) {
-  const RgbImage grid = renderTestPattern("grid", 257, 129, 64);
-  // Centre lines through (128, 64), then every 64 px from the centre, and borders.
-  for (int x : {0, 64, 128, 192, 256}) EXPECT_EQ(grid.at(x, 10, 0), 255) << x;
-  for (int x : {1, 63, 65, 200}) EXPECT_EQ(grid.at(x, 10, 1), 0) << x;
-  for (int y : {0, 64, 128}) EXPECT_EQ(grid.at(10, y, 2), 255) << y;
-  const RgbImage cross = renderTestPattern("crosshair", 257, 129);
-  EXPECT_EQ(cross.at(128, 30, 0), 255);
-  EXPECT_EQ(cross.at(64, 30, 0), 0);  // no grid lines
-  EXPECT_EQ(renderTestPattern("white", 4, 4).at(2, 2, 1), 255);
-  EXPECT_EQ(renderTestPattern("black", 4, 4).at(2, 2, 1), 0);
-  EXPECT_EQ(renderTestPattern("off", 4, 4).at(0, 0, 1), 0);
 }
 
 }  // namespace

@@ -5,7 +5,7 @@
 #include <string_view>
 #include <vector>
 
-namespace procam::daemon {
+namespace procam::content {
 
 struct RgbImage {
   int width = 0;
@@ -19,4 +19,4 @@ struct RgbImage {
 // included; the crosshair is the two centre lines and the border.
 RgbImage renderTestPattern(std::string_view name, int width, int height, int cell = 64);
 
-}  // namespace procam::daemon
+}  // namespace procam::content

@@ -1,6 +1,6 @@
 #include "test_pattern.hpp"
 
-namespace procam::daemon {
+namespace procam::content {
 
 RgbImage renderTestPattern(std::string_view name, int width, int height, int cell) {
   RgbImage img;
@@ -29,4 +29,4 @@ RgbImage renderTestPattern(std::string_view name, int width, int height, int cel
   return img;
 }
 
-}  // namespace procam::daemon
+}  // namespace procam::content
