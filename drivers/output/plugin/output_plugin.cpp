@@ -4,13 +4,14 @@
 // renderer runs the identity homography and the final stage.
 #include <procamd/procam_plugin.h>
 
-#include <cstdio>
+#include <climits>
 #include <cstring>
 #include <memory>
 #include <opencv2/imgproc.hpp>
 #include <string>
 
 #include "headless/headless_output.hpp"
+#include "support/driver_support.hpp"
 #if PROCAM_OUTPUT_PLUGIN_KMS
 #include "kms/kms_output.hpp"
 #endif
@@ -24,34 +25,6 @@ struct Device {
   cv::Mat rgba;
   uint64_t version = 0;
 };
-
-void writeError(char* err, size_t len, const std::string& msg) {
-  if (err && len > 0) std::snprintf(err, len, "%s", msg.c_str());
-}
-
-int statusOf(ErrorCode code) {
-  switch (code) {
-    case ErrorCode::kNotFound:
-      return PROCAM_ENODEV;
-    case ErrorCode::kInvalidInput:
-    case ErrorCode::kParse:
-      return PROCAM_EINVAL;
-    case ErrorCode::kIo:
-      return PROCAM_EIO;
-    default:
-      return PROCAM_EINTERNAL;
-  }
-}
-
-std::string option(const procam_config* config, const char* key, const std::string& fallback) {
-  for (size_t i = 0; config && i < config->n_options; ++i) {
-    if (config->options[i].key && std::strcmp(config->options[i].key, key) == 0 &&
-        config->options[i].value) {
-      return config->options[i].value;
-    }
-  }
-  return fallback;
-}
 
 int getMode(void* self, uint32_t* w, uint32_t* h, double* hz) {
   auto* d = static_cast<Device*>(self);
@@ -67,27 +40,21 @@ int show(void* self, const procam_image* frame, char* err, size_t err_len) {
     auto* d = static_cast<Device*>(self);
     const cv::Size s = d->out->size();
     if (!frame || !frame->data || int(frame->width) != s.width || int(frame->height) != s.height) {
-      writeError(err, err_len, "frame must match the output mode");
-      return PROCAM_EINVAL;
+      return plugins::report(err, err_len, "frame must match the output mode", PROCAM_EINVAL);
     }
     const int type = frame->format == PROCAM_PIXEL_RGB8    ? CV_8UC3
                      : frame->format == PROCAM_PIXEL_GRAY8 ? CV_8UC1
                                                            : -1;
     if (type < 0) {
-      writeError(err, err_len, "outputs take RGB8 or GRAY8 frames");
-      return PROCAM_EINVAL;
+      return plugins::report(err, err_len, "outputs take RGB8 or GRAY8 frames", PROCAM_EINVAL);
     }
     const cv::Mat in(s, type, frame->data, frame->stride);
     cv::cvtColor(in, d->rgba, type == CV_8UC3 ? cv::COLOR_RGB2RGBA : cv::COLOR_GRAY2RGBA);
     auto shown = d->out->show({&d->rgba, nullptr, ++d->version});
-    if (!shown) {
-      writeError(err, err_len, shown.error().message);
-      return statusOf(shown.error().code);
-    }
+    if (!shown) return plugins::report(err, err_len, shown.error());
     return PROCAM_OK;
   } catch (const std::exception& e) {
-    writeError(err, err_len, e.what());
-    return PROCAM_EINTERNAL;
+    return plugins::report(err, err_len, e.what(), PROCAM_EINTERNAL);
   }
 }
 
@@ -103,10 +70,7 @@ const procam_output_ops kOps = {&getMode, &show};
 int finish(std::unique_ptr<Device> d, procam_device* out, char* err, size_t err_len) {
   render::RenderSetup setup;
   setup.output_size = setup.content_size = d->out->size();
-  if (auto ok = d->out->configure(setup); !ok) {
-    writeError(err, err_len, ok.error().message);
-    return statusOf(ok.error().code);
-  }
+  if (auto ok = d->out->configure(setup); !ok) return plugins::report(err, err_len, ok.error());
   out->family = PROCAM_FAMILY_OUTPUT;
   out->self = d.release();
   out->poll_fd = &noPollFd;
@@ -125,20 +89,26 @@ int probeHeadless(const procam_device_desc* desc) {
 int createHeadless(const procam_device_desc*, const procam_config* config, procam_device* out,
                    char* err, size_t err_len) {
   try {
-    const int w = std::stoi(option(config, "width", "1920"));
-    const int h = std::stoi(option(config, "height", "1080"));
-    auto o = HeadlessOutput::create({w, h});
-    if (!o) {
-      writeError(err, err_len, o.error().message);
-      return statusOf(o.error().code);
-    }
+    const plugins::DriverOptions o("headless output", config);
+    auto w = o.integer("width");
+    auto h = o.integer("height");
+    auto hz = o.number("refresh_hz");
+    for (const auto* v : {&w, &h})
+      if (!*v) return plugins::report(err, err_len, v->error());
+    if (!hz) return plugins::report(err, err_len, hz.error());
+    const long width = w->value_or(1920), height = h->value_or(1080);
+    if (width < 1 || height < 1 || width > INT_MAX || height > INT_MAX)
+      return plugins::report(err, err_len, "headless output: width and height must be >= 1",
+                             PROCAM_EINVAL);
+    auto made = HeadlessOutput::create({int(width), int(height)});
+    if (!made) return plugins::report(err, err_len, made.error());
     auto d = std::make_unique<Device>();
-    d->out = std::move(*o);
-    d->refresh_hz = std::stod(option(config, "refresh_hz", "60"));
+    d->out = std::move(*made);
+    d->refresh_hz = hz->value_or(60);
     return finish(std::move(d), out, err, err_len);
   } catch (const std::exception& e) {
-    writeError(err, err_len, std::string("headless output: bad option: ") + e.what());
-    return PROCAM_EINVAL;
+    return plugins::report(err, err_len, std::string("headless output: ") + e.what(),
+                           PROCAM_EINTERNAL);
   }
 }
 
@@ -155,19 +125,16 @@ int createKms(const procam_device_desc* desc, const procam_config* config, proca
   try {
     kms::KmsConfig c;
     c.device = desc && desc->devnode ? desc->devnode : "";
-    c.request.connector = option(config, "connector", "");
-    c.request.mode = option(config, "mode", "preferred");
-    auto o = kms::KmsOutput::create(c);
-    if (!o) {
-      writeError(err, err_len, o.error().message);
-      return statusOf(o.error().code);
-    }
+    const plugins::DriverOptions o("kms output", config);
+    c.request.connector = o.text("connector").value_or("");
+    c.request.mode = o.text("mode").value_or("preferred");
+    auto made = kms::KmsOutput::create(c);
+    if (!made) return plugins::report(err, err_len, made.error());
     auto d = std::make_unique<Device>();
-    d->out = std::move(*o);
+    d->out = std::move(*made);
     return finish(std::move(d), out, err, err_len);
   } catch (const std::exception& e) {
-    writeError(err, err_len, std::string("kms output: ") + e.what());
-    return PROCAM_EINTERNAL;
+    return plugins::report(err, err_len, std::string("kms output: ") + e.what(), PROCAM_EINTERNAL);
   }
 }
 #endif

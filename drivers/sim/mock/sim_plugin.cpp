@@ -1,6 +1,5 @@
 #include "sim_plugin.hpp"
 
-#include <cstdio>
 #include <cstring>
 #include <exception>
 #include <memory>
@@ -11,23 +10,15 @@
 #include "sim/sensors.hpp"
 #include "sim_unplug.hpp"
 #include "sim_world.hpp"
+#include "support/driver_support.hpp"
 
 namespace procam::sim::mock {
 namespace {
 
 constexpr int kSimScore = 100;
 
-std::string property(const procam_device_desc* d, const char* key) {
-  for (size_t i = 0; i < d->n_properties; ++i) {
-    if (std::strcmp(d->properties[i].key, key) == 0) return d->properties[i].value;
-  }
-  return {};
-}
-
-int reason(char* err, size_t len, const std::string& text, int code) {
-  if (err && len > 0) std::snprintf(err, len, "%s", text.c_str());
-  return code;
-}
+using plugins::property;
+using plugins::report;
 
 struct Device {
   std::shared_ptr<SimWorld> world;
@@ -38,8 +29,8 @@ struct Device {
 // PROCAM_OK while the device is plugged in (sim_unplug.hpp).
 int presence(const std::string& name, char* err, size_t len) {
   auto gone = unpluggedNow(name);
-  if (!gone) return reason(err, len, gone.error().message, PROCAM_EINVAL);
-  return *gone ? reason(err, len, "'" + name + "' is unplugged (" + kUnplugVariable + ")",
+  if (!gone) return report(err, len, gone.error().message, PROCAM_EINVAL);
+  return *gone ? report(err, len, "'" + name + "' is unplugged (" + kUnplugVariable + ")",
                         PROCAM_ENODEV)
                : PROCAM_OK;
 }
@@ -61,7 +52,7 @@ int tiltRead(void* self, procam_tilt_sample* out, char* err, size_t len) {
   if (int rc = presence(dev->name, err, len); rc != PROCAM_OK) return rc;
   const double t = dev->world->now();
   auto s = sampleTilt(dev->world->scene(), dev->name, t);
-  if (!s) return reason(err, len, s.error().message, PROCAM_EIO);
+  if (!s) return report(err, len, s.error().message, PROCAM_EIO);
   const TiltSensorSpec* spec = nullptr;
   for (const auto& ts : dev->world->scene().tiltSensors()) {
     if (ts.name == dev->name) spec = &ts;
@@ -79,7 +70,7 @@ int trackerRead(void* self, procam_pose_sample* out, char* err, size_t len) {
   if (int rc = presence(dev->name, err, len); rc != PROCAM_OK) return rc;
   const double t = dev->world->now();
   auto s = sampleTracker(dev->world->scene(), dev->name, t);
-  if (!s) return reason(err, len, s.error().message, PROCAM_EIO);
+  if (!s) return report(err, len, s.error().message, PROCAM_EIO);
   for (int i = 0; i < 3; ++i) out->position[i] = s->position[i];
   out->orientation[0] = 1;  // position-only trackers: identity orientation
   out->orientation[1] = out->orientation[2] = out->orientation[3] = 0;
@@ -108,10 +99,10 @@ int outputMode(void* self, uint32_t* w, uint32_t* h, double* hz) {
 int outputShow(void* self, const procam_image* frame, char* err, size_t len) {
   auto* dev = static_cast<Device*>(self);
   const ProjectorSpec* p = projectorSpec(dev);
-  if (!p) return reason(err, len, "projector gone", PROCAM_ENODEV);
+  if (!p) return report(err, len, "projector gone", PROCAM_ENODEV);
   if (int rc = presence(dev->name, err, len); rc != PROCAM_OK) return rc;
   if (static_cast<int>(frame->width) != p->width || static_cast<int>(frame->height) != p->height) {
-    return reason(err, len,
+    return report(err, len,
                   "frame is not " + std::to_string(p->width) + "x" + std::to_string(p->height),
                   PROCAM_EINVAL);
   }
@@ -125,11 +116,11 @@ int outputShow(void* self, const procam_image* frame, char* err, size_t len) {
     } else if (frame->format == PROCAM_PIXEL_GRAY16) {
       bgr = cv::Mat(frame->height, frame->width, CV_16UC1, frame->data, frame->stride).clone();
     } else {
-      return reason(err, len, "unsupported pixel format", PROCAM_EINVAL);
+      return report(err, len, "unsupported pixel format", PROCAM_EINVAL);
     }
     dev->world->show(dev->name, std::move(bgr));
   } catch (const std::exception& e) {
-    return reason(err, len, e.what(), PROCAM_EINTERNAL);
+    return report(err, len, e.what(), PROCAM_EINTERNAL);
   }
   return PROCAM_OK;
 }
@@ -155,7 +146,7 @@ int cameraFormat(void* self, uint32_t* w, uint32_t* h, procam_pixel_format* f) {
 }
 
 int cameraExposure(void*, double, char* err, size_t len) {
-  return reason(err, len, "the virtual camera's exposure is fixed by the scene", PROCAM_ENOTSUP);
+  return report(err, len, "the virtual camera's exposure is fixed by the scene", PROCAM_ENOTSUP);
 }
 
 int cameraCapture(void* self, int, procam_image* out, char* err, size_t len) {
@@ -165,9 +156,9 @@ int cameraCapture(void* self, int, procam_image* out, char* err, size_t len) {
     const double t = dev->world->now();
     const Scene& scene = dev->world->scene();
     auto renderer = Renderer::create(scene, scene.at(t), dev->world->shown());
-    if (!renderer) return reason(err, len, renderer.error().message, PROCAM_EIO);
+    if (!renderer) return report(err, len, renderer.error().message, PROCAM_EIO);
     auto image = renderer->renderCamera(dev->name);
-    if (!image) return reason(err, len, image.error().message, PROCAM_EIO);
+    if (!image) return report(err, len, image.error().message, PROCAM_EIO);
     cv::Mat m = *image;
     if (m.channels() == 3) cv::cvtColor(m, m, cv::COLOR_BGR2RGB);
     if (!m.isContinuous()) m = m.clone();
@@ -181,7 +172,7 @@ int cameraCapture(void* self, int, procam_image* out, char* err, size_t len) {
     out->data = dev->buffer.data();
     out->timestamp_ns = static_cast<uint64_t>(t * 1e9);
   } catch (const std::exception& e) {
-    return reason(err, len, e.what(), PROCAM_EINTERNAL);
+    return report(err, len, e.what(), PROCAM_EINTERNAL);
   }
   return PROCAM_OK;
 }
@@ -194,11 +185,11 @@ int create(const procam_device_desc* d, const procam_config*, procam_device* out
     const std::string scene = property(d, "SIM_SCENE");
     const std::string name = property(d, "SIM_DEVICE");
     if (scene.empty() || name.empty()) {
-      return reason(err, len, "a sim device needs SIM_SCENE and SIM_DEVICE", PROCAM_EINVAL);
+      return report(err, len, "a sim device needs SIM_SCENE and SIM_DEVICE", PROCAM_EINVAL);
     }
     if (int rc = presence(name, err, len); rc != PROCAM_OK) return rc;
     auto world = SimWorld::open(scene);
-    if (!world) return reason(err, len, world.error().message, PROCAM_EINVAL);
+    if (!world) return report(err, len, world.error().message, PROCAM_EINVAL);
     auto dev = std::make_unique<Device>(Device{*world, name, {}});
     bool known = false;
     const Scene& s = (*world)->scene();
@@ -216,7 +207,7 @@ int create(const procam_device_desc* d, const procam_config*, procam_device* out
       out->ops.output = &kOutputOps;
     }
     if (!known) {
-      return reason(err, len, "scene '" + s.name() + "' has no such device '" + name + "'",
+      return report(err, len, "scene '" + s.name() + "' has no such device '" + name + "'",
                     PROCAM_ENODEV);
     }
     out->family = Family;
@@ -225,7 +216,7 @@ int create(const procam_device_desc* d, const procam_config*, procam_device* out
     out->destroy = destroy;
     return PROCAM_OK;
   } catch (const std::exception& e) {
-    return reason(err, len, e.what(), PROCAM_EINTERNAL);
+    return report(err, len, e.what(), PROCAM_EINTERNAL);
   }
 }
 
