@@ -15,6 +15,24 @@ struct BlockSum {
   bool touches_border = false;
 };
 
+// Calls f(x, y, block) for every camera pixel decoded without a flag; `block` is the
+// row-major index of the coarse block its projector column and row fall in.
+template <class F>
+void forEachDecodedPixel(const PatternSet& coarse, const Decoded& d, F&& f) {
+  const int bx = coarse.columns.cells, by = coarse.rows.cells;
+  for (int y = 0; y < d.u.rows; ++y) {
+    const float* u = d.u.ptr<float>(y);
+    const float* v = d.v.ptr<float>(y);
+    const std::uint8_t* flags = d.flags.ptr<std::uint8_t>(y);
+    for (int x = 0; x < d.u.cols; ++x) {
+      if (flags[x] != 0) continue;
+      const int i = std::clamp(static_cast<int>(u[x]) / coarse.columns.cell, 0, bx - 1);
+      const int j = std::clamp(static_cast<int>(v[x]) / coarse.rows.cell, 0, by - 1);
+      f(x, y, static_cast<std::size_t>(j) * bx + i);
+    }
+  }
+}
+
 std::string format(const char* fmt, auto... args) {
   char buf[256];
   std::snprintf(buf, sizeof buf, fmt, args...);
@@ -42,21 +60,13 @@ Result<PlanarityTest> testPlanarity(const PatternSet& coarse, const Decoded& d,
   const int bx = coarse.columns.cells, by = coarse.rows.cells;
   std::vector<BlockSum> blocks(static_cast<std::size_t>(bx) * by);
   const int w = d.u.cols, h = d.u.rows;
-  for (int y = 0; y < h; ++y) {
-    const float* u = d.u.ptr<float>(y);
-    const float* v = d.v.ptr<float>(y);
-    const std::uint8_t* f = d.flags.ptr<std::uint8_t>(y);
-    for (int x = 0; x < w; ++x) {
-      if (f[x] != 0) continue;
-      const int i = std::clamp(static_cast<int>(u[x]) / coarse.columns.cell, 0, bx - 1);
-      const int j = std::clamp(static_cast<int>(v[x]) / coarse.rows.cell, 0, by - 1);
-      BlockSum& b = blocks[static_cast<std::size_t>(j) * bx + i];
-      b.x += x;
-      b.y += y;
-      ++b.count;
-      b.touches_border |= x == 0 || y == 0 || x == w - 1 || y == h - 1;
-    }
-  }
+  forEachDecodedPixel(coarse, d, [&](int x, int y, std::size_t block) {
+    BlockSum& b = blocks[block];
+    b.x += x;
+    b.y += y;
+    ++b.count;
+    b.touches_border |= x == 0 || y == 0 || x == w - 1 || y == h - 1;
+  });
   std::vector<int> counts;
   for (const BlockSum& b : blocks)
     if (b.count > 0 && !b.touches_border) counts.push_back(b.count);
@@ -112,19 +122,10 @@ Result<PlanarityTest> testPlanarity(const PatternSet& coarse, const Decoded& d,
     int block;
   };
   std::vector<Pixel> pixels;
-  for (int y = 0; y < h; ++y) {
-    const float* u = d.u.ptr<float>(y);
-    const float* v = d.v.ptr<float>(y);
-    const std::uint8_t* f = d.flags.ptr<std::uint8_t>(y);
-    for (int x = 0; x < w; ++x) {
-      if (f[x] != 0) continue;
-      const int i = std::clamp(static_cast<int>(u[x]) / coarse.columns.cell, 0, bx - 1);
-      const int j = std::clamp(static_cast<int>(v[x]) / coarse.rows.cell, 0, by - 1);
-      const int b = kept[static_cast<std::size_t>(j) * bx + i];
-      if (b < 0) continue;
-      pixels.push_back({o.undistort ? o.undistort(Vec2(x, y)) : Vec2(x, y), b});
-    }
-  }
+  forEachDecodedPixel(coarse, d, [&](int x, int y, std::size_t block) {
+    const int b = kept[block];
+    if (b >= 0) pixels.push_back({o.undistort ? o.undistort(Vec2(x, y)) : Vec2(x, y), b});
+  });
   // Blocks partly hidden (cut by the edge of the surface or an occluder) have
   // centres no weighting can recover: a block keeps its place in the fit only with
   // at least 90% of the camera pixels H predicts for it (its projector area over
