@@ -15,9 +15,9 @@ namespace {
 int probe(const procam_device_desc* d) {
   if (!d || d->family != PROCAM_FAMILY_CAMERA) return 0;
   if ((d->subsystem && std::strcmp(d->subsystem, "aravis") == 0) ||
-      !descProperty(d, "ARAVIS_ID").empty())
+      !plugins::property(d, "ARAVIS_ID").empty())
     return 60;
-  return descProperty(d, "ID_USB_INTERFACES").find(":ef0500:") != std::string::npos ? 60 : 0;
+  return plugins::property(d, "ID_USB_INTERFACES").find(":ef0500:") != std::string::npos ? 60 : 0;
 }
 
 CamResult<AravisOptions> parse(const procam_device_desc* d, const CameraOptions& o) {
@@ -28,7 +28,7 @@ CamResult<AravisOptions> parse(const procam_device_desc* d, const CameraOptions&
   AravisOptions a;
   if (auto id = o.text("id"))
     a.id = *id;
-  else if (auto prop = descProperty(d, "ARAVIS_ID"); !prop.empty())
+  else if (auto prop = plugins::property(d, "ARAVIS_ID"); !prop.empty())
     a.id = prop;
   else if (d && d->name)
     a.id = d->name;

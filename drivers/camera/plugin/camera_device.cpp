@@ -5,83 +5,63 @@
 #include <cstdlib>
 #include <cstring>
 #include <exception>
+#include <type_traits>
 
 #include "camera/convert.hpp"
 
 namespace procam::camera::plugin {
 
 int report(char* err, std::size_t len, const CameraError& error) {
-  if (err && len > 0) std::snprintf(err, len, "%s", error.message.c_str());
-  return int(error.status);
+  return plugins::report(err, len, error.message, int(error.status));
 }
 
-CameraOptions::CameraOptions(std::string driver, const procam_config* config)
-    : driver_(std::move(driver)), config_(config) {}
+namespace {
+
+// A DriverOptions result as a camera result (kInvalidInput -> kInvalid).
+template <class T>
+CamResult<T> lift(Result<T> r) {
+  if (!r) return camFail(Status(plugins::statusOf(r.error().code)), r.error().message);
+  if constexpr (std::is_void_v<T>)
+    return {};
+  else
+    return std::move(*r);
+}
+
+}  // namespace
+
+CameraOptions::CameraOptions(const std::string& driver, const procam_config* config)
+    : options_(driver + " camera", config) {}
 
 CamResult<void> CameraOptions::onlyKnown(std::initializer_list<const char*> known) const {
-  for (std::size_t i = 0; config_ && i < config_->n_options; ++i) {
-    const char* key = config_->options[i].key;
-    bool ok = false;
-    for (const char* k : known) ok = ok || (key && std::strcmp(key, k) == 0);
-    if (ok) continue;
-    std::string list;
-    for (const char* k : known) list += (list.empty() ? "" : ", ") + std::string(k);
-    return camFail(Status::kInvalid, driver_ + " camera: unknown option '" +
-                                         (key ? key : "(null)") + "' (known: " + list + ")");
-  }
-  return {};
-}
-
-std::optional<std::string> CameraOptions::text(const char* key) const {
-  std::optional<std::string> value;
-  for (std::size_t i = 0; config_ && i < config_->n_options; ++i) {
-    const procam_kv& kv = config_->options[i];
-    if (kv.key && kv.value && std::strcmp(kv.key, key) == 0) value = kv.value;
-  }
-  return value;
-}
-
-CamResult<void> CameraOptions::bad(const char* key, const std::string& value,
-                                   const char* what) const {
-  return camFail(Status::kInvalid,
-                 driver_ + " camera: option " + key + ": '" + value + "' is not " + what);
+  return lift(options_.onlyKnown(known));
 }
 
 CamResult<std::optional<double>> CameraOptions::number(const char* key) const {
-  const auto t = text(key);
-  if (!t) return std::optional<double>();
-  char* end = nullptr;
-  const double v = std::strtod(t->c_str(), &end);
-  if (t->empty() || *end != '\0' || !std::isfinite(v))
-    return tl::unexpected(bad(key, *t, "a number").error());
-  return std::optional<double>(v);
-}
-
-CamResult<std::optional<int>> CameraOptions::whole(const char* key, int lo, int hi) const {
-  auto v = number(key);
-  if (!v) return tl::unexpected(v.error());
-  if (!*v) return std::optional<int>();
-  if (**v < lo || **v > hi || std::floor(**v) != **v)
-    return tl::unexpected(
-        bad(key, *text(key),
-            ("a whole number " + std::to_string(lo) + ".." + std::to_string(hi)).c_str())
-            .error());
-  return std::optional<int>(int(**v));
+  return lift(options_.number(key));
 }
 
 CamResult<std::optional<bool>> CameraOptions::flag(const char* key) const {
-  const auto t = text(key);
-  if (!t) return std::optional<bool>();
-  if (*t == "true" || *t == "1" || *t == "yes") return std::optional<bool>(true);
-  if (*t == "false" || *t == "0" || *t == "no") return std::optional<bool>(false);
-  return tl::unexpected(bad(key, *t, "true or false").error());
+  return lift(options_.flag(key));
+}
+
+CamResult<std::optional<int>> CameraOptions::whole(const char* key, int lo, int hi) const {
+  auto v = lift(options_.integer(key));
+  if (!v) return tl::unexpected(v.error());
+  if (!*v) return std::optional<int>();
+  if (**v < lo || **v > hi)
+    return camFail(Status::kInvalid, options_.who() + ": option " + key + ": " +
+                                         std::to_string(**v) + " is not in " + std::to_string(lo) +
+                                         ".." + std::to_string(hi));
+  return std::optional<int>(int(**v));
 }
 
 CamResult<std::optional<procam_pixel_format>> CameraOptions::pixel() const {
   const auto t = text("pixel");
   if (!t) return std::optional<procam_pixel_format>();
   auto p = parsePixel(*t);
-  if (!p) return tl::unexpected(bad("pixel", *t, "gray8, gray16 or rgb8").error());
+  if (!p)
+    return camFail(Status::kInvalid,
+                   options_.who() + ": option pixel: '" + *t + "' is not gray8, gray16 or rgb8");
   return p;
 }
 
@@ -104,14 +84,6 @@ CamResult<void> applyControls(Camera& camera, const CameraOptions& o) {
       if (auto ok = camera.setControl(Control::kAutoExposure, 0); !ok) return ok;
     }
     if (auto ok = camera.setControl(control, **v); !ok) return ok;
-  }
-  return {};
-}
-
-std::string descProperty(const procam_device_desc* d, const char* key) {
-  for (std::size_t i = 0; d && i < d->n_properties; ++i) {
-    const procam_kv& kv = d->properties[i];
-    if (kv.key && kv.value && std::strcmp(kv.key, key) == 0) return kv.value;
   }
   return {};
 }

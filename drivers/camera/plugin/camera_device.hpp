@@ -12,30 +12,29 @@
 #include <string>
 
 #include "camera/camera.hpp"
+#include "support/driver_support.hpp"
 
 namespace procam::camera::plugin {
 
 // Writes the message into the caller's buffer and returns the error's status.
 int report(char* err, std::size_t len, const CameraError& error);
 
-// A driver's options from procam_config (the last occurrence of a key wins).
+// A driver's options (plugins/support's DriverOptions, "<driver> camera: option K: ..."),
+// with the camera's error type and the keys only cameras have.
 class CameraOptions {
  public:
-  CameraOptions(std::string driver, const procam_config* config);
+  CameraOptions(const std::string& driver, const procam_config* config);
   // kInvalid naming the first key not in `known`.
   CamResult<void> onlyKnown(std::initializer_list<const char*> known) const;
-  std::optional<std::string> text(const char* key) const;
+  std::optional<std::string> text(const char* key) const { return options_.text(key); }
   CamResult<std::optional<double>> number(const char* key) const;              // finite
   CamResult<std::optional<int>> whole(const char* key, int lo, int hi) const;  // lo..hi
   CamResult<std::optional<bool>> flag(const char* key) const;  // true/false/1/0/yes/no
   // "gray8" / "gray16" / "rgb8" under key "pixel".
   CamResult<std::optional<procam_pixel_format>> pixel() const;
-  const std::string& driver() const { return driver_; }
 
  private:
-  CamResult<void> bad(const char* key, const std::string& value, const char* what) const;
-  std::string driver_;
-  const procam_config* config_;
+  plugins::DriverOptions options_;
 };
 
 // The control keys every camera driver accepts (README.md): exposure_s, auto_exposure,
@@ -46,9 +45,6 @@ class CameraOptions {
 // Sets the configured controls on a started camera; a control the device does not
 // have fails with kNotSupported (the device is not opened half-configured).
 CamResult<void> applyControls(Camera& camera, const CameraOptions& options);
-
-// A udev/config property of a device description, empty when absent.
-std::string descProperty(const procam_device_desc* d, const char* key);
 
 // Starts `camera`, applies the configured controls and fills `out`. capture() maps
 // to Camera::capture; set_exposure turns auto exposure off first.

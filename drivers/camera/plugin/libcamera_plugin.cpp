@@ -14,7 +14,7 @@ namespace {
 int probe(const procam_device_desc* d) {
   if (!d || d->family != PROCAM_FAMILY_CAMERA) return 0;
   if ((d->subsystem && std::strcmp(d->subsystem, "libcamera") == 0) ||
-      !descProperty(d, "LIBCAMERA_ID").empty())
+      !plugins::property(d, "LIBCAMERA_ID").empty())
     return 60;
   return 0;
 }
@@ -28,7 +28,7 @@ CamResult<LibcameraOptions> parse(const procam_device_desc* d, const CameraOptio
   if (auto id = o.text("id"))
     l.id = *id;
   else
-    l.id = descProperty(d, "LIBCAMERA_ID");
+    l.id = plugins::property(d, "LIBCAMERA_ID");
   auto w = o.whole("width", 1, 65535);
   auto h = o.whole("height", 1, 65535);
   auto n = o.whole("buffers", 2, 64);

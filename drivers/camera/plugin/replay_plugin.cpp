@@ -14,7 +14,7 @@ namespace {
 int probe(const procam_device_desc* d) {
   if (!d || d->family != PROCAM_FAMILY_CAMERA) return 0;
   const bool replay = (d->subsystem && std::strcmp(d->subsystem, "replay") == 0) ||
-                      !descProperty(d, "REPLAY_DIR").empty();
+                      !plugins::property(d, "REPLAY_DIR").empty();
   return replay ? 90 : 0;
 }
 
@@ -24,7 +24,7 @@ CamResult<ReplayOptions> parse(const procam_device_desc* d, const CameraOptions&
   ReplayOptions r;
   if (auto dir = o.text("dir"))
     r.dir = *dir;
-  else if (auto prop = descProperty(d, "REPLAY_DIR"); !prop.empty())
+  else if (auto prop = plugins::property(d, "REPLAY_DIR"); !prop.empty())
     r.dir = prop;
   else if (d && d->devnode)
     r.dir = d->devnode;

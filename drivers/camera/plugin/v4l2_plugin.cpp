@@ -12,7 +12,7 @@ namespace {
 
 // udev (70-procamd.rules) tags V4L2 capture nodes PROCAM_ROLE=camera.
 int probe(const procam_device_desc* d) {
-  if (!d || d->family != PROCAM_FAMILY_CAMERA || descProperty(d, "PROCAM_ROLE") != "camera")
+  if (!d || d->family != PROCAM_FAMILY_CAMERA || plugins::property(d, "PROCAM_ROLE") != "camera")
     return 0;
   const bool v4l2 = (d->subsystem && std::strcmp(d->subsystem, "video4linux") == 0) ||
                     (d->devnode && std::strncmp(d->devnode, "/dev/video", 10) == 0);

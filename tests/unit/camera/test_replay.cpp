@@ -156,11 +156,10 @@ TEST(ReplayPlugin, ProbeCreateCaptureAndRefusedControls) {
   const procam_driver_factory* f = factory("replay");
   ASSERT_NE(f, nullptr);
   Recording rec(3, 0.01);
-  const procam_kv props[] = {{"REPLAY_DIR", nullptr}};
   procam_device_desc udev{
       PROCAM_FAMILY_CAMERA, "video4linux", "/dev/video0", nullptr, nullptr, nullptr, 0};
   EXPECT_EQ(f->probe(&udev), 0);  // a V4L2 node is not a recording
-  procam_device_desc desc{PROCAM_FAMILY_CAMERA, "replay", nullptr, nullptr, "rec", props, 0};
+  procam_device_desc desc{PROCAM_FAMILY_CAMERA, "replay", nullptr, nullptr, "rec", nullptr, 0};
   EXPECT_EQ(f->probe(&desc), 90);
 
   const std::string dir = rec.dir();

@@ -281,6 +281,14 @@ TEST(V4l2Plugin, ProbeOptionsAndEnodevThroughTheAbi) {
                                  sizeof err),
             PROCAM_ENOTSUP);
   EXPECT_FALSE(s2->open);
+  const procam_kv three[] = {{"buffers", "3"}};
+  procam_config threeConfig{three, 1};
+  EXPECT_EQ(plugin::createV4l2On(std::make_unique<FakeV4l2>(uvcLike()), &desc, &threeConfig, &dev,
+                                 err, sizeof err),
+            PROCAM_EINVAL);
+  EXPECT_NE(std::string(err).find("v4l2 camera: option buffers: 3 is not in 4..64"),
+            std::string::npos)
+      << err;
   const procam_kv bad[] = {{"format", "H264"}};
   procam_config badConfig{bad, 1};
   EXPECT_EQ(plugin::createV4l2On(std::make_unique<FakeV4l2>(uvcLike()), &desc, &badConfig, &dev,
