@@ -63,9 +63,14 @@ std::vector<std::uint8_t> msacInliers(std::span<const Vec3> world, std::span<con
   return best_mask;
 }
 
+// `refine`: Levenberg-Marquardt after the DLT (the final fit); without it, the
+// normalised DLT alone (enough to tell inliers while the set is being settled).
 Result<ProjectorCalibration> fromCorrespondences(std::span<const Vec3> world,
-                                                 std::span<const Vec2> projector) {
-  auto fit = geom::fitProjectionMatrix(world, projector);
+                                                 std::span<const Vec2> projector,
+                                                 bool refine = true) {
+  geom::ProjectionOptions options;
+  options.refine = refine;
+  auto fit = geom::fitProjectionMatrix(world, projector, options);
   if (!fit) return tl::unexpected(fit.error());
   auto krt = geom::decomposeProjectionMatrix(fit->P);
   if (!krt) return tl::unexpected(krt.error());
@@ -86,11 +91,14 @@ Result<ProjectorCalibration> calibrateProjectorFromSurface(const surface::Surfac
   for (std::size_t i = 0; i < points.world.size(); ++i)
     if (keep[i])
       start_world.push_back(points.world[i]), start_projector.push_back(points.projector[i]);
-  auto c = fromCorrespondences(start_world, start_projector);
+  auto c = fromCorrespondences(start_world, start_projector, false);
   // Rejection at 3 sigma of the residual norm (sigma from its median: for 2D
   // Gaussian noise the median norm is 1.177 sigma, floor 0.1 px), refitting until
   // the inlier set is stable; gross outliers (a wrongly unwrapped phase) bias the
-  // first fits, so this takes a few rounds.
+  // first fits, so this takes a few rounds. DLT fits while the set settles, one
+  // Levenberg-Marquardt fit on the final set.
+  Points3 world = std::move(start_world);
+  Points2 projector = std::move(start_projector);
   for (int round = 0; round < 6 && c; ++round) {
     const Mat34 P = geom::projectionMatrix(c->K, c->pose);
     std::vector<double> err(points.world.size(), 1e9);
@@ -103,8 +111,8 @@ Result<ProjectorCalibration> calibrateProjectorFromSurface(const surface::Surfac
     if (kept.empty()) break;
     std::nth_element(kept.begin(), kept.begin() + kept.size() / 2, kept.end());
     const double limit = std::max(0.1, 3.0 * kept[kept.size() / 2] / 1.177);
-    Points3 world;
-    Points2 projector;
+    world.clear();
+    projector.clear();
     bool changed = false;
     for (std::size_t i = 0; i < points.world.size(); ++i) {
       const std::uint8_t k = err[i] <= limit;
@@ -113,8 +121,9 @@ Result<ProjectorCalibration> calibrateProjectorFromSurface(const surface::Surfac
       if (k) world.push_back(points.world[i]), projector.push_back(points.projector[i]);
     }
     if (!changed) break;
-    c = fromCorrespondences(world, projector);
+    c = fromCorrespondences(world, projector, false);
   }
+  if (c) c = fromCorrespondences(world, projector);
   if (c) c->inliers = std::move(keep);
   if (!c && c.error().code == ErrorCode::kCoplanar)
     return fail(ErrorCode::kCoplanar,
