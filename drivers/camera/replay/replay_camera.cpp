@@ -98,9 +98,10 @@ uint64_t ReplayCamera::dueNs(std::size_t i) const {
 }
 
 void ReplayCamera::armTimer() {
-  if (timer_fd_ < 0 || next_ >= entries_.size()) return;
-  // An absolute expiry in the past fires at once, so a due frame is readable.
-  const uint64_t due = std::max<uint64_t>(dueNs(next_), 1);
+  if (timer_fd_ < 0) return;
+  // An absolute expiry in the past fires at once, so a due frame is readable; so is the
+  // end of the recording, for the reader to learn of it (or to start over).
+  const uint64_t due = next_ < entries_.size() ? std::max<uint64_t>(dueNs(next_), 1) : 1;
   itimerspec spec{};
   spec.it_value.tv_sec = time_t(due / 1'000'000'000ull);
   spec.it_value.tv_nsec = long(due % 1'000'000'000ull);

@@ -76,6 +76,9 @@ TEST(Replay, DeliversEveryFrameInOrderThenReportsTheEnd) {
     // The recorded spacing (40 ms) survives exactly.
     EXPECT_EQ((*f)->timestamp_ns - first, uint64_t(i) * 40'000'000u);
   }
+  // The end is announced on the poll fd too, so a reader waiting on it learns of it.
+  pollfd p{cam.pollFd(), POLLIN, 0};
+  EXPECT_EQ(::poll(&p, 1, 1000), 1);
   auto end = cam.capture(0);
   ASSERT_FALSE(end);
   EXPECT_EQ(end.error().status, Status::kNoDevice);
