@@ -132,7 +132,7 @@ void ControlServer::readFrom(ClientId id, Client& c) {
   char buf[kReadChunk];
   size_t budget = kReadBudgetPerWakeup;
   while (budget > 0 && !c.read_closed) {
-    const ssize_t n = ::recv(c.fd.get(), buf, sizeof buf, 0);
+    const ssize_t n = receive(c, buf, sizeof buf);
     if (n < 0) {
       if (errno == EINTR) continue;
       if (errno == EAGAIN || errno == EWOULDBLOCK) break;
@@ -153,6 +153,7 @@ void ControlServer::readFrom(ClientId id, Client& c) {
                               "request longer than " + std::to_string(proto::kMaxRequestBytes) +
                                   " bytes; skipped up to its newline"));
       } else if (item.line.find_first_not_of(" \t") == std::string::npos) {
+        c.passed_fds.clear();
         continue;  // blank lines are ignored
       } else {
         auto req = proto::parseRequest(item.line);
@@ -167,12 +168,47 @@ void ControlServer::readFrom(ClientId id, Client& c) {
         }
       }
       if (!connected(id)) return;  // dropped while handling (queue overflow)
+      c.passed_fds.clear();        // descriptors the handler did not take
     }
   }
   if (c.read_closed) {
     loop_.modify(c.fd.get(), c.want_write ? uint32_t{EPOLLOUT} : 0u);
     maybeFinish(id, c);
   }
+}
+
+ssize_t ControlServer::receive(Client& c, char* buf, size_t size) {
+  iovec iov{buf, size};
+  alignas(cmsghdr) char control[CMSG_SPACE(kMaxPassedFds * sizeof(int))];
+  msghdr msg{};
+  msg.msg_iov = &iov;
+  msg.msg_iovlen = 1;
+  msg.msg_control = control;
+  msg.msg_controllen = sizeof control;
+  const ssize_t n = ::recvmsg(c.fd.get(), &msg, MSG_CMSG_CLOEXEC);
+  if (n < 0) return n;
+  for (cmsghdr* h = CMSG_FIRSTHDR(&msg); h; h = CMSG_NXTHDR(&msg, h)) {
+    if (h->cmsg_level != SOL_SOCKET || h->cmsg_type != SCM_RIGHTS) continue;
+    const size_t count = (h->cmsg_len - CMSG_LEN(0)) / sizeof(int);
+    for (size_t i = 0; i < count; ++i) {
+      int fd;
+      std::memcpy(&fd, CMSG_DATA(h) + i * sizeof(int), sizeof fd);
+      UniqueFd owned(fd);
+      if (c.passed_fds.size() < kMaxPassedFds) c.passed_fds.push_back(std::move(owned));
+    }
+  }
+  // The kernel closed descriptors beyond the control buffer.
+  if (msg.msg_flags & MSG_CTRUNC) {
+    logWarning(describe(c) + " passed more than " + std::to_string(kMaxPassedFds) +
+               " descriptors; the rest were closed");
+  }
+  return n;
+}
+
+std::vector<UniqueFd> ControlServer::takePassedFds(ClientId id) {
+  auto it = clients_.find(id);
+  if (it == clients_.end()) return {};
+  return std::exchange(it->second->passed_fds, {});
 }
 
 bool ControlServer::send(ClientId id, std::string line) {

@@ -69,6 +69,12 @@ class ControlServer {
   // Drops clients that stopped reading; call periodically.
   void checkStalls();
 
+  // Descriptors a client passed (SCM_RIGHTS) with the request being handled, at
+  // most kMaxPassedFds per request. Only a handler that wants them takes them;
+  // the server closes every one not taken once the handler returns.
+  static constexpr size_t kMaxPassedFds = 4;
+  std::vector<UniqueFd> takePassedFds(ClientId client);
+
   bool connected(ClientId client) const;
   std::optional<PeerCred> peer(ClientId client) const;
   size_t clientCount() const { return clients_.size(); }
@@ -87,11 +93,14 @@ class ControlServer {
     bool read_closed = false;
     bool closing = false;
     int holds = 0;
+    std::vector<UniqueFd> passed_fds;  // for the next request that completes
   };
 
   void onAccept();
   void onClientEvent(ClientId id, uint32_t events);
   void readFrom(ClientId id, Client& c);
+  // recv() that also collects SCM_RIGHTS descriptors into c.passed_fds.
+  ssize_t receive(Client& c, char* buf, size_t size);
   void flush(ClientId id, Client& c);
   void drop(ClientId id, Client& c, const std::string& reason);
   void maybeFinish(ClientId id, Client& c);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "config.hpp"
+#include "content/content_source.hpp"
 #include "control_server.hpp"
 #include "control_socket.hpp"
 #include "device_manager.hpp"
@@ -78,6 +79,11 @@ class Daemon {
   nlohmann::json statusJson() const;
   nlohmann::json keystoneJson() const;
   nlohmann::json contentJson() const;
+  // content_share.cpp: frames another process fills in a sealed memfd.
+  void cmdContentShare(ClientId, const proto::Request&);
+  void pollSharedContent();
+  void stopSharedContent();
+  nlohmann::json sharedContentJson() const;
   // daemon_keystone.cpp: auto keystone and what the outputs show.
   void setupAutoKeystone();
   void probeKeystoneInputs();
@@ -126,6 +132,13 @@ class Daemon {
     int width = 0, height = 0;
   };
   ContentInfo content_info_;
+  struct SharedContent {
+    std::unique_ptr<content::ContentSource> source;
+    int timer = -1;
+    std::string format;
+    uint64_t frames = 0;  // shown so far
+  };
+  std::optional<SharedContent> shared_content_;  // set by `content share`
   KeystoneRuntime keystone_rt_;
   // Destroyed in reverse order: server and workers before the loop they use.
   std::unique_ptr<EventLoop> loop_;

@@ -1,0 +1,175 @@
+// `content share` on procamd --sim: frames a producer writes into a sealed memfd
+// passed over the control socket (SCM_RIGHTS) reach the mock projector through
+// the identity warp; bad descriptors are refused with a clear ERROR and none of
+// them stays open in the daemon.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <sys/mman.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <map>
+
+#include "content/shm_frames.hpp"
+#include "integration/daemon_harness.hpp"
+
+namespace procam::itest {
+namespace {
+
+using content::PixelFormat;
+using content::ShmFrameProducer;
+
+// The handheld scene's projector mode: content of this size is shown unscaled.
+const cv::Size kOutput(1280, 720);
+
+json shareRequest(cv::Size size, const char* format = "rgba8") {
+  return {{"cmd", "content"},
+          {"action", "share"},
+          {"width", size.width},
+          {"height", size.height},
+          {"format", format}};
+}
+
+// Sends one request line with `fds` attached, then returns the reply.
+std::optional<json> callWithFds(Connection& c, const json& request, const std::vector<int>& fds) {
+  const std::string line = request.dump() + "\n";
+  iovec iov{const_cast<char*>(line.data()), line.size()};
+  msghdr msg{};
+  msg.msg_iov = &iov;
+  msg.msg_iovlen = 1;
+  std::vector<char> control(CMSG_SPACE(sizeof(int) * fds.size()));
+  if (!fds.empty()) {
+    msg.msg_control = control.data();
+    msg.msg_controllen = control.size();
+    cmsghdr* h = CMSG_FIRSTHDR(&msg);
+    h->cmsg_level = SOL_SOCKET;
+    h->cmsg_type = SCM_RIGHTS;
+    h->cmsg_len = CMSG_LEN(sizeof(int) * fds.size());
+    std::memcpy(CMSG_DATA(h), fds.data(), sizeof(int) * fds.size());
+  }
+  if (::sendmsg(c.fd(), &msg, MSG_NOSIGNAL) != ssize_t(line.size())) return std::nullopt;
+  for (;;) {
+    auto reply = c.next();
+    if (!reply || reply->value("class", "") != "EVENT") return reply;
+  }
+}
+
+// The daemon's open descriptors and what they refer to.
+std::map<int, std::string> openFds(pid_t pid) {
+  std::map<int, std::string> fds;
+  for (auto& e : std::filesystem::directory_iterator("/proc/" + std::to_string(pid) + "/fd")) {
+    std::error_code ec;
+    fds[std::stoi(e.path().filename())] = std::filesystem::read_symlink(e.path(), ec).string();
+  }
+  return fds;
+}
+
+json shownStats(Connection& c) {
+  auto status = c.call({{"cmd", "status"}});
+  if (!status) return nullptr;
+  const json& shown = (*status)["outputs"]["shown"];
+  return shown.empty() ? json(nullptr) : shown[0];
+}
+
+// Two colour areas: `a` on the left `split` columns, `b` on the rest.
+cv::Mat twoAreas(cv::Vec4b a, cv::Vec4b b, int split) {
+  cv::Mat m(kOutput, CV_8UC4, cv::Scalar(b[0], b[1], b[2], b[3]));
+  m.colRange(0, split).setTo(cv::Scalar(a[0], a[1], a[2], a[3]));
+  return m;
+}
+
+bool showsMean(Connection& c, double r, double g, double b) {
+  const json s = shownStats(c);
+  return s.is_object() && s["source"] == "content" && s["mean_rgb"][0] == r &&
+         s["mean_rgb"][1] == g && s["mean_rgb"][2] == b && s["lit_fraction"] == 1.0;
+}
+
+TEST(ContentShare, TwoSharedFramesAreShownExactly) {
+  TempDir dir;
+  DaemonProcess d(dir, DaemonProcess::Launch{{"--sim", "handheld"}, {}, -1, true});
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  auto producer = ShmFrameProducer::create(kOutput, PixelFormat::kRgba8);
+  ASSERT_TRUE(producer) << producer.error().message;
+  // A fixed identity keystone (auto keystone off), whatever the rig's tilt.
+  auto k = c.call(
+      {{"cmd", "keystone"}, {"action", "set"}, {"homography", {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}}});
+  ASSERT_TRUE(k);
+  ASSERT_EQ((*k)["mode"], "manual") << k->dump();
+
+  // Identity warp (content size = output size): every output pixel is exactly a
+  // content pixel, so the output mean is the content's mean to the last bit.
+  const cv::Mat a = twoAreas({10, 20, 30, 255}, {200, 100, 50, 255}, 640);
+  producer->publish(a.data);
+  auto reply = callWithFds(c, shareRequest(kOutput), {producer->fd()});
+  ASSERT_TRUE(reply);
+  ASSERT_EQ((*reply)["class"], "CONTENT") << reply->dump();
+  EXPECT_EQ((*reply)["content"]["size"], json({1280, 720}));
+  EXPECT_EQ((*reply)["content"]["shared"]["format"], "rgba8");
+  ASSERT_TRUE(eventually([&] { return showsMean(c, 105, 60, 40); })) << shownStats(c).dump();
+
+  // A second frame: a quarter (320 columns) of (255, 255, 255), the rest (1, 2, 3).
+  const cv::Mat b = twoAreas({255, 255, 255, 255}, {1, 2, 3, 255}, 320);
+  producer->publish(b.data);
+  ASSERT_TRUE(eventually([&] { return showsMean(c, 64.5, 65.25, 66); })) << shownStats(c).dump();
+  const json content = (*c.call({{"cmd", "content"}}))["content"];
+  EXPECT_GE(content["shared"]["frames"].get<int>(), 2) << content.dump();
+
+  // Clearing stops the sharing; the producer's frames no longer matter.
+  ASSERT_EQ((*c.call({{"cmd", "content"}, {"action", "clear"}}))["content"], nullptr);
+  ASSERT_TRUE(eventually([&] { return shownStats(c)["source"] == "none"; }));
+}
+
+TEST(ContentShare, BadDescriptorsAreRefusedAndClosed) {
+  TempDir dir;
+  DaemonProcess d(dir, DaemonProcess::Launch{{"--sim", "handheld"}, {}, -1, true});
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  ASSERT_TRUE(c.call({{"cmd", "status"}}));  // settled: every device open
+  const std::map<int, std::string> before = openFds(d.pid());
+  auto expectError = [&](const std::optional<json>& r, const std::string& words) {
+    ASSERT_TRUE(r);
+    EXPECT_EQ((*r)["class"], "ERROR") << r->dump();
+    EXPECT_EQ((*r)["code"], "bad-argument") << r->dump();
+    EXPECT_NE((*r)["message"].get<std::string>().find(words), std::string::npos) << r->dump();
+  };
+
+  // No descriptor.
+  expectError(callWithFds(c, shareRequest(kOutput), {}), "exactly one memfd");
+  // Unsealed memfd of the right size.
+  const int unsealed = ::memfd_create("t", MFD_CLOEXEC | MFD_ALLOW_SEALING);
+  ASSERT_EQ(::ftruncate(unsealed, off_t(content::shmTotalBytes(kOutput, PixelFormat::kRgba8))), 0);
+  expectError(callWithFds(c, shareRequest(kOutput), {unsealed}), "not sealed");
+  // A producer's memfd (sealed) for smaller frames than requested: too small.
+  auto small = ShmFrameProducer::create({64, 64}, PixelFormat::kRgba8);
+  ASSERT_TRUE(small);
+  expectError(callWithFds(c, shareRequest(kOutput), {small->fd()}), "too small");
+  // Not a memfd at all.
+  expectError(callWithFds(c, shareRequest({4, 4}), {STDIN_FILENO}), "not a memfd");
+  // Two descriptors, and more than the daemon takes per request.
+  expectError(callWithFds(c, shareRequest({64, 64}), {small->fd(), small->fd()}),
+              "exactly one memfd");
+  expectError(callWithFds(c, shareRequest({64, 64}), std::vector<int>(7, small->fd())),
+              "exactly one memfd");
+  // A bad argument with a good descriptor.
+  expectError(callWithFds(c, shareRequest({64, 64}, "yuyv"), {small->fd()}), "pixel format");
+  // Descriptors with any other request are closed, the request served as usual.
+  auto status = callWithFds(c, {{"cmd", "status"}}, {small->fd(), unsealed});
+  ASSERT_TRUE(status);
+  EXPECT_EQ((*status)["class"], "STATUS");
+  ::close(unsealed);
+
+  ASSERT_TRUE(c.call({{"cmd", "status"}}));
+  // Nothing new is open (an earlier connection may have closed meanwhile); a kept
+  // memfd would show as "/memfd:..." here.
+  for (const auto& [fd, target] : openFds(d.pid())) {
+    auto it = before.find(fd);
+    EXPECT_TRUE(it != before.end() && it->second == target) << fd << " -> " << target;
+  }
+  const json shown = shownStats(c);  // no shared frame was shown
+  EXPECT_TRUE(shown.is_null() || shown["source"] != "content") << shown.dump();
+}
+
+}  // namespace
+}  // namespace procam::itest
