@@ -1,0 +1,176 @@
+#include "gst_source.hpp"
+
+#include <gst/app/gstappsink.h>
+#include <gst/gst.h>
+#include <gst/video/video.h>
+
+#include <cstring>
+
+namespace procam::content {
+
+namespace {
+
+struct GstUnref {
+  void operator()(GstElement* e) const {
+    gst_element_set_state(e, GST_STATE_NULL);
+    gst_object_unref(e);
+  }
+  void operator()(GstSample* s) const { gst_sample_unref(s); }
+  void operator()(GstMessage* m) const { gst_message_unref(m); }
+  void operator()(GstBus* b) const { gst_object_unref(b); }
+  void operator()(GError* e) const { g_error_free(e); }
+  void operator()(gchar* s) const { g_free(s); }
+};
+template <class T>
+using GstPtr = std::unique_ptr<T, GstUnref>;
+
+// The pipeline's first error message, if one is waiting on the bus.
+std::string busError(GstElement* pipeline) {
+  GstPtr<GstBus> bus(gst_element_get_bus(pipeline));
+  GstPtr<GstMessage> msg(gst_bus_pop_filtered(bus.get(), GST_MESSAGE_ERROR));
+  if (!msg) return {};
+  GError* raw = nullptr;
+  gst_message_parse_error(msg.get(), &raw, nullptr);
+  GstPtr<GError> err(raw);
+  return err ? err->message : "unknown GStreamer error";
+}
+
+class GstVideo final : public ContentSource {
+ public:
+  GstVideo(GstPtr<GstElement> pipeline, GstAppSink* sink, cv::Size size,
+           std::optional<std::chrono::nanoseconds> interval)
+      : pipeline_(std::move(pipeline)), sink_(sink), size_(size), interval_(interval) {}
+  ~GstVideo() override { gst_object_unref(sink_); }
+
+  cv::Size size() const override { return size_; }
+  PixelFormat format() const override { return PixelFormat::kRgba8; }
+  std::optional<std::chrono::nanoseconds> frameInterval() const override { return interval_; }
+
+  Result<ReadStatus> read(Frame& out) override {
+    if (ended_) return ReadStatus::kEnd;
+    GstPtr<GstSample> sample(gst_app_sink_try_pull_sample(sink_, 0));
+    if (!sample) {
+      if (const std::string e = busError(pipeline_.get()); !e.empty()) {
+        ended_ = true;
+        return fail(ErrorCode::kIo, "video: " + e);
+      }
+      if (gst_app_sink_is_eos(sink_)) {
+        ended_ = true;
+        return ReadStatus::kEnd;
+      }
+      return ReadStatus::kNoFrame;
+    }
+    GstVideoInfo info;
+    if (!gst_video_info_from_caps(&info, gst_sample_get_caps(sample.get()))) {
+      ended_ = true;
+      return fail(ErrorCode::kIo, "video: a sample without video caps");
+    }
+    GstBuffer* buffer = gst_sample_get_buffer(sample.get());
+    GstMapInfo map;
+    if (!buffer || !gst_buffer_map(buffer, &map, GST_MAP_READ)) {
+      ended_ = true;
+      return fail(ErrorCode::kIo, "video: cannot map a frame");
+    }
+    const int w = GST_VIDEO_INFO_WIDTH(&info), h = GST_VIDEO_INFO_HEIGHT(&info);
+    const size_t stride = static_cast<size_t>(GST_VIDEO_INFO_PLANE_STRIDE(&info, 0));
+    if (map.size < stride * static_cast<size_t>(h - 1) + static_cast<size_t>(w) * 4) {
+      gst_buffer_unmap(buffer, &map);
+      ended_ = true;
+      return fail(ErrorCode::kIo, "video: frame buffer smaller than its caps");
+    }
+    // Rows may be padded: copy out row by row into a packed frame.
+    out.pixels =
+        cv::Mat(h, w, CV_8UC4,
+                const_cast<uint8_t*>(map.data) + GST_VIDEO_INFO_PLANE_OFFSET(&info, 0), stride)
+            .clone();
+    gst_buffer_unmap(buffer, &map);
+    out.format = PixelFormat::kRgba8;
+    out.sequence = ++sequence_;
+    const GstClockTime pts = GST_BUFFER_PTS(buffer);
+    out.timestamp =
+        GST_CLOCK_TIME_IS_VALID(pts) ? std::chrono::nanoseconds(pts) : std::chrono::nanoseconds(0);
+    size_ = {w, h};
+    return ReadStatus::kFrame;
+  }
+
+ private:
+  GstPtr<GstElement> pipeline_;
+  GstAppSink* sink_;  // a reference of its own
+  cv::Size size_;
+  std::optional<std::chrono::nanoseconds> interval_;
+  uint64_t sequence_ = 0;
+  bool ended_ = false;
+};
+
+Result<void> initGstreamer() {
+  static GError* init_error = [] {
+    GError* e = nullptr;
+    gst_init_check(nullptr, nullptr, &e);
+    return e;
+  }();
+  if (init_error) return fail(ErrorCode::kIo, std::string("GStreamer: ") + init_error->message);
+  return {};
+}
+
+}  // namespace
+
+Result<std::unique_ptr<ContentSource>> openGstPipeline(const std::string& description,
+                                                       const GstOptions& options) {
+  if (auto ok = initGstreamer(); !ok) return tl::unexpected(ok.error());
+  const std::string launch = description +
+                             " ! videoconvert ! video/x-raw,format=RGBA"
+                             " ! appsink name=procam_sink max-buffers=4 sync=" +
+                             (options.realtime ? "true" : "false");
+  GError* raw_error = nullptr;
+  GstPtr<GstElement> pipeline(gst_parse_launch(launch.c_str(), &raw_error));
+  GstPtr<GError> parse_error(raw_error);
+  if (!pipeline || parse_error) {
+    return fail(ErrorCode::kInvalidInput,
+                "video pipeline '" + description +
+                    "': " + (parse_error ? parse_error->message : "does not parse"));
+  }
+  GstElement* sink_element = gst_bin_get_by_name(GST_BIN(pipeline.get()), "procam_sink");
+  if (!sink_element) return fail(ErrorCode::kInvalidInput, "video pipeline without its appsink");
+  auto* sink = GST_APP_SINK(sink_element);
+  // Paused: the first frame prerolls, which gives the size and frame rate.
+  // get_state returns once the frame prerolled or the pipeline failed.
+  gst_element_set_state(pipeline.get(), GST_STATE_PAUSED);
+  const GstStateChangeReturn state = gst_element_get_state(
+      pipeline.get(), nullptr, nullptr,
+      static_cast<GstClockTime>(options.preroll_timeout.count()) * GST_MSECOND);
+  GstPtr<GstSample> preroll(
+      state == GST_STATE_CHANGE_SUCCESS ? gst_app_sink_try_pull_preroll(sink, 0) : nullptr);
+  GstVideoInfo info;
+  if (!preroll || !gst_video_info_from_caps(&info, gst_sample_get_caps(preroll.get()))) {
+    std::string why = busError(pipeline.get());
+    if (why.empty()) why = preroll ? "no video caps" : "no frame before the timeout";
+    gst_object_unref(sink);
+    return fail(ErrorCode::kIo, "video pipeline '" + description + "': " + why);
+  }
+  std::optional<std::chrono::nanoseconds> interval;
+  if (GST_VIDEO_INFO_FPS_N(&info) > 0 && GST_VIDEO_INFO_FPS_D(&info) > 0) {
+    interval = std::chrono::nanoseconds(gst_util_uint64_scale(
+        GST_SECOND, GST_VIDEO_INFO_FPS_D(&info), GST_VIDEO_INFO_FPS_N(&info)));
+  }
+  const cv::Size size(GST_VIDEO_INFO_WIDTH(&info), GST_VIDEO_INFO_HEIGHT(&info));
+  gst_element_set_state(pipeline.get(), GST_STATE_PLAYING);
+  return std::unique_ptr<ContentSource>(
+      std::make_unique<GstVideo>(std::move(pipeline), sink, size, interval));
+}
+
+Result<std::unique_ptr<ContentSource>> openVideoFile(const std::string& path,
+                                                     const GstOptions& options) {
+  if (auto ok = initGstreamer(); !ok) return tl::unexpected(ok.error());
+  GError* raw_error = nullptr;
+  GstPtr<gchar> uri(gst_filename_to_uri(path.c_str(), &raw_error));
+  GstPtr<GError> error(raw_error);
+  if (!uri) return fail(ErrorCode::kIo, path + ": " + (error ? error->message : "bad path"));
+  if (!g_file_test(path.c_str(), G_FILE_TEST_IS_REGULAR)) {
+    return fail(ErrorCode::kIo, path + ": no such file");
+  }
+  auto source = openGstPipeline(std::string("uridecodebin uri=\"") + uri.get() + "\"", options);
+  if (!source) return fail(source.error().code, path + ": " + source.error().message);
+  return source;
+}
+
+}  // namespace procam::content
