@@ -33,7 +33,7 @@ void Daemon::cmdPattern(ClientId client, const proto::Request& req) {
 }
 
 json Daemon::contentJson() const {
-  if (shared_content_) return sharedContentJson();
+  if (live_content_) return liveContentJson();
   if (settings_.content.empty()) return nullptr;
   json j = {{"path", settings_.content}};
   if (content_info_.width > 0) j["size"] = {content_info_.width, content_info_.height};
@@ -42,6 +42,7 @@ json Daemon::contentJson() const {
 
 void Daemon::cmdContent(ClientId client, const proto::Request& req) {
   if (req.body.value("action", json()) == "share") return cmdContentShare(client, req);
+  if (req.body.value("action", json()) == "stream") return cmdContentStream(client, req);
   RequestArgs args(req.body);
   PROCAM_CHECK_KEYS(args, "action", "path");
   const std::string action = args.string("action").value_or("get");
@@ -51,7 +52,7 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
     if (path)
       return errorTo(client, req, code::kBadArgument, "content " + action + " takes no path");
     if (action == "clear") {
-      stopSharedContent();
+      stopLiveContent();
       settings_.content.clear();
       content_info_ = {};
       keystone_rt_.content.reset();
@@ -63,7 +64,7 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
   }
   if (action != "load") {
     return errorTo(client, req, code::kBadArgument,
-                   "unknown content action '" + action + "' (get, load, clear, share)");
+                   "unknown content action '" + action + "' (get, load, clear, share, stream)");
   }
   if (!path || path->empty()) {
     return errorTo(client, req, code::kBadArgument, "content load needs \"path\"");
@@ -102,7 +103,7 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
       } else if (!failure.empty()) {
         errorTo(client, req, code::kIo, failure);
       } else {
-        stopSharedContent();
+        stopLiveContent();
         settings_.content = file;
         content_info_ = {image->cols, image->rows};
         keystone_rt_.content = image;

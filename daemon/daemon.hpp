@@ -79,11 +79,18 @@ class Daemon {
   nlohmann::json statusJson() const;
   nlohmann::json keystoneJson() const;
   nlohmann::json contentJson() const;
-  // content_share.cpp: frames another process fills in a sealed memfd.
+  // content_live.cpp: shared-memory frames, raw frames and video.
   void cmdContentShare(ClientId, const proto::Request&);
-  void pollSharedContent();
-  void stopSharedContent();
-  nlohmann::json sharedContentJson() const;
+  void cmdContentStream(ClientId, const proto::Request&);
+  void startStream(ClientId client, const proto::Request& req,
+                   Result<std::unique_ptr<content::ContentSource>> source,
+                   const nlohmann::json& info);
+  Result<void> startLiveContent(std::unique_ptr<content::ContentSource> source,
+                                nlohmann::json info);
+  void pollLiveContent();
+  void stopLiveContent();
+  void stopWatchingLiveContent();
+  nlohmann::json liveContentJson() const;
   // daemon_keystone.cpp: auto keystone and what the outputs show.
   void setupAutoKeystone();
   void probeKeystoneInputs();
@@ -132,13 +139,15 @@ class Daemon {
     int width = 0, height = 0;
   };
   ContentInfo content_info_;
-  struct SharedContent {
-    std::unique_ptr<content::ContentSource> source;
-    int timer = -1;
-    std::string format;
-    uint64_t frames = 0;  // shown so far
+  struct LiveContent {
+    std::unique_ptr<content::ContentSource> source;  // null once ended
+    int timer = -1;                                  // read at the frame rate, or
+    int fd = -1;                                     // read when readable
+    nlohmann::json info;                             // what `content` reports about the source
+    uint64_t frames = 0;                             // shown so far
+    bool ended = false;                              // the last frame stays shown
   };
-  std::optional<SharedContent> shared_content_;  // set by `content share`
+  std::optional<LiveContent> live_content_;  // set by `content share` / `stream`
   KeystoneRuntime keystone_rt_;
   // Destroyed in reverse order: server and workers before the loop they use.
   std::unique_ptr<EventLoop> loop_;

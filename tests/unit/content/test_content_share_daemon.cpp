@@ -6,10 +6,12 @@
 #include <gtest/gtest.h>
 #include <sys/mman.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <map>
+#include <opencv2/imgproc.hpp>
 
 #include "content/shm_frames.hpp"
 #include "integration/daemon_harness.hpp"
@@ -85,6 +87,14 @@ bool showsMean(Connection& c, double r, double g, double b) {
          s["mean_rgb"][1] == g && s["mean_rgb"][2] == b && s["lit_fraction"] == 1.0;
 }
 
+// A fixed identity keystone (auto keystone off), whatever the rig's tilt.
+void identityKeystone(Connection& c) {
+  auto k = c.call(
+      {{"cmd", "keystone"}, {"action", "set"}, {"homography", {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}}});
+  ASSERT_TRUE(k);
+  ASSERT_EQ((*k)["mode"], "manual") << k->dump();
+}
+
 TEST(ContentShare, TwoSharedFramesAreShownExactly) {
   TempDir dir;
   DaemonProcess d(dir, DaemonProcess::Launch{{"--sim", "handheld"}, {}, -1, true});
@@ -114,7 +124,7 @@ TEST(ContentShare, TwoSharedFramesAreShownExactly) {
   producer->publish(b.data);
   ASSERT_TRUE(eventually([&] { return showsMean(c, 64.5, 65.25, 66); })) << shownStats(c).dump();
   const json content = (*c.call({{"cmd", "content"}}))["content"];
-  EXPECT_GE(content["shared"]["frames"].get<int>(), 2) << content.dump();
+  EXPECT_GE(content["frames"].get<int>(), 2) << content.dump();
 
   // Clearing stops the sharing; the producer's frames no longer matter.
   ASSERT_EQ((*c.call({{"cmd", "content"}, {"action", "clear"}}))["content"], nullptr);
@@ -170,6 +180,91 @@ TEST(ContentShare, BadDescriptorsAreRefusedAndClosed) {
   const json shown = shownStats(c);  // no shared frame was shown
   EXPECT_TRUE(shown.is_null() || shown["source"] != "content") << shown.dump();
 }
+
+// Raw RGB frames through a FIFO: each whole frame is shown, the writer closing
+// ends the stream with the last frame still shown.
+TEST(ContentStream, RawFramesFromAFifo) {
+  TempDir dir;
+  DaemonProcess d(dir, DaemonProcess::Launch{{"--sim", "handheld"}, {}, -1, true});
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  ASSERT_NO_FATAL_FAILURE(identityKeystone(c));
+  const std::string fifo = dir.file("frames");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  auto reply = c.call({{"cmd", "content"},
+                       {"action", "stream"},
+                       {"path", fifo},
+                       {"width", kOutput.width},
+                       {"height", kOutput.height},
+                       {"format", "rgb8"}});
+  ASSERT_TRUE(reply);
+  ASSERT_EQ((*reply)["class"], "CONTENT") << reply->dump();
+  EXPECT_EQ((*reply)["content"]["stream"]["raw"]["format"], "rgb8");
+  const int w = ::open(fifo.c_str(), O_WRONLY | O_CLOEXEC);
+  ASSERT_GE(w, 0);
+  auto writeFrame = [&](const cv::Mat& rgba) {
+    cv::Mat rgb;
+    cv::cvtColor(rgba, rgb, cv::COLOR_RGBA2RGB);
+    const size_t n = rgb.total() * 3;
+    for (size_t done = 0; done < n;) {
+      const ssize_t k = ::write(w, rgb.data + done, n - done);
+      ASSERT_GT(k, 0);
+      done += size_t(k);
+    }
+  };
+  ASSERT_NO_FATAL_FAILURE(writeFrame(twoAreas({10, 20, 30, 255}, {200, 100, 50, 255}, 640)));
+  ASSERT_TRUE(eventually([&] { return showsMean(c, 105, 60, 40); })) << shownStats(c).dump();
+  ASSERT_NO_FATAL_FAILURE(writeFrame(twoAreas({255, 255, 255, 255}, {1, 2, 3, 255}, 320)));
+  ASSERT_TRUE(eventually([&] { return showsMean(c, 64.5, 65.25, 66); })) << shownStats(c).dump();
+  ::close(w);
+  ASSERT_TRUE(eventually([&] {
+    return (*c.call({{"cmd", "content"}}))["content"]["ended"] == true;
+  }));
+  const json content = (*c.call({{"cmd", "content"}}))["content"];
+  EXPECT_EQ(content["frames"], 2) << content.dump();
+  EXPECT_TRUE(showsMean(c, 64.5, 65.25, 66));
+
+  // Refusals.
+  auto r = c.call({{"cmd", "content"}, {"action", "stream"}});
+  EXPECT_EQ((*r)["code"], "bad-argument") << r->dump();
+  r = c.call({{"cmd", "content"}, {"action", "stream"}, {"path", fifo}, {"width", 64}});
+  EXPECT_EQ((*r)["code"], "bad-argument") << r->dump();
+  r = c.call({{"cmd", "content"},
+              {"action", "stream"},
+              {"path", dir.file("missing")},
+              {"width", 64},
+              {"height", 64}});
+  EXPECT_EQ((*r)["code"], "io-error") << r->dump();
+}
+
+#if PROCAM_HAVE_GSTREAMER
+TEST(ContentStream, VideoPipelineFramesAreShown) {
+  TempDir dir;
+  DaemonProcess d(dir, DaemonProcess::Launch{{"--sim", "handheld"}, {}, -1, true});
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  ASSERT_NO_FATAL_FAILURE(identityKeystone(c));
+  auto reply = c.call({{"cmd", "content"},
+                       {"action", "stream"},
+                       {"pipeline",
+                        "videotestsrc num-buffers=3 pattern=solid-color "
+                        "foreground-color=0xff102030 ! video/x-raw,width=1280,height=720,"
+                        "framerate=30/1"}});
+  ASSERT_TRUE(reply);
+  ASSERT_EQ((*reply)["class"], "CONTENT") << reply->dump();
+  ASSERT_TRUE(eventually([&] {
+    return (*c.call({{"cmd", "content"}}))["content"]["ended"] == true;
+  }));
+  EXPECT_TRUE(showsMean(c, 16, 32, 48)) << shownStats(c).dump();
+  EXPECT_GE((*c.call({{"cmd", "content"}}))["content"]["frames"].get<int>(), 1);
+  auto bad = c.call({{"cmd", "content"}, {"action", "stream"}, {"pipeline", "no_such_element"}});
+  ASSERT_TRUE(bad);
+  EXPECT_EQ((*bad)["code"], "bad-argument") << bad->dump();
+  bad = c.call({{"cmd", "content"}, {"action", "stream"}, {"path", dir.file("none.mp4")}});
+  ASSERT_TRUE(bad);
+  EXPECT_EQ((*bad)["code"], "io-error") << bad->dump();
+}
+#endif
 
 }  // namespace
 }  // namespace procam::itest

@@ -1,0 +1,209 @@
+// Content that changes while shown: `content share` (frames another process
+// fills in a sealed memfd passed with the request, SCM_RIGHTS) and `content
+// stream` (raw frames from a file or FIFO, video through GStreamer). The source
+// is read on a timer at its frame rate; each new frame goes through the keystone
+// warp like a loaded image.
+#include <sys/epoll.h>
+
+#include "content/raw_source.hpp"
+#include "content/shm_frames.hpp"
+#include "daemon.hpp"
+#include "request_args.hpp"
+#if PROCAM_HAVE_GSTREAMER
+#include "content/gst_source.hpp"
+#endif
+
+namespace procam::daemon {
+
+using nlohmann::json;
+namespace code = proto::code;
+
+namespace {
+
+// An integer side from 2 to 16384; absent is fine when not `required`.
+std::optional<int> sideArg(RequestArgs& args, const char* key, bool required) {
+  const json* v = args.get(key);
+  if (!v) {
+    if (required) args.setError("content " + std::string("needs \"") + key + "\"");
+    return std::nullopt;
+  }
+  if (!v->is_number_integer() || v->get<int64_t>() < 2 || v->get<int64_t>() > 16384) {
+    args.setError(std::string("\"") + key + "\" must be an integer from 2 to 16384");
+    return std::nullopt;
+  }
+  return v->get<int>();
+}
+
+}  // namespace
+
+void Daemon::cmdContentShare(ClientId client, const proto::Request& req) {
+  // Taken before any check: every descriptor is closed on each error return.
+  std::vector<UniqueFd> fds = server_->takePassedFds(client);
+  RequestArgs args(req.body);
+  PROCAM_CHECK_KEYS(args, "action", "width", "height", "format");
+  const auto width = sideArg(args, "width", true);
+  const auto height = sideArg(args, "height", true);
+  const std::string format_name = args.string("format").value_or("rgba8");
+  if (!args.ok()) return errorTo(client, req, code::kBadArgument, args.error());
+  auto format = content::parsePixelFormat(format_name);
+  if (!format) return errorTo(client, req, code::kBadArgument, format.error().message);
+  if (fds.size() != 1) {
+    return errorTo(client, req, code::kBadArgument,
+                   "content share needs exactly one memfd passed with the request "
+                   "(SCM_RIGHTS); got " +
+                       std::to_string(fds.size()));
+  }
+  auto source = content::openSharedFrames(fds.front().release(), {*width, *height}, *format);
+  if (!source) return errorTo(client, req, code::kBadArgument, source.error().message);
+  if (auto ok = startLiveContent(std::move(*source), {{"shared", {{"format", format_name}}}});
+      !ok) {
+    return errorTo(client, req, code::kInternal, ok.error().message);
+  }
+  replyTo(client, req, "CONTENT", {{"content", contentJson()}});
+}
+
+void Daemon::cmdContentStream(ClientId client, const proto::Request& req) {
+  RequestArgs args(req.body);
+  PROCAM_CHECK_KEYS(args, "action", "path", "pipeline", "width", "height", "format", "fps");
+  const auto path = args.string("path");
+  const auto pipeline = args.string("pipeline");
+  const auto width = sideArg(args, "width", false);
+  const auto height = sideArg(args, "height", false);
+  const std::string format_name = args.string("format").value_or("rgba8");
+  double fps = 0;
+  if (const json* v = args.get("fps")) {
+    if (!v->is_number() || !(v->get<double>() >= 0) || v->get<double>() > 1000) {
+      args.setError("\"fps\" must be a number from 0 to 1000");
+    } else {
+      fps = v->get<double>();
+    }
+  }
+  if (!args.ok()) return errorTo(client, req, code::kBadArgument, args.error());
+  if (bool(path) == bool(pipeline) || (path && path->empty())) {
+    return errorTo(client, req, code::kBadArgument,
+                   "content stream needs either \"path\" or \"pipeline\"");
+  }
+  json info;
+  Result<std::unique_ptr<content::ContentSource>> source =
+      fail(ErrorCode::kInvalidInput, "no source");
+  if (width || height) {
+    // Raw frames: the size (and format) say how to cut the bytes into frames.
+    if (!width || !height || !path) {
+      return errorTo(client, req, code::kBadArgument,
+                     "raw frames need \"path\", \"width\" and \"height\"");
+    }
+    auto format = content::parsePixelFormat(format_name);
+    if (!format) return errorTo(client, req, code::kBadArgument, format.error().message);
+    source = content::openRawFrames(*path, {{*width, *height}, *format, fps});
+    info = {{"path", *path}, {"raw", {{"format", format_name}, {"fps", fps}}}};
+  } else {
+#if PROCAM_HAVE_GSTREAMER
+    // Opening waits for the first decoded frame (up to the preroll timeout): on
+    // a worker, the reply once it is shown or refused.
+    info = path ? json{{"path", *path}, {"video", true}}
+                : json{{"pipeline", *pipeline}, {"video", true}};
+    server_->hold(client);
+    compute_worker_->submit([this, client, req, path, pipeline, info] {
+      auto opened = std::make_shared<Result<std::unique_ptr<content::ContentSource>>>(
+          path ? content::openVideoFile(*path) : content::openGstPipeline(*pipeline));
+      return [this, client, req, opened, info] {
+        startStream(client, req, std::move(*opened), info);
+        server_->release(client);
+      };
+    });
+    return;
+#else
+    return errorTo(client, req, code::kUnavailable,
+                   "video needs GStreamer, which this procamd was built without");
+#endif
+  }
+  startStream(client, req, std::move(source), info);
+}
+
+void Daemon::startStream(ClientId client, const proto::Request& req,
+                         Result<std::unique_ptr<content::ContentSource>> source, const json& info) {
+  if (!source) {
+    const bool io = source.error().code == ErrorCode::kIo;
+    return errorTo(client, req, io ? code::kIo : code::kBadArgument, source.error().message);
+  }
+  if (auto ok = startLiveContent(std::move(*source), {{"stream", info}}); !ok) {
+    return errorTo(client, req, code::kInternal, ok.error().message);
+  }
+  replyTo(client, req, "CONTENT", {{"content", contentJson()}});
+}
+
+Result<void> Daemon::startLiveContent(std::unique_ptr<content::ContentSource> source, json info) {
+  stopLiveContent();
+  // A source with an fd (a FIFO) is read whenever bytes arrive, so that its
+  // writer never waits for a timer; the others are read at their frame rate.
+  const int fd = source->pollFd();
+  int timer = -1;
+  if (fd >= 0) {
+    if (auto ok = loop_->add(fd, EPOLLIN, [this](uint32_t) { pollLiveContent(); }); !ok) {
+      return tl::unexpected(ok.error());
+    }
+  } else {
+    const auto interval = source->frameInterval().value_or(std::chrono::milliseconds(16));
+    auto added = loop_->addTimer(interval, true, [this] { pollLiveContent(); });
+    if (!added) return tl::unexpected(added.error());
+    timer = *added;
+  }
+  settings_.content.clear();
+  keystone_rt_.content.reset();
+  content_info_ = {source->size().width, source->size().height};
+  live_content_ = LiveContent{std::move(source), timer, fd, std::move(info), 0, false};
+  pollLiveContent();  // a frame already there shows at once
+  broadcast("content", {{"content", contentJson()}});
+  return {};
+}
+
+void Daemon::pollLiveContent() {
+  if (!live_content_ || live_content_->ended) return;
+  LiveContent& live = *live_content_;
+  // Timer sources: one frame in flight at a time, the newest taken once it is
+  // shown. A FIFO is drained whenever it is readable (its writer must not
+  // block); frames that arrive while one renders replace each other.
+  if (live.fd < 0 && keystone_rt_.rendering) return;
+  content::Frame frame, newest;
+  Result<content::ReadStatus> status = content::ReadStatus::kNoFrame;
+  while ((status = live.source->read(frame)) && *status == content::ReadStatus::kFrame) {
+    newest = std::move(frame);
+    if (live.fd < 0) break;
+  }
+  if (!newest.pixels.empty()) {
+    keystone_rt_.content = std::make_shared<const cv::Mat>(content::toRgba(newest));
+    content_info_ = {newest.pixels.cols, newest.pixels.rows};
+    ++live.frames;
+    refreshOutputs();
+  }
+  if (!status || *status == content::ReadStatus::kEnd) {
+    // The last frame stays shown; the source is closed.
+    if (!status) warn("content stopped: " + status.error().message);
+    stopWatchingLiveContent();
+    live.source.reset();
+    live.ended = true;
+    broadcast("content", {{"content", contentJson()}});
+  }
+}
+
+void Daemon::stopWatchingLiveContent() {
+  if (live_content_->fd >= 0) loop_->remove(live_content_->fd);
+  if (live_content_->timer >= 0) loop_->removeTimer(live_content_->timer);
+  live_content_->fd = live_content_->timer = -1;
+}
+
+void Daemon::stopLiveContent() {
+  if (!live_content_) return;
+  stopWatchingLiveContent();
+  live_content_.reset();
+}
+
+json Daemon::liveContentJson() const {
+  json j = live_content_->info;
+  j["frames"] = live_content_->frames;
+  j["ended"] = live_content_->ended;
+  j["size"] = {content_info_.width, content_info_.height};
+  return j;
+}
+
+}  // namespace procam::daemon
