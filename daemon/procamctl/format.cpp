@@ -59,7 +59,12 @@ std::string keystoneText(const json& k) {
 std::string contentText(const json& c) {
   if (c.is_null()) return "none";
   std::string s = c.value("path", "");
+  if (c.contains("stream")) s = c["stream"].value("path", c["stream"].value("pipeline", ""));
+  if (c.contains("shared")) s = "shared memory";
   if (c.contains("size")) s += " (" + scalar(c["size"][0]) + "x" + scalar(c["size"][1]) + ")";
+  if (c.contains("frames")) {
+    s += ", " + scalar(c["frames"]) + " frames" + (c.value("ended", false) ? ", ended" : "");
+  }
   return s;
 }
 

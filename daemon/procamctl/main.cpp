@@ -29,6 +29,9 @@ constexpr const char* kUsage =
     "  keystone auto on|off\n"
     "  pattern [off|grid|crosshair|white|black]\n"
     "  content [get] | content load PATH | content clear\n"
+    "  content stream PATH [WxH [rgb8|rgba8 [FPS]]]\n"
+    "                                 raw frames (with a size) or a video file\n"
+    "  content pipeline 'GST-SOURCE'  video from a gst-launch source description\n"
     "  log-level [error|warning|info|debug]\n"
     "exit codes: 0 ok, 1 daemon error, 2 usage, 3 cannot connect, 4 protocol, 5 unavailable\n";
 
@@ -104,6 +107,24 @@ json buildRequest(const std::string& cmd, const std::vector<std::string>& a) {
       r["path"] = a[1];
     } else if (action == "get" || action == "clear") {
       arity(0, 1);
+    } else if (action == "stream") {
+      arity(2, 5);
+      r["path"] = a[1];
+      if (a.size() > 2) {
+        int w = 0, h = 0;
+        char tail = 0;
+        if (std::sscanf(a[2].c_str(), "%dx%d%c", &w, &h, &tail) != 2) {
+          usage("content stream: size '" + a[2] + "' is not WxH");
+        }
+        r["width"] = w;
+        r["height"] = h;
+      }
+      if (a.size() > 3) r["format"] = a[3];
+      if (a.size() > 4) r["fps"] = std::atof(a[4].c_str());
+    } else if (action == "pipeline") {
+      arity(2, 2);
+      r["action"] = "stream";
+      r["pipeline"] = a[1];
     } else {
       usage("unknown content action '" + action + "'");
     }

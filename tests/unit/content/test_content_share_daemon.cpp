@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <opencv2/imgproc.hpp>
 
@@ -235,6 +236,33 @@ TEST(ContentStream, RawFramesFromAFifo) {
               {"width", 64},
               {"height", 64}});
   EXPECT_EQ((*r)["code"], "io-error") << r->dump();
+}
+
+// procamctl: `content stream PATH WxH FORMAT FPS` sends the raw-frames request.
+TEST(ContentStream, ProcamctlStreamsRawFramesFromAFile) {
+  TempDir dir;
+  DaemonProcess d(dir, DaemonProcess::Launch{{"--sim", "handheld"}, {}, -1, true});
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  ASSERT_NO_FATAL_FAILURE(identityKeystone(c));
+  const std::string file = dir.file("one.rgba");
+  const cv::Mat a = twoAreas({10, 20, 30, 255}, {200, 100, 50, 255}, 640);
+  {
+    std::ofstream out(file, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(a.data), std::streamsize(a.total() * 4));
+  }
+  auto run = runProgram({PROCAMCTL_BIN, "--socket", d.socketPath(), "content", "stream", file,
+                         "1280x720", "rgba8", "50"});
+  EXPECT_EQ(run.status, 0) << run.out << run.err;
+  EXPECT_NE(run.out.find("one.rgba (1280x720"), std::string::npos) << run.out;
+  ASSERT_TRUE(eventually([&] { return showsMean(c, 105, 60, 40); })) << shownStats(c).dump();
+  ASSERT_TRUE(eventually([&] {
+    return (*c.call({{"cmd", "content"}}))["content"]["ended"] == true;
+  }));
+  run = runProgram({PROCAMCTL_BIN, "--socket", d.socketPath(), "content"});
+  EXPECT_NE(run.out.find("1 frames, ended"), std::string::npos) << run.out;
+  run = runProgram({PROCAMCTL_BIN, "--socket", d.socketPath(), "content", "stream", file, "12"});
+  EXPECT_EQ(run.status, 2) << run.out << run.err;  // usage: not WxH
 }
 
 #if PROCAM_HAVE_GSTREAMER
