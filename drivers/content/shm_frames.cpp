@@ -59,7 +59,7 @@ class SharedFrames final : public ContentSource {
   Result<ReadStatus> read(Frame& out) override {
     const uint64_t published = reader_.published();
     if (published == seen_) return ReadStatus::kNoFrame;
-    cv::Mat pixels;
+    cv::Mat pixels = spareBuffer();
     if (!reader_.copyNewest(pixels)) return ReadStatus::kNoFrame;  // mid-write: next tick
     seen_ = published;
     out.pixels = std::move(pixels);
@@ -70,12 +70,26 @@ class SharedFrames final : public ContentSource {
   }
 
  private:
+  // A frame buffer no consumer holds any more (only this pool references it), so
+  // that steady streaming does not fault in a fresh 8 MB buffer per frame.
+  cv::Mat spareBuffer() {
+    for (cv::Mat& m : pool_) {
+      if (__atomic_load_n(&m.u->refcount, __ATOMIC_ACQUIRE) == 1) return m;
+    }
+    const int type = format_ == PixelFormat::kRgb8 ? CV_8UC3 : CV_8UC4;
+    cv::Mat fresh(size_, type);
+    if (pool_.size() < kPoolSize) pool_.push_back(fresh);
+    return fresh;
+  }
+  static constexpr size_t kPoolSize = 3;
+
   UniqueFd fd_;
   void* map_;
   size_t bytes_;
   cv::Size size_;
   PixelFormat format_;
   ShmFrameReader reader_;
+  std::vector<cv::Mat> pool_;
   uint64_t seen_ = 0;
   uint64_t sequence_ = 0;
 };

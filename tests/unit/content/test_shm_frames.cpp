@@ -50,6 +50,35 @@ TEST(ShmFrames, TwoPublishedFramesReadBackExactly) {
   EXPECT_EQ(f.sequence, 2u);
 }
 
+// A frame the consumer still holds is never reused for the next one; one it
+// released is.
+TEST(ShmFrames, HeldFramesAreNotOverwritten) {
+  const cv::Size size(4, 4);
+  auto producer = ShmFrameProducer::create(size, PixelFormat::kRgba8);
+  ASSERT_TRUE(producer);
+  auto source = openSharedFrames(::dup(producer->fd()), size, PixelFormat::kRgba8);
+  ASSERT_TRUE(source);
+  std::vector<cv::Mat> held;
+  for (int k = 0; k < 5; ++k) {
+    const cv::Mat m = solid(size, {uint8_t(k), 0, 0, 255}, k);
+    producer->publish(m.data);
+    Frame f;
+    ASSERT_EQ((*source)->read(f).value(), ReadStatus::kFrame);
+    held.push_back(f.pixels);
+  }
+  for (int k = 0; k < 5; ++k) {
+    EXPECT_TRUE(same(held[size_t(k)], solid(size, {uint8_t(k), 0, 0, 255}, k))) << k;
+  }
+  const uint8_t* first = held[0].data;
+  held.clear();  // all released: the next frame lands in a pooled buffer
+  const cv::Mat m = solid(size, {9, 9, 9, 255}, 9);
+  producer->publish(m.data);
+  Frame f;
+  ASSERT_EQ((*source)->read(f).value(), ReadStatus::kFrame);
+  EXPECT_EQ(f.pixels.data, first);
+  EXPECT_TRUE(same(f.pixels, m));
+}
+
 TEST(ShmFrames, RgbFramesToo) {
   const cv::Size size(3, 3);
   auto producer = ShmFrameProducer::create(size, PixelFormat::kRgb8);
