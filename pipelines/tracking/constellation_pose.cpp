@@ -101,6 +101,26 @@ long combinations(long n, long k) {
   return r;
 }
 
+// Strict gate on the RMS, then the world position and its covariance.
+Result<ConstellationPose> finish(const geom::CameraModel& camera, std::span<const Vec3> leds,
+                                 const Scored& best, const ConstellationOptions& o) {
+  const double rms = std::sqrt(best.sq / best.matched);
+  if (rms > o.max_reprojection_px)
+    return fail(ErrorCode::kNotFound, "refined constellation pose fails the reprojection gate");
+  ConstellationPose out;
+  out.pose = best.pose;
+  out.blob_of_led = best.blob_of_led;
+  out.matched = best.matched;
+  out.rms_px = rms;
+  out.position_world = camera.pose.toWorld(best.pose.t);
+  std::vector<int> used;
+  for (size_t i = 0; i < leds.size(); ++i)
+    if (out.blob_of_led[i] >= 0) used.push_back(static_cast<int>(i));
+  const Mat3 cov_cam = positionCovariance(camera.K, best.pose, leds, o.pixel_sigma, used);
+  out.covariance_world = camera.pose.R.transpose() * cov_cam * camera.pose.R;
+  return out;
+}
+
 }  // namespace
 
 Mat3 positionCovariance(const geom::Intrinsics& K, const geom::Pose& pose,
@@ -140,18 +160,13 @@ Mat3 positionCovariance(const geom::Intrinsics& K, const geom::Pose& pose,
 Result<ConstellationPose> estimateConstellationPose(const geom::CameraModel& camera,
                                                     std::span<const Vec3> leds,
                                                     std::span<const Vec2> blobs_distorted,
-                                                    const ConstellationOptions& o) {
+                                                    const ConstellationOptions& o,
+                                                    const std::optional<geom::Pose>& previous) {
   if (leds.size() < 4 || blobs_distorted.size() < 4)
     return fail(ErrorCode::kTooFewPoints, "constellation pose needs >= 4 LEDs and >= 4 blobs");
   if (!(o.max_reprojection_px > 0) || !(o.hypothesis_gate_factor >= 1) || o.max_refinements < 1 ||
       o.min_leds < 4 || !(o.pixel_sigma >= 0))
     return fail(ErrorCode::kInvalidInput, "bad constellation options");
-  const long hyp = combinations(static_cast<long>(leds.size()), 4) *
-                   permutations(static_cast<long>(blobs_distorted.size()), 4);
-  if (hyp > o.max_hypotheses)
-    return fail(ErrorCode::kInvalidInput,
-                "too many blob/LED hypotheses (" + std::to_string(hyp) + ")");
-
   Points2 blobs;
   for (const Vec2& b : blobs_distorted) {
     auto u = camera.undistortPixel(b);
@@ -161,12 +176,41 @@ Result<ConstellationPose> estimateConstellationPose(const geom::CameraModel& cam
   const geom::Intrinsics& Ki = camera.K;
   cv::Mat K = (cv::Mat_<double>(3, 3) << Ki.fx, Ki.skew, Ki.cx, 0, Ki.fy, Ki.cy, 0, 0, 1);
 
+  const double loose_gate = o.hypothesis_gate_factor * o.max_reprojection_px;
+  const int nl = static_cast<int>(leds.size()), nb = static_cast<int>(blobs.size());
+  // Refine on the matched LEDs and re-match: with the loose gate, then the strict one.
+  auto refine = [&](Scored s) -> std::optional<Scored> {
+    for (const double gate : {loose_gate, o.max_reprojection_px, o.max_reprojection_px}) {
+      Points3 obj_all;
+      Points2 img_all;
+      for (int i = 0; i < nl; ++i)
+        if (const int j = s.blob_of_led[static_cast<size_t>(i)]; j >= 0) {
+          obj_all.push_back(leds[static_cast<size_t>(i)]);
+          img_all.push_back(blobs[static_cast<size_t>(j)]);
+        }
+      if (obj_all.size() < 4) return std::nullopt;
+      auto refined = solvePnP(K, obj_all, img_all, cv::SOLVEPNP_ITERATIVE, &s.pose);
+      if (!refined) return std::nullopt;
+      s = scoreByReprojection(Ki, *refined, leds, blobs, gate);
+    }
+    if (s.matched < o.min_leds) return std::nullopt;
+    return s;
+  };
+
+  // Tracking: the previous frame's pose, accepted when it explains every LED or blob.
+  if (previous) {
+    auto s = refine(scoreByReprojection(Ki, *previous, leds, blobs, loose_gate));
+    if (s && s->matched == std::min(nl, nb)) return finish(camera, leds, *s, o);
+  }
+
+  const long hyp = combinations(nl, 4) * permutations(nb, 4);
+  if (hyp > o.max_hypotheses)
+    return fail(ErrorCode::kInvalidInput,
+                "too many blob/LED hypotheses (" + std::to_string(hyp) + ")");
   // Near weak perspective (a 10 cm constellation 2 m away) a pose from four noisy blobs
   // extrapolates poorly to the other LEDs, so hypotheses are scored with a wider gate;
   // each distinct assignment that passes is then refined and judged with the strict one.
-  const double loose_gate = o.hypothesis_gate_factor * o.max_reprojection_px;
   std::map<std::vector<int>, Scored> by_assignment;  // best loose score per assignment
-  const int nl = static_cast<int>(leds.size()), nb = static_cast<int>(blobs.size());
   std::array<Vec3, 4> obj;
   std::array<Vec2, 4> img;
   // Hypotheses: each 4-subset of LEDs against each ordered 4-tuple of blobs.
@@ -194,7 +238,6 @@ Result<ConstellationPose> estimateConstellationPose(const geom::CameraModel& cam
             }
         }
 
-  // Refine on the matched LEDs and re-match: with the loose gate, then the strict one.
   // Only the strongest few are refined (LM per candidate is the costly step).
   std::vector<Scored> candidates;
   for (auto& [assignment, scored] : by_assignment) candidates.push_back(std::move(scored));
@@ -202,45 +245,11 @@ Result<ConstellationPose> estimateConstellationPose(const geom::CameraModel& cam
   if (candidates.size() > static_cast<size_t>(o.max_refinements))
     candidates.resize(static_cast<size_t>(o.max_refinements));
   std::optional<Scored> best;
-  for (Scored s : candidates) {
-    bool ok = true;
-    for (const double gate : {loose_gate, o.max_reprojection_px, o.max_reprojection_px}) {
-      Points3 obj_all;
-      Points2 img_all;
-      for (int i = 0; i < nl; ++i)
-        if (const int j = s.blob_of_led[static_cast<size_t>(i)]; j >= 0) {
-          obj_all.push_back(leds[static_cast<size_t>(i)]);
-          img_all.push_back(blobs[static_cast<size_t>(j)]);
-        }
-      auto refined = obj_all.size() >= 4
-                         ? solvePnP(K, obj_all, img_all, cv::SOLVEPNP_ITERATIVE, &s.pose)
-                         : std::nullopt;
-      if (!refined) {
-        ok = false;
-        break;
-      }
-      s = scoreByReprojection(Ki, *refined, leds, blobs, gate);
-    }
-    if (ok && s.matched >= o.min_leds && (!best || better(s, *best))) best = std::move(s);
-  }
+  for (const Scored& c : candidates)
+    if (auto s = refine(c); s && (!best || better(*s, *best))) best = std::move(s);
   if (!best)
     return fail(ErrorCode::kNotFound, "no blob-to-LED assignment reprojects within the gate");
-  const double rms = std::sqrt(best->sq / best->matched);
-  if (rms > o.max_reprojection_px)
-    return fail(ErrorCode::kNotFound, "refined constellation pose fails the reprojection gate");
-
-  ConstellationPose out;
-  out.pose = best->pose;
-  out.blob_of_led = best->blob_of_led;
-  out.matched = best->matched;
-  out.rms_px = rms;
-  out.position_world = camera.pose.toWorld(best->pose.t);
-  std::vector<int> used;
-  for (int i = 0; i < nl; ++i)
-    if (out.blob_of_led[static_cast<size_t>(i)] >= 0) used.push_back(i);
-  const Mat3 cov_cam = positionCovariance(Ki, best->pose, leds, o.pixel_sigma, used);
-  out.covariance_world = camera.pose.R.transpose() * cov_cam * camera.pose.R;
-  return out;
+  return finish(camera, leds, *best, o);
 }
 
 }  // namespace procam::tracking

@@ -34,10 +34,12 @@ struct ConstellationPose {
 // `leds`: LED positions in the constellation frame (>= 4, not all collinear).
 // `blobs`: blob centres in the camera's (distorted) pixels. kNotFound when no
 // hypothesis passes the gate with min_leds LEDs; kTooFewPoints for < 4 blobs or LEDs.
-Result<ConstellationPose> estimateConstellationPose(const geom::CameraModel& camera,
-                                                    std::span<const Vec3> leds,
-                                                    std::span<const Vec2> blobs,
-                                                    const ConstellationOptions& options);
+// `previous` (the last frame's pose, constellation -> camera) is tried first and kept
+// when, refined, it explains every LED or every blob; the hypothesis search runs
+// otherwise.
+Result<ConstellationPose> estimateConstellationPose(
+    const geom::CameraModel& camera, std::span<const Vec3> leds, std::span<const Vec2> blobs,
+    const ConstellationOptions& options, const std::optional<geom::Pose>& previous = std::nullopt);
 
 // First-order covariance of the constellation origin in the camera frame for a pose
 // seen with isotropic pixel noise `sigma` on every LED in `used` (all when empty):

@@ -109,6 +109,31 @@ TEST(ConstellationPose, SingleCameraMeetsTwoMillimetresWithALongLens) {
   expectWithinBudget(sq, predicted, trials);
 }
 
+TEST(ConstellationPose, PreviousPoseShortcutsTheSearch) {
+  std::mt19937_64 rng(13);
+  const geom::CameraModel cam = makeCamera(4000, Vec3::Zero(), Vec3(0, 0, 2));
+  Head h = randomHead(rng);
+  h.R = h.R * Eigen::AngleAxisd(M_PI, Vec3::UnitY()).toRotationMatrix();
+  auto first = estimateConstellationPose(cam, kLeds, observe(cam, h, 0.1, rng), {});
+  ASSERT_TRUE(first) << first.error().message;
+  // One frame later: 5 mm and 1 degree of head motion.
+  h.t += Vec3(0.004, -0.003, 0.0);
+  h.R = Eigen::AngleAxisd(0.0175, Vec3::UnitY()).toRotationMatrix() * h.R;
+  Points2 blobs = observe(cam, h, 0.1, rng);
+  std::shuffle(blobs.begin(), blobs.end(), rng);
+  auto searched = estimateConstellationPose(cam, kLeds, blobs, {});
+  auto tracked = estimateConstellationPose(cam, kLeds, blobs, {}, first->pose);
+  ASSERT_TRUE(searched && tracked);
+  EXPECT_EQ(tracked->blob_of_led, searched->blob_of_led);
+  EXPECT_LT((tracked->position_world - searched->position_world).norm(), 1e-6);
+  // A stale pose (head turned 90 degrees) falls back to the search.
+  geom::Pose stale = first->pose;
+  stale.R = Eigen::AngleAxisd(M_PI / 2, Vec3::UnitY()).toRotationMatrix() * stale.R;
+  auto recovered = estimateConstellationPose(cam, kLeds, blobs, {}, stale);
+  ASSERT_TRUE(recovered);
+  EXPECT_EQ(recovered->blob_of_led, searched->blob_of_led);
+}
+
 TEST(ConstellationPose, ExtraBlobAndMissingLedAreHandled) {
   std::mt19937_64 rng(12);
   const geom::CameraModel cam = makeCamera(4000, Vec3::Zero(), Vec3(0, 0, 2));
