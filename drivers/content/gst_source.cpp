@@ -117,10 +117,12 @@ Result<void> initGstreamer() {
 Result<std::unique_ptr<ContentSource>> openGstPipeline(const std::string& description,
                                                        const GstOptions& options) {
   if (auto ok = initGstreamer(); !ok) return tl::unexpected(ok.error());
-  const std::string launch = description +
-                             " ! videoconvert ! video/x-raw,format=RGBA"
-                             " ! appsink name=procam_sink max-buffers=4 sync=" +
-                             (options.realtime ? "true" : "false");
+  // Playback drops frames the reader did not take in time (the newest is shown);
+  // offline reading holds the decoder back instead, so that no frame is lost.
+  const std::string launch =
+      description + " ! videoconvert ! video/x-raw,format=RGBA ! appsink name=procam_sink " +
+      (options.realtime ? "sync=true max-buffers=2 drop=true"
+                        : "sync=false max-buffers=4 drop=false");
   GError* raw_error = nullptr;
   GstPtr<GstElement> pipeline(gst_parse_launch(launch.c_str(), &raw_error));
   GstPtr<GError> parse_error(raw_error);
