@@ -302,7 +302,8 @@ double estimateResponseGamma(const std::vector<cv::Mat>& frames, int white, int 
   return 0.5 * (lo + hi);
 }
 
-// Marks decoded pixels with fewer than `needed` consistent direct neighbours, and
+// Marks decoded pixels with fewer than `needed` consistent direct neighbours (two
+// per image axis along which the pixel lies on a straight line in projector space), and
 // (partial > 0) partly lit ones whose contrast is below `partial` of their
 // brightest neighbour's less `margin`; all read before any is dropped, so the
 // result does not depend on order.
@@ -312,10 +313,10 @@ void dropUnreliable(Decoded& d, const cv::Mat& white, const cv::Mat& black, floa
   const int w = d.u.cols, h = d.u.rows;
   cv::Mat drop(d.u.size(), CV_8U, cv::Scalar(0));
   cv::parallel_for_(cv::Range(0, h), [&](const cv::Range& rows) {
-    // Rows y-1, y, y+1 padded by one pixel each side: out-of-image neighbours are
+    // Rows y-2 .. y+2 padded by two pixels each side: out-of-image neighbours are
     // undecoded with zero contrast, so the inner loop has no bounds tests.
-    const int pw = w + 2;
-    std::vector<float> contrast(3 * static_cast<std::size_t>(pw)), u(contrast.size()),
+    const int pw = w + 4;
+    std::vector<float> contrast(5 * static_cast<std::size_t>(pw)), u(contrast.size()),
         v(contrast.size());
     std::vector<std::uint8_t> ok(contrast.size());
     auto load = [&](int y, int slot) {
@@ -332,29 +333,43 @@ void dropUnreliable(Decoded& d, const cv::Mat& white, const cv::Mat& black, floa
       const float* su = d.u.ptr<float>(y);
       const float* sv = d.v.ptr<float>(y);
       for (int x = 0; x < w; ++x) {
-        c[x + 1] = static_cast<float>(wh[x]) - static_cast<float>(bl[x]);
-        o[x + 1] = f[x] == 0;
-        uu[x + 1] = su[x];
-        vv[x + 1] = sv[x];
+        c[x + 2] = static_cast<float>(wh[x]) - static_cast<float>(bl[x]);
+        o[x + 2] = f[x] == 0;
+        uu[x + 2] = su[x];
+        vv[x + 2] = sv[x];
       }
     };
     for (int y = rows.start; y < rows.end; ++y) {
-      load(y - 1, 0);
-      load(y, 1);
-      load(y + 1, 2);
+      for (int k = -2; k <= 2; ++k) load(y + k, k + 2);
       std::uint8_t* out = drop.ptr<std::uint8_t>(y);
-      const float* c = contrast.data() + pw + 1;  // row y, x = 0
-      const float* uc = u.data() + pw + 1;
-      const float* vc = v.data() + pw + 1;
-      const std::uint8_t* oc = ok.data() + pw + 1;
+      const int at = 2 * pw + 2;  // row y, x = 0
+      const float* c = contrast.data() + at;
+      const float* uc = u.data() + at;
+      const float* vc = v.data() + at;
+      const std::uint8_t* oc = ok.data() + at;
+      // Three decoded pixels in a line at x + a*off, x + (a+1)*off, x + (a+2)*off whose
+      // second difference stays within the tolerance.
+      auto straight = [&](int i, int off, int a) {
+        const int p = i + a * off, q = p + off, r = q + off;
+        return oc[p] && oc[q] && oc[r] && std::abs(uc[p] + uc[r] - 2 * uc[q]) <= 2 * tol_u &&
+               std::abs(vc[p] + vc[r] - 2 * vc[q]) <= 2 * tol_v;
+      };
       for (int x = 0; x < w; ++x) {
         if (!oc[x]) continue;
         std::uint8_t flag = 0;
         if (needed > 0) {
+          // Second differences along each image axis: the first-order change between
+          // neighbours (the projector pixels one camera pixel spans, several when the
+          // camera is coarser than the projector) cancels, so the tolerance holds at
+          // any footprint while a slipped code (a Gray cell or a phase period) shows
+          // twice over (once when the pixel ends the line, at the edge of the
+          // decoded area). Each agreeing axis counts as two neighbours.
           int n = 0;
-          for (const int off : {-1, 1, -pw, pw})
-            n += oc[x + off] && std::abs(uc[x + off] - uc[x]) <= tol_u &&
-                 std::abs(vc[x + off] - vc[x]) <= tol_v;
+          for (const int off : {1, pw}) {
+            const bool centred = oc[x - off] && oc[x + off];
+            n += (centred ? straight(x, off, -1) : straight(x, off, 0) || straight(x, off, -2)) ? 2
+                                                                                                : 0;
+          }
           if (n < needed) flag |= kInconsistent;
         }
         if (partial > 0) {

@@ -40,10 +40,15 @@ struct DecodeOptions {
   // shifted frames of a pixel average to midway between its black and white);
   // 1: linear. Gray bits compare a frame with its inverse and need no linearising.
   double response_gamma = 0;
-  // A decoded pixel needs this many of its 4 direct neighbours decoded and within
+  // A decoded pixel needs this many of its 4 direct neighbours to agree with it
+  // (kInconsistent otherwise): along an image axis, the pixel and its two neighbours
+  // (or, at the edge of the decoded area, the next two inwards) must lie on a
+  // straight line in projector space, second difference within 2 *
   // neighbour_tolerance projector pixels (plus one Gray cell without phase) on both
-  // axes; an isolated decode is a noise-flipped bit, not a surface (kInconsistent).
-  // 0: off.
+  // projector axes; such an axis counts as two neighbours. The second difference
+  // cancels the projector pixels one camera pixel spans, however many, so the test
+  // holds for cameras coarser than the projector, while an isolated noise-flipped
+  // bit (a Gray cell or phase period off) still fails it. 0: off.
   int min_consistent_neighbours = 2;
   double neighbour_tolerance = 4.0;
   // Partly lit pixels (kShadow): white - black below this fraction of the largest

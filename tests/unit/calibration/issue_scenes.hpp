@@ -12,11 +12,12 @@
 
 namespace procam::testing {
 
-// corner_stereo at half resolution: projector 640x400, cameras 512x384.
-inline std::string issueCornerStereo() {
+// corner_stereo, by default at half resolution: projector 640x400, cameras 512x384.
+inline std::string issueCornerStereo(double projector_scale = 0.5, double camera_scale = 0.5) {
   std::string t = sceneText("corner_stereo");
-  const bool ok = scaleDevice(t, 1280, 800, 0.5) && scaleDevice(t, 1024, 768, 0.5) &&  // left
-                  scaleDevice(t, 1024, 768, 0.5) &&                                    // right
+  const bool ok = scaleDevice(t, 1280, 800, projector_scale) &&
+                  scaleDevice(t, 1024, 768, camera_scale) &&  // left
+                  scaleDevice(t, 1024, 768, camera_scale) &&  // right
                   edit(t, "bit_depth = 10", "bit_depth = 8") &&
                   edit(t, "read_noise_dn = 2.0", "read_noise_dn = 1.0") &&
                   edit(t, "full_well_e = 10000.0\n", "");

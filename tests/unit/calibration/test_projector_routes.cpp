@@ -3,29 +3,16 @@
 #include <algorithm>
 
 #include "calibration/projector_calibration.hpp"
+#include "route_tolerances.hpp"
 #include "synthetic_rig.hpp"
 
 using namespace procam;
 using namespace procam::calib;
+using procam::testing::expectMatches;
 using procam::testing::litPoint;
 using procam::testing::planeThrough;
 
 namespace {
-
-double rotationErrorDeg(const Mat3& a, const Mat3& b) {
-  return Eigen::AngleAxisd(a.transpose() * b).angle() * 180 / M_PI;
-}
-
-// The route (a) tolerances: focal 0.5%, principal point 2 px, position
-// 2 mm, rotation 0.05 degrees.
-void expectMatches(const ProjectorCalibration& c, const geom::CameraModel& truth) {
-  EXPECT_NEAR(c.K.fx, truth.K.fx, 0.005 * truth.K.fx);
-  EXPECT_NEAR(c.K.fy, truth.K.fy, 0.005 * truth.K.fy);
-  EXPECT_NEAR(c.K.cx, truth.K.cx, 2.0);
-  EXPECT_NEAR(c.K.cy, truth.K.cy, 2.0);
-  EXPECT_LT((c.pose.center() - truth.pose.center()).norm(), 0.002);
-  EXPECT_LT(rotationErrorDeg(c.pose.R, truth.pose.R), 0.05);
-}
 
 // Two walls meeting in a vertical corner in front of the projector, sampled every
 // `step` projector pixels, with Gaussian noise on the 3D points.
