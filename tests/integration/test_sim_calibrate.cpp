@@ -17,13 +17,14 @@ namespace procam::itest {
 namespace {
 
 // Projector 640x400 and cameras 512x384 (corner_stereo's scaled by 1/2, intrinsics
-// with them), as in tests/unit/calibration/test_rig_accuracy.cpp.
+// with them), as in tests/unit/calibration/test_rig_accuracy.cpp; with
+// projector_scale 1 the projector keeps its 1280x800.
 
-std::string sceneFile(const TempDir& dir) {
+std::string sceneFile(const TempDir& dir, double projector_scale = 0.5) {
   std::string t = procam::testing::sceneText("corner_stereo");
-  EXPECT_TRUE(procam::testing::scaleDevice(t, 1280, 800, 0.5));  // proj
-  EXPECT_TRUE(procam::testing::scaleDevice(t, 1024, 768, 0.5));  // cam_left
-  EXPECT_TRUE(procam::testing::scaleDevice(t, 1024, 768, 0.5));  // cam_right
+  EXPECT_TRUE(procam::testing::scaleDevice(t, 1280, 800, projector_scale));  // proj
+  EXPECT_TRUE(procam::testing::scaleDevice(t, 1024, 768, 0.5));              // cam_left
+  EXPECT_TRUE(procam::testing::scaleDevice(t, 1024, 768, 0.5));              // cam_right
   dir.write("corner_small.toml", t);
   return dir.file("corner_small.toml");
 }
@@ -79,6 +80,49 @@ std::string writePreviousRig(const TempDir& dir) {
                                "\n";
   dir.write("state/rig.json", previous);
   return previous;
+}
+
+// rig.json in the state directory, against the scene's truth, with the
+// structured-light issue's route (a) tolerances on corner_stereo: focal 0.5%,
+// principal point 2 px, position 2 mm, rotation 0.05 degrees, reprojection RMS
+// <= 0.15 px.
+void expectRigMatchesTruth(const TempDir& dir, const json& reply, const std::string& scene,
+                           int projector_width) {
+  const std::string path = reply["path"];
+  EXPECT_EQ(path, dir.path() + "/state/rig.json");
+  const json rig = json::parse(readFile(path));
+  ASSERT_EQ(rig["projectors"].size(), 1u);
+  const json& p = rig["projectors"][0];
+  EXPECT_EQ(p["name"], "proj");
+  EXPECT_EQ(p["width"], projector_width);
+  EXPECT_EQ(p, reply["projector"]);
+  const geom::CameraModel truth = projectorTruth(scene);
+  const double fx = p["K"][0], fy = p["K"][4], cx = p["K"][2], cy = p["K"][5];
+  EXPECT_NEAR(fx, truth.K.fx, 0.005 * truth.K.fx);
+  EXPECT_NEAR(fy, truth.K.fy, 0.005 * truth.K.fy);
+  EXPECT_NEAR(cx, truth.K.cx, 2.0);
+  EXPECT_NEAR(cy, truth.K.cy, 2.0);
+  Mat3 R;
+  for (int i = 0; i < 9; ++i) R(i / 3, i % 3) = p["R"][i];
+  const Vec3 t(p["t"][0], p["t"][1], p["t"][2]);
+  const Vec3 position = -R.transpose() * t;
+  const double position_mm = (position - truth.pose.center()).norm() * 1000;
+  const double rotation_deg = Eigen::AngleAxisd(R.transpose() * truth.pose.R).angle() * 180 / M_PI;
+  EXPECT_LT(position_mm, 2.0);
+  EXPECT_LT(rotation_deg, 0.05);
+  const double rms = reply["reprojection_rms_px"];
+  EXPECT_LE(rms, 0.15);
+  // Two walls: a mesh, written beside rig.json.
+  EXPECT_EQ(reply["surface_type"], "mesh");
+  EXPECT_EQ(rig["surface"], json({{"mesh", "surface.ply"}}));
+  EXPECT_EQ(readFile(dir.path() + "/state/surface.ply").substr(0, 4), "ply\n");
+  EXPECT_EQ(rig["cameras"].size(), 2u);
+  std::printf(
+      "[ figures  ] fx %.2f (truth %.2f, %.3f%%), fy %.2f (%.3f%%), cx %.2f (%+.2f px), "
+      "cy %.2f (%+.2f px), position %.2f mm, rotation %.4f deg, RMS %.3f px, %d nodes\n",
+      fx, truth.K.fx, 100 * (fx - truth.K.fx) / truth.K.fx, fy,
+      100 * (fy - truth.K.fy) / truth.K.fy, cx, cx - truth.K.cx, cy, cy - truth.K.cy, position_mm,
+      rotation_deg, rms, static_cast<int>(reply["triangulated"]));
 }
 
 DaemonProcess::Launch sim(const std::string& scene) {
@@ -145,50 +189,30 @@ TEST(SimCalibrate, WritesRigJsonWithTheProjectorsIntrinsics) {
   EXPECT_EQ(stages,
             (std::set<std::string>{"starting", "capturing", "decoding", "solving", "writing"}));
 
-  // rig.json in the state directory, against the scene's truth, with the
-  // structured-light issue's route (a) tolerances on corner_stereo: focal 0.5%,
-  // principal point 2 px, position 2 mm, rotation 0.05 degrees, reprojection RMS
-  // <= 0.15 px.
-  const std::string path = (*run.reply)["path"];
-  EXPECT_EQ(path, dir.path() + "/state/rig.json");
-  const json rig = json::parse(readFile(path));
-  ASSERT_EQ(rig["projectors"].size(), 1u);
-  const json& p = rig["projectors"][0];
-  EXPECT_EQ(p["name"], "proj");
-  EXPECT_EQ(p["width"], 640);
-  EXPECT_EQ(p, (*run.reply)["projector"]);
-  const geom::CameraModel truth = projectorTruth(scene);
-  const double fx = p["K"][0], fy = p["K"][4], cx = p["K"][2], cy = p["K"][5];
-  EXPECT_NEAR(fx, truth.K.fx, 0.005 * truth.K.fx);
-  EXPECT_NEAR(fy, truth.K.fy, 0.005 * truth.K.fy);
-  EXPECT_NEAR(cx, truth.K.cx, 2.0);
-  EXPECT_NEAR(cy, truth.K.cy, 2.0);
-  Mat3 R;
-  for (int i = 0; i < 9; ++i) R(i / 3, i % 3) = p["R"][i];
-  const Vec3 t(p["t"][0], p["t"][1], p["t"][2]);
-  const Vec3 position = -R.transpose() * t;
-  const double position_mm = (position - truth.pose.center()).norm() * 1000;
-  const double rotation_deg = Eigen::AngleAxisd(R.transpose() * truth.pose.R).angle() * 180 / M_PI;
-  EXPECT_LT(position_mm, 2.0);
-  EXPECT_LT(rotation_deg, 0.05);
-  const double rms = (*run.reply)["reprojection_rms_px"];
-  EXPECT_LE(rms, 0.15);
-  // Two walls: a mesh, written beside rig.json.
-  EXPECT_EQ((*run.reply)["surface_type"], "mesh");
-  EXPECT_EQ(rig["surface"], json({{"mesh", "surface.ply"}}));
-  EXPECT_EQ(readFile(dir.path() + "/state/surface.ply").substr(0, 4), "ply\n");
-  EXPECT_EQ(rig["cameras"].size(), 2u);
-  std::printf(
-      "[ figures  ] fx %.2f (truth %.2f, %.3f%%), fy %.2f (%.3f%%), cx %.2f (%+.2f px), "
-      "cy %.2f (%+.2f px), position %.2f mm, rotation %.4f deg, RMS %.3f px, %d nodes\n",
-      fx, truth.K.fx, 100 * (fx - truth.K.fx) / truth.K.fx, fy,
-      100 * (fy - truth.K.fy) / truth.K.fy, cx, cx - truth.K.cx, cy, cy - truth.K.cy, position_mm,
-      rotation_deg, rms, static_cast<int>((*run.reply)["triangulated"]));
+  expectRigMatchesTruth(dir, *run.reply, scene, 640);
 
   // The daemon is free again.
   auto status = c.call({{"cmd", "status"}});
   ASSERT_TRUE(status);
   EXPECT_EQ((*status)["operations"], json::array());
+}
+
+// The projector at its full 1280x800 with the cameras at 512x384: one camera pixel
+// spans ~3.3 projector pixels, and the same tolerances hold.
+TEST(SimCalibrate, CamerasCoarserThanTheProjector) {
+  TempDir dir;
+  const std::string scene = sceneFile(dir, 1.0);
+  DaemonProcess d(dir, sim(scene));
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  auto started = c.call(calibrateRequest(1));
+  ASSERT_TRUE(started);
+  ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
+  CalibrateRun run;
+  follow(c, 1, run);
+  ASSERT_TRUE(run.reply) << d.log();
+  ASSERT_EQ((*run.reply)["class"], "CALIBRATE") << run.reply->dump();
+  expectRigMatchesTruth(dir, *run.reply, scene, 1280);
 }
 
 TEST(SimCalibrate, CancelMidRunKeepsThePreviousRigJson) {
