@@ -1,6 +1,7 @@
 #include "structured_light/decoder.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -56,8 +57,8 @@ struct Scratch {
 };
 
 // One Gray bit of a row: the code gains the bit, plus the two smallest |pattern -
-// inverse| (normalised at the end), the weak-bit count and the range check against
-// [black, white]. Restrict-qualified parameters let the compiler vectorise.
+// inverse| (normalised at the end), the weak bits (a mask like the code) and the range check
+// against [black, white]. Restrict-qualified parameters let the compiler vectorise.
 template <class T, class W, class U>
 void accumulateBit(const T* __restrict p, const T* __restrict q, U* __restrict code,
                    U* __restrict weak, U* __restrict bad, W* __restrict min1, W* __restrict min2,
@@ -68,7 +69,7 @@ void accumulateBit(const T* __restrict p, const T* __restrict q, U* __restrict c
     const W d = static_cast<W>(pv - qv);
     const W ad = std::max(d, static_cast<W>(-d));
     code[x] = static_cast<U>((code[x] << 1) | static_cast<U>(d > 0));
-    weak[x] = static_cast<U>(weak[x] + static_cast<U>(ad < firm[x]));
+    weak[x] = static_cast<U>((weak[x] << 1) | static_cast<U>(ad < firm[x]));
     min2[x] = std::min(min2[x], std::max(min1[x], ad));
     min1[x] = std::min(min1[x], ad);
     bad[x] = static_cast<U>(bad[x] | static_cast<U>(std::max(pv, qv) > hi[x]) |
@@ -178,18 +179,33 @@ class RowDecoder {
     const double period = code.period;
     const double two_pi = 2 * std::numbers::pi;
     const float amplitude_scale = phase ? 4.0f / static_cast<float>(a.phase.size()) : 0.0f;
+    // With phase the Gray code only unwraps, and a block centre more than a cell
+    // off would unwrap to the wrong period.
+    const int max_blurred = phase ? 0 : o_.max_blurred_bits;
     for (int x = 0; x < width; ++x) {
       if (flags[x] != 0) continue;
       std::uint8_t f = 0;
-      if (static_cast<int>(s.weak[x]) > o_.max_weak_bits) f |= kLowContrast;
+      // Weak bits: the one flipping at a stripe edge, and, where a camera pixel spans
+      // more than the finest stripes, the finest bits blurred out. A run of weak
+      // bits ending at the finest (up to max_blurred_bits) leaves the code known to
+      // blocks of 2^blurred cells: the pixel decodes to its block's centre.
       if (s.bad[x]) f |= kInconsistent;
-      const std::uint32_t cell = fromGray(static_cast<std::uint32_t>(s.code[x]));
-      if (cell >= static_cast<std::uint32_t>(code.cells)) f |= kInconsistent;
+      const auto weak = static_cast<std::uint32_t>(s.weak[x]);
+      int blurred = 0;
+      if (std::popcount(weak) > o_.max_weak_bits) {
+        blurred = std::countr_one(weak);
+        if (blurred > max_blurred || blurred >= code.bits ||
+            std::popcount(weak >> blurred) > o_.max_weak_bits)
+          f |= kLowContrast;
+      }
+      const std::uint32_t cell = fromGray(static_cast<std::uint32_t>(s.code[x]) >> blurred);
+      const int block = code.cell << blurred;
+      if (cell >= static_cast<std::uint32_t>((code.extent + block - 1) / block)) f |= kInconsistent;
       float conf = code.bits >= 2   ? static_cast<float>(s.min2[x]) * s.inv_contrast[x]
                    : code.bits == 1 ? static_cast<float>(s.min1[x]) * s.inv_contrast[x]
                                     : 1.0f;
-      const int first = static_cast<int>(cell) * code.cell;
-      const int width_of_cell = std::min(code.cell, code.extent - first);
+      const int first = static_cast<int>(cell) * block;
+      const int width_of_cell = std::min(block, code.extent - first);
       double position = first + (width_of_cell - 1) * 0.5;
       if (phase && f == 0) {
         // N-step phase: sum I_n cos(theta - delta_n) sin/cos(delta_n) = N/2 sin/cos(theta).

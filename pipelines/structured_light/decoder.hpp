@@ -24,9 +24,14 @@ enum DecodeFlag : std::uint8_t {
 
 struct DecodeOptions {
   // Thresholds as fractions of the capture's full scale (255 or 65535 unless set).
-  double min_contrast = 0.03;     // white - black
-  double bit_contrast = 0.12;     // |pattern - inverse| / (white - black) for a firm bit
-  int max_weak_bits = 1;          // per axis; the bit flipping at a stripe edge is weak
+  double min_contrast = 0.03;  // white - black
+  double bit_contrast = 0.12;  // |pattern - inverse| / (white - black) for a firm bit
+  int max_weak_bits = 1;       // per axis; the bit flipping at a stripe edge is weak
+  // Finest Gray bits that may all be weak (blurred out where one camera pixel spans
+  // more than their stripes), plus max_weak_bits above them: the pixel then decodes
+  // to the centre of its block of 2^n cells. Gray-only sets (with phase the Gray
+  // code only unwraps and needs every bit). 0: none.
+  int max_blurred_bits = 4;
   double range_tolerance = 0.15;  // pattern may exceed [black, white] by this * (white - black)
   double saturation = 0.995;      // clipped at or above this fraction of full scale
   double min_modulation = 0.15;   // phase amplitude / ((white - black) / 2)
