@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -39,9 +40,14 @@ std::optional<Child> Child::start(const std::vector<std::string>& argv, const st
                                   bool pipe_stdout) {
   int fds[2] = {-1, -1};
   if (pipe_stdout && ::pipe2(fds, O_CLOEXEC) != 0) return std::nullopt;
+  const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
   if (pid < 0) return std::nullopt;
   if (pid == 0) {
+    // The demo's daemon and clients must not outlive the demo, however it ends (a closed
+    // pipe or a signal skips the destructors that would stop them).
+    ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (::getppid() != parent) ::_exit(127);  // the parent is already gone
     if (!log_file.empty()) {
       const int log = ::open(log_file.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
       if (log >= 0) {
