@@ -4,7 +4,10 @@
 
 #include <cmath>
 #include <ctime>
+#include <mutex>
+#include <set>
 #include <thread>
+#include <vector>
 
 namespace procam::camera {
 namespace {
@@ -31,6 +34,48 @@ std::optional<SourceFormat> sourceOf(ArvPixelFormat f) {
     default:
       return std::nullopt;
   }
+}
+
+// Releases of gone cameras run off the caller's thread (each waits out Aravis' register
+// timeouts, about 10 s). The threads are joined when this object is destroyed: at exit
+// for procamd, or when a module holding the driver is unloaded, so no release outlives
+// the code it runs.
+class DeadCameraReleaser {
+ public:
+  ~DeadCameraReleaser() {
+    std::vector<std::thread> threads;
+    {
+      std::lock_guard lock(mutex_);
+      threads.swap(threads_);
+    }
+    for (auto& t : threads) t.join();
+  }
+  void release(ArvStream* stream, ArvCamera* camera) {
+    std::lock_guard lock(mutex_);
+    // Finished releases are joined here so the list stays short.
+    std::erase_if(threads_, [this](std::thread& t) {
+      if (!done_.contains(t.get_id())) return false;
+      done_.erase(t.get_id());
+      t.join();
+      return true;
+    });
+    threads_.emplace_back([this, stream, camera] {
+      if (stream) g_object_unref(stream);
+      g_object_unref(camera);
+      std::lock_guard done_lock(mutex_);
+      done_.insert(std::this_thread::get_id());
+    });
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::thread> threads_;
+  std::set<std::thread::id> done_;
+};
+
+DeadCameraReleaser& deadCameraReleaser() {
+  static DeadCameraReleaser releaser;
+  return releaser;
 }
 
 uint32_t bytesPerPixel(SourceFormat f) {
@@ -159,10 +204,7 @@ void AravisCamera::stop() {
   if (lost_ && camera_) {
     // Releasing a gone GigE camera waits out Aravis' register timeouts (about 10 s here);
     // the daemon closes lost devices on its loop thread, so let that happen elsewhere.
-    std::thread([stream = stream_, camera = camera_] {
-      if (stream) g_object_unref(stream);
-      g_object_unref(camera);
-    }).detach();
+    deadCameraReleaser().release(stream_, camera_);
     stream_ = nullptr;
     camera_ = nullptr;
   }
