@@ -45,9 +45,10 @@ class Recording {
     std::normal_distribution<double> n(0, 0.1);
     const geom::CameraModel cam = capCamera();
     for (int k = 0; k < frames; ++k) {
-      cv::Mat img(cam.height, cam.width, CV_8UC1, cv::Scalar(0));
+      Points2 centres;
       for (size_t i = 0; leds && i < kCapLeds.size(); ++i)
-        spot(img, *cam.project(headAt(k * kFrame).led(i)) + Vec2(n(rng), n(rng)));
+        centres.push_back(*cam.project(headAt(k * kFrame).led(i)) + Vec2(n(rng), n(rng)));
+      const cv::Mat img = tracking::synthetic::renderSpots(cam.width, cam.height, centres);
       const std::string name = "f" + std::to_string(k) + ".png";
       cv::imwrite((dir_ / name).string(), img, {cv::IMWRITE_PNG_COMPRESSION, 1});
       char stamp[32];
@@ -59,15 +60,6 @@ class Recording {
   std::string dir() const { return dir_.string(); }
 
  private:
-  static void spot(cv::Mat& img, const Vec2& c) {
-    const int x0 = static_cast<int>(std::round(c.x())), y0 = static_cast<int>(std::round(c.y()));
-    for (int y = y0 - 6; y <= y0 + 6; ++y)
-      for (int x = x0 - 6; x <= x0 + 6; ++x) {
-        const double r2 = (x - c.x()) * (x - c.x()) + (y - c.y()) * (y - c.y());
-        const double v = img.at<uint8_t>(y, x) + 200 * std::exp(-r2 / (2 * 1.5 * 1.5));
-        img.at<uint8_t>(y, x) = static_cast<uint8_t>(std::min(255.0, std::round(v)));
-      }
-  }
   static inline int counter_ = 0;
   fs::path dir_;
 };

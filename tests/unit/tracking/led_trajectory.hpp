@@ -4,8 +4,10 @@
 // Camera f = 4000 px on a 1280x1024 sensor: positionCovariance's bound for this layout
 // at 2 m with 0.1 px blob noise is below 1.5 mm there, and above 2 mm at f = 1000 px
 // (see tests/unit/tracking/test_constellation_pose.cpp).
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <opencv2/core/mat.hpp>
 #include <span>
 #include <vector>
 
@@ -45,6 +47,22 @@ inline HeadPose headAt(double t) {
                      .toRotationMatrix();
   return HeadPose{R,
                   Vec3(0.1 * std::sin(kTwoPi * 0.5 * t), 0.03 * std::sin(kTwoPi * 0.3 * t), 2.0)};
+}
+
+// A gray8 IR frame: black, with a Gaussian spot (sigma 1.5 px, peak 200 DN, pixel
+// centres at integers) at each centre.
+inline cv::Mat renderSpots(int width, int height, const Points2& centres) {
+  cv::Mat img(height, width, CV_8UC1, cv::Scalar(0));
+  for (const Vec2& c : centres) {
+    const int x0 = static_cast<int>(std::round(c.x())), y0 = static_cast<int>(std::round(c.y()));
+    for (int y = std::max(0, y0 - 6); y <= std::min(height - 1, y0 + 6); ++y)
+      for (int x = std::max(0, x0 - 6); x <= std::min(width - 1, x0 + 6); ++x) {
+        const double r2 = (x - c.x()) * (x - c.x()) + (y - c.y()) * (y - c.y());
+        const double v = img.at<uint8_t>(y, x) + 200 * std::exp(-r2 / (2 * 1.5 * 1.5));
+        img.at<uint8_t>(y, x) = static_cast<uint8_t>(std::min(255.0, std::round(v)));
+      }
+  }
+  return img;
 }
 
 // Time shift s (s, grid of 0.1 ms within +-0.1 s) minimising sum |x_i - truth(t_i - s)|^2
