@@ -7,6 +7,7 @@ extern "C" const procam_plugin_table* procam_tracker_plugin_entry(void) {
   // Built on first call: the factories live in other translation units.
   static const procam_driver_factory factories[] = {
       kIrCameraFactory,
+      kHidFactory,
   };
   static const procam_plugin_table table = {PROCAM_PLUGIN_ABI_VERSION, "tracker", "1",
                                             sizeof(factories) / sizeof(factories[0]), factories};

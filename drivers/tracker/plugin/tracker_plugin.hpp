@@ -10,6 +10,7 @@
 namespace procam::tracker::plugin {
 
 extern const procam_driver_factory kIrCameraFactory;
+extern const procam_driver_factory kHidFactory;  // Wii Remote IR camera (hid_plugin.hpp)
 
 // The last frame's full result (raw, filtered, predicted) of a device made by the
 // ir_camera driver; nullptr before its first pose.
