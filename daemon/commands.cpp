@@ -51,6 +51,7 @@ void Daemon::handle(ClientId client, const proto::Request& req) {
       {"keystone", &Daemon::cmdKeystone},   {"pattern", &Daemon::cmdPattern},
       {"content", &Daemon::cmdContent},     {"save", &Daemon::cmdSave},
       {"reload", &Daemon::cmdReload},       {"log-level", &Daemon::cmdLogLevel},
+      {"tracker", &Daemon::cmdTracker},
   };
   for (const auto& [name, fn] : kCommands) {
     if (req.cmd == name) {
@@ -98,6 +99,7 @@ json Daemon::statusJson() const {
           {"operations", ops},
           {"log_level", logLevelName(logLevel())},
           {"outputs", outputsJson()},
+          {"viewer", viewerJson()},
           {"capabilities", {{"calibrate", true}, {"auto_keystone", true}, {"render", true}}},
           {"warnings", warnings_}};
 }
@@ -112,7 +114,11 @@ void Daemon::cmdDevices(ClientId client, const proto::Request& req) {
   RequestArgs args(req.body);
   PROCAM_CHECK_KEYS(args, "");
   json list = json::array();
-  for (const auto& e : devices_.entries()) list.push_back(e.toJson());
+  for (const auto& e : devices_.entries()) {
+    json entry = e.toJson();
+    addReadingStats(e, entry);  // frames or samples, rate_hz, last_timestamp
+    list.push_back(std::move(entry));
+  }
   json drivers = json::array();
   for (const auto& d : registry_.drivers()) {
     drivers.push_back(

@@ -131,6 +131,7 @@ Result<void> Daemon::setup() {
       [this](ClientId c) { onDisconnect(c); });
   if (auto ok = server_->start(); !ok) return ok;
   setupAutoKeystone();
+  setupTrackers();
   loadContentAtStart();
   refreshOutputs();
 

@@ -20,6 +20,7 @@
 #include "registry.hpp"
 #include "settings.hpp"
 #include "state_file.hpp"
+#include "tracker_state.hpp"
 #include "worker_pool.hpp"
 
 namespace procam::daemon {
@@ -108,6 +109,14 @@ class Daemon {
   void loadContentAtStart();
   nlohmann::json outputsJson() const;
   Result<void> reloadConfig();
+  // daemon_tracker.cpp: trackers read at their rate, registrations, camera frame counts.
+  void setupTrackers();
+  void syncTrackerPolls();
+  void onTrackerSample(const std::string& name, const procam_pose_sample& sample);
+  void cmdTracker(ClientId, const proto::Request&);
+  nlohmann::json trackersJson() const;
+  nlohmann::json viewerJson() const;
+  void addReadingStats(const DeviceEntry& entry, nlohmann::json& json) const;
 
   struct Operation {
     std::string kind;
@@ -149,6 +158,7 @@ class Daemon {
   };
   std::optional<LiveContent> live_content_;  // set by `content share` / `stream`
   KeystoneRuntime keystone_rt_;
+  TrackerRuntime trackers_;
   // Destroyed in reverse order: server and workers before the loop they use.
   std::unique_ptr<EventLoop> loop_;
   std::unique_ptr<WorkerPool> io_worker_;       // state writes (fsync)

@@ -63,6 +63,9 @@ void DeviceManager::onDeviceRemoved(DeviceCallback callback) {
 void DeviceManager::onReading(ReadingCallback callback) {
   on_reading_.push_back(std::move(callback));
 }
+void DeviceManager::setReadGate(std::function<bool(const std::string&)> may_read) {
+  may_read_ = std::move(may_read);
+}
 
 // --- start-up and hotplug ---
 
@@ -338,6 +341,11 @@ bool DeviceManager::readEntry(const std::string& name) {
     unwatchFd(name);
     return false;
   }
+  if (!gateOpen(name)) {
+    if (watched_.count(name)) gated_.insert(name);
+    unwatchFd(name);
+    return false;
+  }
   const procam_device& raw = e->device.raw();
   std::array<char, 256> err{};
   int rc = PROCAM_ENOTSUP;
@@ -386,16 +394,43 @@ void DeviceManager::stopPolling(int id) {
 }
 
 void DeviceManager::presenceCheck() {
-  std::vector<std::string> names;
+  for (auto it = gated_.begin(); it != gated_.end();) {
+    const DeviceEntry* e = devices_.find(*it);
+    if (e && !gateOpen(*it)) {
+      ++it;
+      continue;
+    }
+    if (e) watchFd(*e);
+    it = gated_.erase(it);
+  }
+  std::vector<std::string> names, cameras;
   for (const auto& e : devices_.entries()) {
     const auto family = e.description.family;
-    if (!e.usable() || (family != PROCAM_FAMILY_TILT && family != PROCAM_FAMILY_TRACKER)) continue;
-    if (watched_.count(e.name)) continue;
+    if (!e.usable() || family == PROCAM_FAMILY_OUTPUT || watched_.count(e.name) ||
+        gated_.count(e.name)) {
+      continue;
+    }
+    if (family == PROCAM_FAMILY_CAMERA) {
+      cameras.push_back(e.name);
+      continue;
+    }
     bool polled = false;
     for (const auto& [id, n] : polls_) polled = polled || n == e.name;
     if (!polled) names.push_back(e.name);
   }
   for (const auto& n : names) readEntry(n);
+  for (const auto& n : cameras) checkCameraPresence(n);
+}
+
+void DeviceManager::checkCameraPresence(const std::string& name) {
+  DeviceEntry* e = devices_.find(name);
+  if (!e || !e->usable() || !gateOpen(name)) return;
+  const procam_device& raw = e->device.raw();
+  uint32_t w = 0, h = 0;
+  procam_pixel_format format{};
+  if (int rc = raw.ops.camera->get_format(raw.self, &w, &h, &format); rc == PROCAM_ENODEV) {
+    report(name, rc, "the camera is gone (no format)");
+  }
 }
 
 void DeviceManager::added(const std::string& name) {

@@ -35,7 +35,9 @@ struct DeviceManagerOptions {
   // devices are the whole rig).
   bool udev = true;
   // Tilt sensors and trackers without a poll fd that nobody polls are read
-  // this often, so that a device gone without a udev event is noticed.
+  // this often, so that a device gone without a udev event is noticed;
+  // cameras without one are asked for their format (rendering or grabbing a
+  // frame each second would cost too much).
   std::chrono::milliseconds presence_interval{1000};
 };
 
@@ -71,6 +73,12 @@ class DeviceManager {
   // Every sample or frame the manager reads: on a readable device fd, from
   // pollEvery() and from the presence reads.
   void onReading(ReadingCallback callback);
+  // Devices an operation uses on its own thread (calibrate's cameras) must not
+  // be read by the manager meanwhile: while `may_read(name)` is false the
+  // device is neither read nor presence-checked, and its fd is left out of
+  // the loop (readable, it would wake the loop forever) until the next
+  // presence check finds the gate open again.
+  void setReadGate(std::function<bool(const std::string& name)> may_read);
 
   // Reads a tilt sensor, tracker or camera (capture with timeout 0) once and
   // hands the reading to the onReading hooks; false when nothing was read.
@@ -103,6 +111,8 @@ class DeviceManager {
   void watchFd(const DeviceEntry& entry);
   void unwatchFd(const std::string& name);
   bool readEntry(const std::string& name);
+  bool gateOpen(const std::string& name) const { return !may_read_ || may_read_(name); }
+  void checkCameraPresence(const std::string& name);
   void presenceCheck();
   void added(const std::string& name);
   void removed(const std::string& name);
@@ -116,11 +126,13 @@ class DeviceManager {
   WarnSink warn_;
   std::vector<DeviceCallback> on_added_, on_removed_;
   std::vector<ReadingCallback> on_reading_;
+  std::function<bool(const std::string&)> may_read_;
 
   std::unique_ptr<Udev> udev_;
   std::unique_ptr<UdevMonitor> monitor_;
   std::map<std::string, int> watched_;  // device name -> its poll fd in the loop
   std::map<int, std::string> polls_;    // pollEvery timer id -> device name
+  std::set<std::string> gated_;         // fds taken out of the loop by the read gate
   std::set<std::string> pending_;       // syspaths being opened on the worker
   struct Retry {
     uint64_t token = 0;

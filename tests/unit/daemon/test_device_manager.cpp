@@ -261,6 +261,28 @@ TEST_F(ManagerTest, PollEveryReadsATimerPolledDevice) {
   EXPECT_FALSE(manager_->pollEvery("nothing", 10ms));
 }
 
+TEST_F(ManagerTest, ClosedReadGateKeepsTheManagerOffADeviceUntilItOpens) {
+  devices_.open(registry_, *describeUdevDevice(iioTilt()), "", {{"fd", "pipe"}});
+  bool may_read = false;  // as while calibrate captures from the device on a worker
+  manager_->setReadGate([&](const std::string&) { return may_read; });
+  startWithoutUdev(20ms);
+  std::vector<double> got;
+  manager_->onReading([&](const DeviceEntry&, const Reading& r) {
+    got.push_back(std::get<procam_tilt_sample>(r).specific_force[0]);
+  });
+  const int wfd =
+      static_cast<fake::Tilt*>(devices_.find("iio:device0")->device.raw().self)->pipe[1];
+  const char samples[] = {4, 5};
+  ASSERT_EQ(::write(wfd, samples, 2), 2);
+  // Readable all along, yet nothing is read (the first wake-up takes the fd out).
+  EXPECT_FALSE(runUntil([&] { return !got.empty(); }, 200ms));
+  EXPECT_FALSE(manager_->read("iio:device0"));
+  // Open again: the next presence check puts the fd back and the samples come.
+  may_read = true;
+  ASSERT_TRUE(runUntil([&] { return got.size() == 2; }));
+  EXPECT_EQ(got, (std::vector<double>{4, 5}));
+}
+
 TEST_F(ManagerTest, LostDeviceIsClosedAndReopenedAfterBackOff) {
   devices_.open(registry_, *describeUdevDevice(iioTilt()), "", {});
   startWithoutUdev(20ms);
