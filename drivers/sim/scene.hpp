@@ -52,6 +52,7 @@ struct CameraSpec {
   int channels = 1;             // 1 (luminance) or 3 (BGR, OpenCV order)
   int supersamples = 4;         // n*n stratified samples per pixel, n >= 2
   double psf_sigma_px = 0.0;    // lens blur: Gaussian point spread, camera pixels
+  double latency_s = 0.0;  // display-to-capture: a frame at t sees the outputs of t - latency_s
   int maxDn() const { return (1 << bit_depth) - 1; }
   double electronsPerDn() const { return full_well_e / maxDn(); }  // at gain 1
 };

@@ -174,6 +174,7 @@ class Reader {
     s.channels = f.integerIn("channels", 1, 1, 3);
     if (s.channels == 2) f.error("channels", "must be 1 or 3");
     s.psf_sigma_px = f.numberIn("psf_sigma_px", 0, 0, 20);
+    s.latency_s = f.numberIn("latency_s", 0, 0, 10);
     s.supersamples = f.integerIn("supersamples", 4, 4, 256);
     const int n = static_cast<int>(std::lround(std::sqrt(s.supersamples)));
     if (n * n != s.supersamples) f.error("supersamples", "must be a square number (4, 9, 16, ...)");

@@ -155,7 +155,12 @@ int cameraCapture(void* self, int, procam_image* out, char* err, size_t len) {
   try {
     const double t = dev->world->now();
     const Scene& scene = dev->world->scene();
-    auto renderer = Renderer::create(scene, scene.at(t), dev->world->shown());
+    const CameraSpec* spec = cameraSpec(dev);
+    if (!spec) return report(err, len, "camera gone", PROCAM_ENODEV);
+    // The outputs as they were latency_s ago (SCENE-FORMAT.md, mock drivers).
+    const Framebuffers shown =
+        spec->latency_s > 0 ? dev->world->shownAt(t - spec->latency_s) : dev->world->shown();
+    auto renderer = Renderer::create(scene, scene.at(t), shown);
     if (!renderer) return report(err, len, renderer.error().message, PROCAM_EIO);
     auto image = renderer->renderCamera(dev->name);
     if (!image) return report(err, len, image.error().message, PROCAM_EIO);
@@ -170,7 +175,7 @@ int cameraCapture(void* self, int, procam_image* out, char* err, size_t len) {
                   : m.depth() == CV_16U ? PROCAM_PIXEL_GRAY16
                                         : PROCAM_PIXEL_GRAY8;
     out->data = dev->buffer.data();
-    out->timestamp_ns = static_cast<uint64_t>(t * 1e9);
+    out->timestamp_ns = dev->world->monotonicNs(t);  // the ABI's clock
   } catch (const std::exception& e) {
     return report(err, len, e.what(), PROCAM_EINTERNAL);
   }

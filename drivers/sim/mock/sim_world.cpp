@@ -1,10 +1,17 @@
 #include "sim_world.hpp"
 
+#include <algorithm>
 #include <map>
 
 #include "sim/scene_library.hpp"
 
 namespace procam::sim::mock {
+
+namespace {
+// Slack over the largest latency: a capture reads the clock before it looks up
+// the frames, and a show may come in between.
+constexpr double kHistorySlackS = 0.25;
+}  // namespace
 
 Result<std::shared_ptr<SimWorld>> SimWorld::open(const std::string& scene) {
   static std::mutex registry_mutex;
@@ -18,18 +25,58 @@ Result<std::shared_ptr<SimWorld>> SimWorld::open(const std::string& scene) {
   return world;
 }
 
+SimWorld::SimWorld(Scene scene) : scene_(std::move(scene)) {
+  double latency = 0;
+  for (const auto& c : scene_.cameras()) latency = std::max(latency, c.latency_s);
+  keep_s_ = latency > 0 ? latency + kHistorySlackS : 0;
+}
+
 double SimWorld::now() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - epoch_).count();
 }
 
+uint64_t SimWorld::monotonicNs(double world_time) const {
+  const auto at = epoch_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                               std::chrono::duration<double>(world_time));
+  return static_cast<uint64_t>(
+      std::chrono::duration_cast<std::chrono::nanoseconds>(at.time_since_epoch()).count());
+}
+
 void SimWorld::show(const std::string& projector, cv::Mat framebuffer) {
+  const double t = now();
   std::lock_guard lock(mutex_);
-  shown_[projector] = std::move(framebuffer);
+  History& h = history_[projector];
+  h.frames.push_back({t, std::move(framebuffer)});
+  // Keep the frame that was on at t - keep_s_ (the one before the first younger
+  // than that), and no more than kMaxKeptFrames.
+  while (h.frames.size() > 1 &&
+         (h.frames[1].time <= t - keep_s_ || h.frames.size() > kMaxKeptFrames)) {
+    h.frames.pop_front();
+    h.trimmed = true;
+  }
 }
 
 Framebuffers SimWorld::shown() const {
   std::lock_guard lock(mutex_);
-  return shown_;
+  Framebuffers out;
+  for (const auto& [name, h] : history_) out[name] = h.frames.back().frame;
+  return out;
+}
+
+Framebuffers SimWorld::shownAt(double t) const {
+  std::lock_guard lock(mutex_);
+  Framebuffers out;
+  for (const auto& [name, h] : history_) {
+    // The last frame shown at or before t.
+    auto after = std::upper_bound(h.frames.begin(), h.frames.end(), t,
+                                  [](double time, const Shown& s) { return time < s.time; });
+    if (after != h.frames.begin()) {
+      out[name] = std::prev(after)->frame;
+    } else if (h.trimmed) {
+      out[name] = h.frames.front().frame;  // before the kept history
+    }
+  }
+  return out;
 }
 
 }  // namespace procam::sim::mock

@@ -1,8 +1,13 @@
 #pragma once
 // The one virtual world the mock drivers of a process share: every mock
 // device opened on the same scene sees the frames the mock outputs show, on a
-// common clock (seconds since the world was first opened).
+// common clock (seconds since the world was first opened). Shown frames are kept
+// with their show times for cameras with a display-to-capture latency
+// (CameraSpec::latency_s).
 #include <chrono>
+#include <cstdint>
+#include <deque>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -15,22 +20,41 @@ namespace procam::sim::mock {
 
 class SimWorld {
  public:
+  // At most this many frames are kept per projector, however fast they are shown.
+  static constexpr std::size_t kMaxKeptFrames = 64;
+
   // The world of a scene (a shipped scene's name or a file), created on first use.
   static Result<std::shared_ptr<SimWorld>> open(const std::string& scene);
 
   const Scene& scene() const { return scene_; }
   double now() const;
+  // A world time on CLOCK_MONOTONIC (ns), the camera frames' clock.
+  uint64_t monotonicNs(double world_time) const;
 
+  // Shows `framebuffer` on `projector` from now on.
   void show(const std::string& projector, cv::Mat framebuffer);
+  // What the projectors show now.
   Framebuffers shown() const;
+  // What they showed at world time `t` (a projector that had shown nothing yet is
+  // absent); older than the kept history: the oldest frame kept.
+  Framebuffers shownAt(double t) const;
 
-  explicit SimWorld(Scene scene) : scene_(std::move(scene)) {}
+  explicit SimWorld(Scene scene);
 
  private:
+  struct Shown {
+    double time;
+    cv::Mat frame;
+  };
   Scene scene_;
+  double keep_s_ = 0;  // history length: the largest camera latency, plus slack
   std::chrono::steady_clock::time_point epoch_ = std::chrono::steady_clock::now();
   mutable std::mutex mutex_;
-  Framebuffers shown_;
+  struct History {
+    std::deque<Shown> frames;  // oldest first
+    bool trimmed = false;      // frames were dropped from its front
+  };
+  std::map<std::string, History, std::less<>> history_;
 };
 
 }  // namespace procam::sim::mock

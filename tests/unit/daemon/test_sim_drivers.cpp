@@ -1,24 +1,50 @@
 // The virtual rig's mock drivers through the plugin ABI: the tilt sensor
-// reports gravity, the camera sees what the mock projector shows.
+// reports gravity, the camera sees what the mock projector shows (after the
+// camera's latency).
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <chrono>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <numeric>
+#include <thread>
 
 #include "loader.hpp"
 #include "registry.hpp"
+#include "sim/embedded_scenes.hpp"
 #include "sim_plugin.hpp"
+#include "sim_world.hpp"
 
 namespace procam::plugins {
 namespace {
 
-DeviceDescription simDevice(procam_family family, const char* name) {
+DeviceDescription simDevice(procam_family family, const char* name,
+                            const std::string& scene = "handheld") {
   DeviceDescription d;
   d.family = family;
   d.subsystem = "sim";
   d.name = name;
-  d.properties = {{"SIM_SCENE", "handheld"}, {"SIM_DEVICE", name}};
+  d.properties = {{"SIM_SCENE", scene}, {"SIM_DEVICE", name}};
   return d;
+}
+
+// handheld.toml with a display-to-capture latency on its camera.
+std::string handheldWithLatency(double latency_s) {
+  std::string text;
+  for (std::size_t i = 0; i < sim::detail::kEmbeddedSceneCount; ++i) {
+    if (sim::detail::kEmbeddedScenes[i].name == "handheld") {
+      text = std::string(sim::detail::kEmbeddedScenes[i].text);
+    }
+  }
+  const std::string camera = "[[cameras]]\n";
+  const std::size_t at = text.find(camera);
+  EXPECT_NE(at, std::string::npos);
+  if (at != std::string::npos) {
+    text.insert(at + camera.size(), "latency_s = " + std::to_string(latency_s) + "\n");
+  }
+  return text;
 }
 
 DriverRegistry simRegistry() {
@@ -85,6 +111,90 @@ TEST(SimDrivers, UnknownDeviceIsRefusedWithTheSceneName) {
   ASSERT_FALSE(dev);
   EXPECT_NE(dev.error().message.find("has no such device 'gyro'"), std::string::npos)
       << dev.error().message;
+}
+
+TEST(SimDrivers, WorldGivesTheFramesShownAtATime) {
+  auto scene = sim::Scene::parse(handheldWithLatency(0.3), "handheld+latency", {});
+  ASSERT_TRUE(scene) << scene.error().message;
+  ASSERT_EQ(scene->cameras().at(0).latency_s, 0.3);
+  sim::mock::SimWorld world(std::move(*scene));
+  auto frame = [](int v) { return cv::Mat(2, 2, CV_8UC1, cv::Scalar(v)); };
+  auto valueAt = [&](double t) {
+    auto shown = world.shownAt(t);
+    return shown.count("proj") ? int(shown.at("proj").at<uint8_t>(0, 0)) : -1;
+  };
+  const double before = world.now();
+  std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  world.show("proj", frame(1));
+  const double t1 = world.now();
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  world.show("proj", frame(2));
+  const double t2 = world.now();
+  EXPECT_EQ(valueAt(before), -1);  // nothing shown yet
+  EXPECT_EQ(valueAt(t1), 1);
+  EXPECT_EQ(valueAt(t2), 2);
+  EXPECT_EQ(int(world.shown().at("proj").at<uint8_t>(0, 0)), 2);
+  // Shown faster than the history lasts: the frame cap bounds it, and earlier
+  // times get the oldest frame kept.
+  for (int i = 3; i < 103; ++i) world.show("proj", frame(i));
+  EXPECT_EQ(valueAt(t1), 103 - int(sim::mock::SimWorld::kMaxKeptFrames));
+  EXPECT_EQ(valueAt(world.now()), 102);
+  // Frames older than the largest latency (0.3 s + 0.25 s slack) are dropped,
+  // except the one that was on then.
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));
+  world.show("proj", frame(200));
+  EXPECT_EQ(valueAt(t2), 102);
+  EXPECT_EQ(valueAt(world.now()), 200);
+}
+
+TEST(SimDrivers, CameraSeesTheOutputAfterItsLatency) {
+  // A scene file of this test: the world registry keys worlds by scene.
+  const auto file = std::filesystem::temp_directory_path() /
+                    ("procam_latency_" + std::to_string(::getpid()) + ".toml");
+  {
+    std::ofstream out(file);
+    out << handheldWithLatency(0.3);
+  }
+  auto r = simRegistry();
+  Device out = open(r, simDevice(PROCAM_FAMILY_OUTPUT, "proj", file.string()));
+  Device cam = open(r, simDevice(PROCAM_FAMILY_CAMERA, "cam", file.string()));
+  std::filesystem::remove(file);
+  uint32_t w = 0, h = 0;
+  double hz = 0;
+  ASSERT_EQ(out.raw().ops.output->get_mode(out.raw().self, &w, &h, &hz), PROCAM_OK);
+  auto show = [&](uint8_t level) {
+    std::vector<uint8_t> px(static_cast<size_t>(w) * h * 3, level);
+    procam_image frame{w, h, w * 3, PROCAM_PIXEL_RGB8, px.data(), 0};
+    char err[256] = {};
+    EXPECT_EQ(out.raw().ops.output->show(out.raw().self, &frame, err, sizeof err), PROCAM_OK)
+        << err;
+  };
+  auto mean = [&] {
+    const auto called = std::chrono::steady_clock::now();
+    procam_image img{};
+    char err[256] = {};
+    EXPECT_EQ(cam.raw().ops.camera->capture(cam.raw().self, 1000, &img, err, sizeof err), PROCAM_OK)
+        << err;
+    // Timestamps on CLOCK_MONOTONIC (steady_clock), within the call.
+    const auto ns = [](std::chrono::steady_clock::time_point t) {
+      return static_cast<uint64_t>(
+          std::chrono::duration_cast<std::chrono::nanoseconds>(t.time_since_epoch()).count());
+    };
+    EXPECT_GE(img.timestamp_ns + 1000, ns(called));
+    EXPECT_LE(img.timestamp_ns, ns(std::chrono::steady_clock::now()));
+    const size_t n = static_cast<size_t>(img.stride) * img.height;
+    return std::accumulate(img.data, img.data + n, 0.0) / static_cast<double>(n);
+  };
+  show(0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(350));
+  const double black = mean();
+  show(255);
+  const double still_black = mean();  // captured within 0.3 s of the switch
+  std::this_thread::sleep_for(std::chrono::milliseconds(350));
+  const double white = mean();
+  EXPECT_GT(white, black + 10.0) << "black " << black << " white " << white;
+  // The same black frame, up to the camera's noise (1 DN read noise, shot noise).
+  EXPECT_NEAR(still_black, black, 2.0);
 }
 
 }  // namespace
