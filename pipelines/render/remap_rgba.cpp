@@ -2,7 +2,9 @@
 
 #include <cstring>
 
-#if defined(__SSE2__)
+#include "render/bilinear_avx2.hpp"
+
+#if defined(__x86_64__)
 #include <emmintrin.h>
 #endif
 
@@ -28,11 +30,9 @@ inline uint32_t loadPixel(const uint8_t* p) {
   return v;
 }
 
-void rowScalar(const uint8_t* src, size_t src_step, const PackedMap& m, size_t k0, int width,
-               uint8_t* out) {
+void rowScalar(const uint8_t* src, size_t src_step, const PackedRow& row, int width, uint8_t* out) {
   for (int x = 0; x < width; ++x) {
-    const size_t k = k0 + x;
-    const int32_t off = m.offset[k];
+    const int32_t off = row.offset[x];
     uint8_t* o = out + 4 * x;
     if (off < 0) {
       std::memset(o, 0, 4);
@@ -40,7 +40,7 @@ void rowScalar(const uint8_t* src, size_t src_step, const PackedMap& m, size_t k
     }
     const uint8_t* p0 = src + off;
     const uint8_t* p1 = p0 + src_step;
-    const Weights w = weights(m.fx[k], m.fy[k]);
+    const Weights w = weights(row.fx[x], row.fy[x]);
     for (int c = 0; c < 4; ++c) {
       const int v = p0[c] * w.w00 + p0[4 + c] * w.w01 + p1[c] * w.w10 + p1[4 + c] * w.w11;
       o[c] = static_cast<uint8_t>((v + kRound) >> kShift);
@@ -48,16 +48,12 @@ void rowScalar(const uint8_t* src, size_t src_step, const PackedMap& m, size_t k
   }
 }
 
-#if defined(__SSE2__)
-void rowSse2(const uint8_t* src, size_t src_step, const PackedMap& m, size_t k0, int width,
-             uint8_t* out) {
+#if defined(__x86_64__)
+void rowSse2(const uint8_t* src, size_t src_step, const PackedRow& row, int width, uint8_t* out) {
   const __m128i zero = _mm_setzero_si128();
   const __m128i round = _mm_set1_epi32(kRound);
-  const int32_t* offsets = m.offset.data() + k0;
-  const uint8_t* fxs = m.fx.data() + k0;
-  const uint8_t* fys = m.fy.data() + k0;
   for (int x = 0; x < width; ++x) {
-    const int32_t off = offsets[x];
+    const int32_t off = row.offset[x];
     if (off < 0) {
       std::memset(out + 4 * x, 0, 4);
       continue;
@@ -74,7 +70,7 @@ void rowSse2(const uint8_t* src, size_t src_step, const PackedMap& m, size_t k0,
         _mm_unpacklo_epi8(_mm_unpacklo_epi8(_mm_cvtsi32_si128(static_cast<int>(loadPixel(p1))),
                                             _mm_cvtsi32_si128(static_cast<int>(loadPixel(p1 + 4)))),
                           zero);
-    const Weights w = weights(fxs[x], fys[x]);
+    const Weights w = weights(row.fx[x], row.fy[x]);
     const __m128i wt = _mm_set1_epi32(w.w00 | (w.w01 << 16));
     const __m128i wb = _mm_set1_epi32(w.w10 | (w.w11 << 16));
     __m128i sum = _mm_add_epi32(_mm_madd_epi16(top, wt), _mm_madd_epi16(bottom, wb));
@@ -85,9 +81,39 @@ void rowSse2(const uint8_t* src, size_t src_step, const PackedMap& m, size_t k0,
     std::memcpy(out + 4 * x, &v, 4);
   }
 }
+
+// Eight pixels per step (bilinear_avx2.hpp), the last width % 8 by rowScalar.
+PROCAM_AVX2 void rowAvx2(const uint8_t* src, size_t src_step, const PackedRow& row, int width,
+                         uint8_t* out) {
+  const __m256i minus_one = _mm256_set1_epi32(-1);
+  int x = 0;
+  for (; x + 8 <= width; x += 8) {
+    const __m256i off = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(row.offset + x));
+    const __m256i valid = _mm256_cmpgt_epi32(off, minus_one);
+    int64_t fx8, fy8;
+    std::memcpy(&fx8, row.fx + x, 8);
+    std::memcpy(&fy8, row.fy + x, 8);
+    avx2::blendStore8(src, src_step, _mm256_and_si256(off, valid),
+                      _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(fx8)),
+                      _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(fy8)), valid, out + 4 * x);
+  }
+  if (x < width) {
+    rowScalar(src, src_step, {row.offset + x, row.fx + x, row.fy + x}, width - x, out + 4 * x);
+  }
+}
 #endif
 
 }  // namespace
+
+RemapRowFn remapRowKernel(RemapKernel kernel) {
+#if defined(__x86_64__)
+  if (kernel == RemapKernel::kBest && __builtin_cpu_supports("avx2")) return rowAvx2;
+  if (kernel != RemapKernel::kScalar) return rowSse2;
+#else
+  (void)kernel;
+#endif
+  return rowScalar;
+}
 
 Result<void> remapRgba(const cv::Mat& src, const PackedMap& map, cv::Mat& dst, RemapKernel kernel) {
   if (src.type() != CV_8UC4 || src.size() != map.source_size ||
@@ -100,28 +126,15 @@ Result<void> remapRgba(const cv::Mat& src, const PackedMap& map, cv::Mat& dst, R
   }
   dst.create(map.output_size, CV_8UC4);
   const int width = map.output_size.width;
-  const uint8_t* s = src.data;
-  const size_t step = src.step;
-  [[maybe_unused]] bool simd = false;
-#if defined(__SSE2__)
-  simd = kernel == RemapKernel::kBest;
-#else
-  (void)kernel;
-#endif
+  const RemapRowFn row = remapRowKernel(kernel);
   // Stripes of rows; OpenCV's pool uses every core.
   cv::parallel_for_(
       cv::Range(0, map.output_size.height),
       [&](const cv::Range& rows) {
         for (int y = rows.start; y < rows.end; ++y) {
-          const size_t k0 = static_cast<size_t>(y) * width;
-          uint8_t* out = dst.ptr<uint8_t>(y);
-#if defined(__SSE2__)
-          if (simd) {
-            rowSse2(s, step, map, k0, width, out);
-            continue;
-          }
-#endif
-          rowScalar(s, step, map, k0, width, out);
+          const size_t k = static_cast<size_t>(y) * width;
+          row(src.data, src.step, {&map.offset[k], &map.fx[k], &map.fy[k]}, width,
+              dst.ptr<uint8_t>(y));
         }
       },
       16);
