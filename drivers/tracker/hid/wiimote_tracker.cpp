@@ -1,5 +1,6 @@
 #include "tracker/hid/wiimote_tracker.hpp"
 
+#include <algorithm>
 #include <string>
 
 namespace procam::tracker::wiimote {
@@ -18,8 +19,12 @@ Result<tracking::TrackedPose> WiimoteTracker::read(int timeout_ms) {
   // A clock that went back (a replay starting over) starts a new track.
   if (last_frame_ns_ && frame->timestamp_ns <= *last_frame_ns_) tracker_.reset();
   last_frame_ns_ = frame->timestamp_ns;
+  // Strongest first, as LedTracker takes them: the size is the camera's blob weight.
+  std::vector<IrBlob> blobs = frame->blobs;
+  std::stable_sort(blobs.begin(), blobs.end(),
+                   [](const IrBlob& a, const IrBlob& b) { return a.size > b.size; });
   Points2 centres;
-  for (const IrBlob& b : frame->blobs) centres.push_back(b.pixel);
+  for (const IrBlob& b : blobs) centres.push_back(b.pixel);
   auto pose = tracker_.update(centres, double(frame->timestamp_ns) * 1e-9);
   if (!pose)
     return fail(pose.error().code, "LEDs not seen: " + std::to_string(centres.size()) +

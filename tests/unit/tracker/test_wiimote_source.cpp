@@ -1,6 +1,8 @@
 // WiimoteIrSource on a fake Wii Remote: the IR setup handshake, its failures (named by
 // step), and reading frames among other reports.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <numbers>
@@ -175,6 +177,29 @@ TEST(WiimoteIrSource, BadOptionsAreRefused) {
   options.ack_timeout_ms = 0;
   EXPECT_EQ(start(std::make_unique<FakeWiimote>(), options).source.error().code,
             ErrorCode::kInvalidInput);
+}
+
+// The hidraw transport's fd handling on a FIFO (no hidraw node on this machine): what is
+// written comes back as one report, poll times out on an empty one.
+TEST(HidrawWiimote, WritesAndReadsWholeReportsOnItsDescriptor) {
+  const std::string path = ::testing::TempDir() + "wiimote-fifo-" + std::to_string(::getpid());
+  ASSERT_EQ(::mkfifo(path.c_str(), 0600), 0);
+  {
+    auto t = HidrawWiimote::open(path);
+    ASSERT_TRUE(t) << t.error().message;
+    EXPECT_GE((*t)->pollFd(), 0);
+    EXPECT_EQ((*t)->read(10).error().code, ErrorCode::kNotFound);
+    const Bytes ack = {0x22, 0x00, 0x00, 0x16, 0x00};
+    ASSERT_TRUE((*t)->write(ack));
+    auto back = (*t)->read(100);
+    ASSERT_TRUE(back) << back.error().message;
+    EXPECT_EQ(*back, ack);
+  }
+  ::unlink(path.c_str());
+  auto missing = HidrawWiimote::open(path);
+  ASSERT_FALSE(missing);
+  EXPECT_EQ(missing.error().code, ErrorCode::kIo);
+  EXPECT_NE(missing.error().message.find(path), std::string::npos);
 }
 
 TEST(WiimoteCamera, ThirtyThreeDegreesOver1024Pixels) {
