@@ -8,7 +8,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -16,26 +15,11 @@
 #include <string>
 #include <vector>
 
+#include "bench_timing.hpp"
 #include "content/shm_frames.hpp"
 
 using namespace procam::content;
-
-namespace {
-
-template <class F>
-double medianMs(int runs, F&& f) {
-  std::vector<double> ms;
-  for (int i = 0; i < runs; ++i) {
-    const auto t0 = std::chrono::steady_clock::now();
-    f();
-    ms.push_back(
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-  }
-  std::nth_element(ms.begin(), ms.begin() + runs / 2, ms.end());
-  return ms[runs / 2];
-}
-
-}  // namespace
+using procam::bench::measure;
 
 int main(int argc, char** argv) {
   std::string out = ".";
@@ -65,22 +49,18 @@ int main(int argc, char** argv) {
   std::memcpy(dst.data(), src.data(), bytes);
   reader.copyNewest(copy);
 
-  const double memcpy_ms = medianMs(frames, [&] { std::memcpy(dst.data(), src.data(), bytes); });
-  const double copy_ms = medianMs(frames, [&] { reader.copyNewest(copy); });
+  const double memcpy_ms =
+      measure(frames, [&] { std::memcpy(dst.data(), src.data(), bytes); }).median_ms;
+  const double copy_ms = measure(frames, [&] { reader.copyNewest(copy); }).median_ms;
   // A new frame before each read; only the read is timed. The previous frame is
   // released before the read, as procamd does once it is shown.
-  std::vector<double> reads;
-  for (int i = 0; i < frames; ++i) {
+  auto next_frame = [&] {
     producer->publish(src.data());
     frame = Frame{};
-    const auto t0 = std::chrono::steady_clock::now();
-    (void)(*source)->read(frame);
-    reads.push_back(
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-  }
-  std::nth_element(reads.begin(), reads.begin() + frames / 2, reads.end());
-  const double read_only_ms = reads[size_t(frames / 2)];
-  const double publish_ms = medianMs(frames, [&] { producer->publish(src.data()); });
+  };
+  auto read_one = [&] { (void)(*source)->read(frame); };
+  const double read_only_ms = measure(frames, read_one, next_frame).median_ms;
+  const double publish_ms = measure(frames, [&] { producer->publish(src.data()); }).median_ms;
 
   std::printf("1920x1080 RGBA8 (%.1f MB), median of %d\n", bytes / 1e6, frames);
   std::printf("  memcpy                 %7.3f ms  (%.2f GB/s)\n", memcpy_ms,

@@ -1,49 +1,55 @@
-// Render bench: the CPU warp of a 1920x1080 RGBA frame against cv::warpPerspective and
-// cv::remap on the same input in the same run, and against a plain copy of the same
-// bytes (the bandwidth floor); the GLES 3 headless output's frames per second at 1080p
-// (render + read-back) on whatever EGL provides (Mesa llvmpipe here). Writes
-// render_cpu.csv and render_gles.csv to --out DIR.
+// Render bench at 1920x1080 RGBA8, every case on the same input in the same run:
+//  - CPU homography pre-warp: procamd's packed-map remap (each kernel) against
+//    cv::warpPerspective (INTER_LINEAR, BORDER_CONSTANT) and cv::remap of the same map
+//    (CV_16SC2 fixed-point maps, OpenCV's fastest, and float maps);
+//  - CPU lookup-table path (a dense post-render/lookup warp grid): procamd against
+//    cv::remap with CV_16SC2 maps;
+//  - the bandwidth floor: a copy of the same 8 MB into a distinct buffer, on one core
+//    (memcpy) and on all cores (row stripes on OpenCV's pool, as the warps run).
+// All CPU cases use the same thread count (cv::setNumThreads = hardware threads) and run
+// twice: "warm" (the same buffers again and again, resident in the last-level cache when it
+// holds them) and "cold" (before each timed call, untimed, a buffer of 4x the last-level
+// cache is written, so source, map and destination come from memory as in a daemon whose
+// frames arrive from elsewhere). Each warp's error is measured against the
+// double-precision bilinear reference over the pixels whose sample lies at least half a
+// pixel inside the source, where every implementation reads real texels.
+//  - GLES 3 on the surfaceless EGL platform (Mesa llvmpipe here), per render path: frames
+//    per second with content upload + draw + glFinish ("render"), and the same plus
+//    glReadPixels of the frame ("render + read-back").
+// Writes render_cpu.csv and render_gles.csv to --out DIR.
 //
 //   bench_render [--out DIR] [--runs N]
+#include <unistd.h>
+
 #include <algorithm>
-#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
+#include <thread>
 #include <vector>
 
+#include "bench_timing.hpp"
+#include "render/bilinear.hpp"
 #include "render/packed_map.hpp"
 #include "render/remap_rgba.hpp"
+#include "render/warp_homography.hpp"
 #include "render/warp_map.hpp"
 #if PROCAM_BENCH_GLES
-#include "headless/headless_output.hpp"
+#include "../unit/render/render_test_rig.hpp"  // test camera rigs
+#include "egl/egl_context.hpp"
+#include "gl/gl_renderer.hpp"
 #endif
 
 using namespace procam;
+using bench::measure;
+using bench::Timing;
 
 namespace {
-
-struct Timing {
-  double median_ms = 0, min_ms = 0;
-};
-
-Timing measure(int runs, const std::function<void()>& fn) {
-  fn();  // warm caches, thread pool and lazy allocations
-  std::vector<double> ms;
-  for (int i = 0; i < runs; ++i) {
-    const auto t0 = std::chrono::steady_clock::now();
-    fn();
-    ms.push_back(
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-  }
-  std::sort(ms.begin(), ms.end());
-  return {ms[ms.size() / 2], ms.front()};
-}
 
 cv::Mat content(cv::Size size) {
   cv::Mat img(size, CV_8UC4);
@@ -51,6 +57,196 @@ cv::Mat content(cv::Size size) {
   cv::GaussianBlur(img, img, cv::Size(5, 5), 1.0);
   return img;
 }
+
+// Touching this evicts every earlier buffer from the caches. Plain read-modify-write of
+// each cache line: a large memset would use non-temporal stores that bypass the caches.
+class CacheScrub {
+ public:
+  CacheScrub() {
+    const long l3 = std::clamp<long>(sysconf(_SC_LEVEL3_CACHE_SIZE), 8L << 20, 64L << 20);
+    lines_.resize(4 * static_cast<size_t>(l3));
+  }
+  void operator()() {
+    for (size_t i = 0; i < lines_.size(); i += 64) lines_[i] = static_cast<uint8_t>(lines_[i] + 1);
+    sink_ = lines_[lines_.size() / 2];
+  }
+  size_t size() const { return lines_.size(); }
+
+ private:
+  std::vector<uint8_t> lines_;
+  volatile uint8_t sink_ = 0;
+};
+
+// Every output pixel's exact source coordinate (double) for the error reference.
+using SourceOf = std::function<bool(int x, int y, double& sx, double& sy)>;
+
+struct Error {
+  double mean_abs = 0, max_abs = 0;
+  long pixels = 0;
+};
+
+Error errorAgainstReference(const cv::Mat& src, const cv::Mat& out, const SourceOf& source_of) {
+  Error e;
+  double sum = 0;
+  for (int y = 0; y < out.rows; ++y) {
+    for (int x = 0; x < out.cols; ++x) {
+      double sx = 0, sy = 0;
+      if (!source_of(x, y, sx, sy)) continue;
+      if (!(sx >= 0 && sy >= 0 && sx <= src.cols - 1 && sy <= src.rows - 1)) continue;
+      const cv::Vec4d ref = render::sampleBilinear(src, sx, sy);
+      const cv::Vec4b v = out.at<cv::Vec4b>(y, x);
+      for (int c = 0; c < 4; ++c) {
+        const double d = std::abs(v[c] - ref[c]);
+        sum += d;
+        e.max_abs = std::max(e.max_abs, d);
+      }
+      ++e.pixels;
+    }
+  }
+  e.mean_abs = e.pixels ? sum / (4.0 * e.pixels) : 0;
+  return e;
+}
+
+struct Row {
+  std::string path, name;
+  Timing warm, cold;
+  Error error;
+  bool has_error = false;
+};
+
+cv::Mat toCv(const Mat3& m) {
+  cv::Mat out(3, 3, CV_64F);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) out.at<double>(r, c) = m(r, c);
+  return out;
+}
+
+// A smooth lookup warp over the whole frame: nodes every 16 px, displaced by up to ~20 px.
+render::WarpGrid lookupGrid(cv::Size size) {
+  render::WarpGrid g;
+  g.step = Vec2(16, 16);
+  g.cols = size.width / 16 + 2;
+  g.rows = size.height / 16 + 2;
+  for (int j = 0; j < g.rows; ++j) {
+    for (int i = 0; i < g.cols; ++i) {
+      const Vec2 n = g.node(i, j);
+      g.source.push_back(n + Vec2(14 * std::sin(n.y() / 230.0) + 6 * std::cos(n.x() / 310.0),
+                                  11 * std::cos(n.x() / 270.0) - 5 * std::sin(n.y() / 190.0)));
+    }
+  }
+  return g;
+}
+
+void printCpu(const Row& r, double copy_warm, double copy_cold, double ref_warm, double ref_cold) {
+  std::printf(
+      "  %-9s %-24s warm %7.3f ms (%5.2fx copy %5.2fx cv)  cold %7.3f ms (%5.2fx copy %5.2fx cv)",
+      r.path.c_str(), r.name.c_str(), r.warm.median_ms, r.warm.median_ms / copy_warm,
+      r.warm.median_ms / ref_warm, r.cold.median_ms, r.cold.median_ms / copy_cold,
+      r.cold.median_ms / ref_cold);
+  if (r.has_error) {
+    std::printf("  err mean %.3f max %.1f", r.error.mean_abs, r.error.max_abs);
+  }
+  std::printf("\n");
+}
+
+#if PROCAM_BENCH_GLES
+// A grid of coloured triangles covering the frame at depth 0 (pixel coordinates map
+// straight to projector pixels: planar3d = identity).
+render::ColoredMesh coloredGrid(cv::Size size, int n) {
+  const Vec2 half(size.width / 2.0, size.height / 2.0);
+  const render::SurfaceMesh grid = test::planeMesh(Vec3(half.x(), half.y(), 0), Vec3::UnitX(),
+                                                   Vec3::UnitY(), half.x(), half.y(), n);
+  render::ColoredMesh m{grid.vertices, {}, grid.triangles};
+  for (const Vec3& v : grid.vertices) {
+    m.colors.push_back(cv::Vec4b(uint8_t(40 + 200 * v.x() / size.width),
+                                 uint8_t(40 + 200 * v.y() / size.height), 128, 255));
+  }
+  return m;
+}
+
+void benchGles(const std::filesystem::path& out, cv::Size size, const cv::Mat& src, const Mat3& H,
+               int runs) {
+  std::ofstream csv(out / "render_gles.csv");
+  csv << "path,renderer,render_ms,render_fps,render_readback_ms,render_readback_fps\n";
+  auto ctx = output::egl::EglContext::surfaceless();
+  if (!ctx) {
+    std::printf("GLES: unavailable: %s\n", ctx.error().message.c_str());
+    csv << "unavailable,\"" << ctx.error().message << "\",,,,\n";
+    return;
+  }
+  auto gl = output::gl::GlRenderer::create(output::gl::GlTarget{true, 0});
+  if (!gl) {
+    std::printf("GLES: %s\n", gl.error().message.c_str());
+    return;
+  }
+  const std::string name = (*ctx)->renderer();
+  std::printf("GLES 3 at %dx%d on %s, %d runs (content upload included in every frame)\n",
+              size.width, size.height, name.c_str(), runs);
+
+  struct Case {
+    const char* path;
+    render::RenderSetup setup;
+  };
+  std::vector<Case> cases;
+  render::RenderSetup base;
+  base.output_size = size;
+  base.content_size = size;
+  base.homography = H;
+  cases.push_back({"homography", base});
+  render::RenderSetup lookup = base;
+  lookup.path = render::RenderPath::kLookupWarp;
+  lookup.lookup = lookupGrid(size);
+  cases.push_back({"lookup", lookup});
+  render::RenderSetup post = base;
+  post.post_warp = lookupGrid(size);
+  cases.push_back({"homography+post_warp", post});
+  render::RenderSetup mesh = base;
+  mesh.path = render::RenderPath::kTwoPassMesh;
+  mesh.surface = test::domeMesh(Vec3(0, 0, 0), 2.0, 32, 96);
+  mesh.projector = test::lookAtProjection(1560, 959.5, 539.5, Vec3(0.3, 0.2, 0.1),
+                                          Vec3(0.3, 2, 0.5), Vec3::UnitZ());
+  mesh.viewer = test::lookAtProjection(900, 959.5, 539.5, Vec3(-0.2, 0.1, -0.3), Vec3(0, 2, 0.2),
+                                       Vec3::UnitZ());
+  cases.push_back({"two_pass_mesh", mesh});
+  render::RenderSetup planar = base;
+  planar.path = render::RenderPath::kPlanar3d;
+  planar.planar3d = Mat4::Identity();
+  cases.push_back({"planar3d", planar});
+  const render::ColoredMesh triangles = coloredGrid(size, 64);
+
+  cv::Mat frame;
+  uint64_t version = 0;
+  for (const Case& c : cases) {
+    if (auto ok = (*gl)->configure(c.setup); !ok) {
+      std::printf("  %-22s %s\n", c.path, ok.error().message.c_str());
+      continue;
+    }
+    const bool is3d = c.setup.path == render::RenderPath::kPlanar3d;
+    const render::Content content =
+        is3d ? render::Content{nullptr, &triangles, 0} : render::Content{&src, nullptr, 0};
+    auto draw = [&] {
+      render::Content next = content;
+      next.version = ++version;  // a new frame each time: nothing is skipped
+      (void)(*gl)->render(next);
+    };
+    draw();
+    (void)(*gl)->readFrame(frame);  // compile shaders, allocate, warm the driver
+    const Timing render = measure(runs, [&] {
+      draw();
+      glFinish();
+    });
+    const Timing readback = measure(runs, [&] {
+      draw();
+      (void)(*gl)->readFrame(frame);
+    });
+    csv << c.path << ",\"" << name << "\"," << render.median_ms << ',' << 1000 / render.median_ms
+        << ',' << readback.median_ms << ',' << 1000 / readback.median_ms << '\n';
+    std::printf("  %-22s render %7.2f ms %6.1f fps   render + read-back %7.2f ms %6.1f fps\n",
+                c.path, render.median_ms, 1000 / render.median_ms, readback.median_ms,
+                1000 / readback.median_ms);
+  }
+}
+#endif
 
 }  // namespace
 
@@ -69,88 +265,168 @@ int main(int argc, char** argv) {
     }
   }
   std::filesystem::create_directories(out);
+  const int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  cv::setNumThreads(threads);
   const cv::Size size(1920, 1080);
   const cv::Mat src = content(size);
   // A keystone pre-warp: the content shrunk into an oblique quadrilateral.
   Mat3 H;
   H << 0.82, 0.06, 140, -0.04, 0.88, 70, 6e-5, -2.5e-5, 1;
-  cv::Mat Hcv(3, 3, CV_64F);
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) Hcv.at<double>(r, c) = H(r, c);
+  const Mat3 Hinv = H.inverse();
 
-  auto map = render::homographyMap(H, size);
-  auto packed = map ? render::packMap(*map, size) : tl::unexpected(map.error());
-  if (!packed) {
-    std::fprintf(stderr, "bench_render: %s\n", packed.error().message.c_str());
+  auto hmap = render::homographyMap(H, size);
+  auto lmap = render::gridMap(lookupGrid(size), size);
+  if (!hmap || !lmap) {
+    std::fprintf(stderr, "bench_render: cannot build the maps\n");
     return 1;
   }
-  cv::Mat dst(size, CV_8UC4), copy(size, CV_8UC4), ocv(size, CV_8UC4);
-  std::vector<cv::Mat> xy;
-  cv::split(map->xy, xy);
-  cv::Mat m1, m2;
-  cv::convertMaps(xy[0], xy[1], m1, m2, CV_16SC2);
-
-  struct Row {
-    std::string name;
-    Timing t;
+  auto hpacked = render::packMap(*hmap, size);
+  auto lpacked = render::packMap(*lmap, size);
+  if (!hpacked || !lpacked) {
+    std::fprintf(stderr, "bench_render: cannot pack the maps\n");
+    return 1;
+  }
+  auto fixedMaps = [](const render::WarpMap& m, cv::Mat& m1, cv::Mat& m2, cv::Mat& fx,
+                      cv::Mat& fy) {
+    std::vector<cv::Mat> xy;
+    cv::split(m.xy, xy);
+    fx = xy[0];
+    fy = xy[1];
+    cv::convertMaps(fx, fy, m1, m2, CV_16SC2);
   };
-  std::vector<Row> rows;
-  rows.push_back(
-      {"memcpy", measure(runs, [&] { std::memcpy(copy.data, src.data, src.total() * 4); })});
-  rows.push_back({"procam_remap_simd", measure(runs, [&] {
-                    (void)render::remapRgba(src, *packed, dst, render::RemapKernel::kBest);
-                  })});
-  rows.push_back({"procam_remap_scalar", measure(runs, [&] {
-                    (void)render::remapRgba(src, *packed, dst, render::RemapKernel::kScalar);
-                  })});
-  rows.push_back({"cv_warpPerspective", measure(runs, [&] {
-                    cv::warpPerspective(src, ocv, Hcv, size, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
-                  })});
-  rows.push_back({"cv_remap_fixed_maps", measure(runs, [&] {
-                    cv::remap(src, ocv, m1, m2, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
-                  })});
-  rows.push_back({"cv_remap_float_maps", measure(runs, [&] {
-                    cv::remap(src, ocv, xy[0], xy[1], cv::INTER_LINEAR, cv::BORDER_CONSTANT);
-                  })});
-  rows.push_back({"procam_map_build", measure(std::max(3, runs / 5), [&] {
-                    auto m = render::homographyMap(H, size);
-                    if (m) (void)render::packMap(*m, size);
-                  })});
+  cv::Mat h1, h2, hfx, hfy, l1, l2, lfx, lfy;
+  fixedMaps(*hmap, h1, h2, hfx, hfy);
+  fixedMaps(*lmap, l1, l2, lfx, lfy);
 
-  const double copy_ms = rows[0].t.median_ms, warp_ms = rows[3].t.median_ms;
+  const SourceOf homography_source = [&](int x, int y, double& sx, double& sy) {
+    const Vec3 p = Hinv * Vec3(x, y, 1);
+    if (p.z() <= 0) return false;
+    sx = p.x() / p.z();
+    sy = p.y() / p.z();
+    return true;
+  };
+  // The lookup map is defined by its float entries (gridMap evaluates the grid in double).
+  const SourceOf lookup_source = [&](int x, int y, double& sx, double& sy) {
+    const cv::Vec2f v = lmap->xy.at<cv::Vec2f>(y, x);
+    if (v[0] == render::kOutside) return false;
+    sx = v[0];
+    sy = v[1];
+    return true;
+  };
+
+  CacheScrub scrub;
+  cv::Mat copy(size, CV_8UC4), dst(size, CV_8UC4);
+  const size_t bytes = src.total() * src.elemSize();
+  std::vector<Row> rows;
+  auto run = [&](const char* path, const char* name, const std::function<void()>& body,
+                 const SourceOf* source_of) {
+    body();  // thread pool, lazy allocations
+    Row r{path, name, measure(runs, body), measure(runs, body, [&] { scrub(); }), {}, false};
+    if (source_of) {
+      dst.setTo(cv::Scalar::all(0));
+      body();
+      r.error = errorAgainstReference(src, dst, *source_of);
+      r.has_error = true;
+    }
+    rows.push_back(r);
+  };
+  using render::RemapKernel;
+  run(
+      "copy", "memcpy_1_thread", [&] { std::memcpy(copy.data, src.data, bytes); }, nullptr);
+  run(
+      "copy", "copy_all_threads",
+      [&] {
+        cv::parallel_for_(
+            cv::Range(0, size.height),
+            [&](const cv::Range& r) {
+              std::memcpy(copy.ptr(r.start), src.ptr(r.start), (r.end - r.start) * src.step);
+            },
+            threads);
+      },
+      nullptr);
+  const struct {
+    RemapKernel kernel;
+    const char* name;
+  } kernels[] = {{RemapKernel::kBest, "procam_map_best"},
+                 {RemapKernel::kSse2, "procam_map_sse2"},
+                 {RemapKernel::kScalar, "procam_map_scalar"}};
+  for (const auto& k : kernels) {
+    run(
+        "homography", k.name, [&] { (void)render::remapRgba(src, *hpacked, dst, k.kernel); },
+        &homography_source);
+  }
+  auto direct = render::makeHomographyWarp(H, size, size);
+  if (!direct) return 1;
+  run(
+      "homography", "procam_direct_best",
+      [&] { (void)render::warpHomographyRgba(src, *direct, dst, RemapKernel::kBest); },
+      &homography_source);
+  run(
+      "homography", "procam_direct_sse2",
+      [&] { (void)render::warpHomographyRgba(src, *direct, dst, RemapKernel::kSse2); },
+      &homography_source);
+  const cv::Mat Hcv = toCv(H);
+  run(
+      "homography", "cv_warpPerspective",
+      [&] { cv::warpPerspective(src, dst, Hcv, size, cv::INTER_LINEAR, cv::BORDER_CONSTANT); },
+      &homography_source);
+  run(
+      "homography", "cv_remap_16SC2",
+      [&] { cv::remap(src, dst, h1, h2, cv::INTER_LINEAR, cv::BORDER_CONSTANT); },
+      &homography_source);
+  run(
+      "homography", "cv_remap_32F",
+      [&] { cv::remap(src, dst, hfx, hfy, cv::INTER_LINEAR, cv::BORDER_CONSTANT); },
+      &homography_source);
+  run(
+      "lookup", "procam_map_best",
+      [&] { (void)render::remapRgba(src, *lpacked, dst, RemapKernel::kBest); }, &lookup_source);
+  run(
+      "lookup", "cv_remap_16SC2",
+      [&] { cv::remap(src, dst, l1, l2, cv::INTER_LINEAR, cv::BORDER_CONSTANT); }, &lookup_source);
+  run(
+      "map_build", "homography_map_and_pack",
+      [&] {
+        auto m = render::homographyMap(H, size);
+        if (m) (void)render::packMap(*m, size);
+      },
+      nullptr);
+
+  auto find = [&](const char* path, const char* name) -> const Row& {
+    for (const Row& r : rows)
+      if (r.path == path && r.name == name) return r;
+    return rows.front();
+  };
+  const Row& copy_row = find("copy", "copy_all_threads");
   std::ofstream csv(out / "render_cpu.csv");
-  csv << "case,median_ms,min_ms,x_memcpy,x_warpPerspective,threads\n";
-  std::printf("CPU 1920x1080 RGBA, %d runs, %d threads\n", runs, cv::getNumThreads());
-  for (const auto& r : rows) {
-    csv << r.name << ',' << r.t.median_ms << ',' << r.t.min_ms << ',' << r.t.median_ms / copy_ms
-        << ',' << r.t.median_ms / warp_ms << ',' << cv::getNumThreads() << '\n';
-    std::printf("  %-22s median %7.3f ms  min %7.3f ms  %5.2fx copy  %5.2fx warpPerspective\n",
-                r.name.c_str(), r.t.median_ms, r.t.min_ms, r.t.median_ms / copy_ms,
-                r.t.median_ms / warp_ms);
+  csv << "path,case,threads,warm_median_ms,warm_min_ms,cold_median_ms,cold_min_ms,"
+         "warm_x_copy,cold_x_copy,warm_x_opencv,cold_x_opencv,err_mean_abs,err_max_abs,"
+         "err_pixels\n";
+  std::printf(
+      "CPU %dx%d RGBA8 (%.1f MB), %d runs, %d threads; cold = caches evicted (%zu MB "
+      "written) before each run; copy = copy_all_threads; cv = the OpenCV reference of "
+      "the path; err in code values vs the double-precision bilinear reference\n",
+      size.width, size.height, bytes / 1e6, runs, threads, scrub.size() >> 20);
+  for (const Row& r : rows) {
+    const Row& ref = r.path == "lookup" ? find("lookup", "cv_remap_16SC2")
+                                        : find("homography", "cv_warpPerspective");
+    csv << r.path << ',' << r.name << ',' << threads << ',' << r.warm.median_ms << ','
+        << r.warm.min_ms << ',' << r.cold.median_ms << ',' << r.cold.min_ms << ','
+        << r.warm.median_ms / copy_row.warm.median_ms << ','
+        << r.cold.median_ms / copy_row.cold.median_ms << ','
+        << r.warm.median_ms / ref.warm.median_ms << ',' << r.cold.median_ms / ref.cold.median_ms
+        << ',';
+    if (r.has_error)
+      csv << r.error.mean_abs << ',' << r.error.max_abs << ',' << r.error.pixels;
+    else
+      csv << ",,";
+    csv << '\n';
+    printCpu(r, copy_row.warm.median_ms, copy_row.cold.median_ms, ref.warm.median_ms,
+             ref.cold.median_ms);
   }
 
 #if PROCAM_BENCH_GLES
-  std::ofstream gcsv(out / "render_gles.csv");
-  gcsv << "case,renderer,median_ms,min_ms,fps\n";
-  auto headless = output::HeadlessOutput::create(size);
-  if (!headless) {
-    std::printf("GLES: %s\n", headless.error().message.c_str());
-    gcsv << "unavailable,\"" << headless.error().message << "\",,,\n";
-    return 0;
-  }
-  render::RenderSetup setup;
-  setup.output_size = size;
-  setup.content_size = size;
-  setup.homography = H;
-  if (!(*headless)->configure(setup)) return 1;
-  uint64_t version = 0;
-  const Timing g = measure(runs, [&] { (void)(*headless)->show({&src, nullptr, ++version}); });
-  const std::string gl = (*headless)->glRenderer();
-  gcsv << "homography_upload_render_readback,\"" << gl << "\"," << g.median_ms << ',' << g.min_ms
-       << ',' << 1000.0 / g.median_ms << '\n';
-  std::printf(
-      "GLES 1080p homography (upload + render + read-back) on %s: median %.2f ms, %.1f fps\n",
-      gl.c_str(), g.median_ms, 1000.0 / g.median_ms);
+  benchGles(out, size, src, H, std::max(5, runs / 3));
 #endif
   return 0;
 }

@@ -7,40 +7,24 @@
 //
 //   bench_sim_render [--out DIR] [--runs N]
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
-#include <vector>
 
+#include "bench_timing.hpp"
 #include "sim/projector_image.hpp"
 #include "sim/renderer.hpp"
 #include "sim/scene_library.hpp"
 
 using namespace procam;
 using namespace procam::sim;
+using procam::bench::measure;
+using procam::bench::Timing;
 
 namespace {
-
-struct Timing {
-  double median_ms = 0, min_ms = 0;
-};
-
-Timing measure(int runs, const std::function<void()>& body) {
-  std::vector<double> ms;
-  for (int i = 0; i < runs; ++i) {
-    const auto t0 = std::chrono::steady_clock::now();
-    body();
-    ms.push_back(
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-  }
-  std::sort(ms.begin(), ms.end());
-  return {ms[ms.size() / 2], ms.front()};
-}
 
 cv::Mat checkerboard(int width, int height, int square) {
   cv::Mat fb(height, width, CV_8UC3);

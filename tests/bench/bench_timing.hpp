@@ -1,0 +1,30 @@
+#pragma once
+// Wall-clock timing shared by the benches: `runs` timed calls of a body, each optionally
+// preceded by an untimed preparation (publishing a new frame, evicting the caches), and
+// the median and fastest of them.
+#include <algorithm>
+#include <chrono>
+#include <functional>
+#include <vector>
+
+namespace procam::bench {
+
+struct Timing {
+  double median_ms = 0, min_ms = 0;
+};
+
+inline Timing measure(int runs, const std::function<void()>& body,
+                      const std::function<void()>& untimed_before = {}) {
+  std::vector<double> ms;
+  for (int i = 0; i < std::max(1, runs); ++i) {
+    if (untimed_before) untimed_before();
+    const auto t0 = std::chrono::steady_clock::now();
+    body();
+    ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  }
+  std::sort(ms.begin(), ms.end());
+  return {ms[ms.size() / 2], ms.front()};
+}
+
+}  // namespace procam::bench
