@@ -3,6 +3,23 @@
 #include <cmath>
 
 namespace procam::tracking {
+namespace {
+
+// The largest blob count whose hypotheses, C(leds, 4) LED quadruples x P(blobs, 4)
+// ordered blob quadruples (estimateConstellationPose's search), stay within `budget`;
+// 0 when even 4 blobs exceed it.
+size_t searchBlobLimit(size_t leds, long budget) {
+  const double quads = static_cast<double>(leds) * (leds - 1) * (leds - 2) * (leds - 3) / 24;
+  size_t n = 0;
+  for (size_t b = 4; b < 4096; ++b) {
+    if (quads * static_cast<double>(b) * (b - 1) * (b - 2) * (b - 3) > static_cast<double>(budget))
+      break;
+    n = b;
+  }
+  return n;
+}
+
+}  // namespace
 
 Result<LedTracker> LedTracker::create(const geom::CameraModel& camera,
                                       const LedTrackerOptions& options) {
@@ -16,9 +33,14 @@ Result<LedTracker> LedTracker::create(const geom::CameraModel& camera,
     return fail(ErrorCode::kInvalidInput, "LED tracker: camera intrinsics or pose invalid");
   if (options.to_world && !(std::isfinite(options.to_world->scale) && options.to_world->scale > 0))
     return fail(ErrorCode::kInvalidInput, "LED tracker: registration scale must be positive");
+  const size_t search_blobs = searchBlobLimit(options.leds.size(), options.pose.max_hypotheses);
+  if (search_blobs == 0)
+    return fail(ErrorCode::kInvalidInput,
+                "LED tracker: " + std::to_string(options.leds.size()) +
+                    " LEDs exceed the pose search's max_hypotheses even with 4 blobs");
   auto filter = MotionFilter::create(options.filter);
   if (!filter) return tl::unexpected(filter.error());
-  return LedTracker(camera, options, std::move(*filter));
+  return LedTracker(camera, options, std::move(*filter), search_blobs);
 }
 
 void LedTracker::reset() {
@@ -29,6 +51,9 @@ void LedTracker::reset() {
 Result<TrackedPose> LedTracker::update(std::span<const Vec2> blobs, double time) {
   if (!std::isfinite(time)) return fail(ErrorCode::kInvalidInput, "LED tracker: bad frame time");
   auto pose = estimateConstellationPose(camera_, options_.leds, blobs, options_.pose, previous_);
+  if (!pose && pose.error().code == ErrorCode::kInvalidInput && blobs.size() > search_blobs_)
+    pose = estimateConstellationPose(camera_, options_.leds, blobs.first(search_blobs_),
+                                     options_.pose, previous_);
   if (!pose) {
     previous_.reset();  // a stale pose would only cost a failed refinement next frame
     return tl::unexpected(pose.error());

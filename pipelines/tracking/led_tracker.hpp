@@ -39,28 +39,38 @@ struct TrackedPose {
 
 class LedTracker {
  public:
-  // kInvalidInput for fewer than 4 LEDs, non-finite LEDs, a camera without positive
-  // focal lengths or bad filter options.
+  // kInvalidInput for fewer than 4 LEDs, non-finite LEDs, more LEDs than
+  // pose.max_hypotheses allows with 4 blobs, a camera without positive focal lengths or
+  // bad filter options.
   static Result<LedTracker> create(const geom::CameraModel& camera,
                                    const LedTrackerOptions& options);
 
-  // Blobs of one frame (camera pixels, distorted) at `time` (s, increasing). Errors of
+  // Blobs of one frame (camera pixels, distorted, strongest first as detectBlobs gives
+  // them) at `time` (s, increasing). When the hypothesis search would exceed
+  // pose.max_hypotheses it runs on the strongest searchBlobs() blobs. Errors of
   // estimateConstellationPose pass through (kNotFound / kTooFewPoints when the LEDs are
   // not seen); the filter keeps its state across such frames.
   Result<TrackedPose> update(std::span<const Vec2> blobs, double time);
   // Forgets the previous pose and the filter's state (e.g. after the camera reopens).
   void reset();
 
+  // Most blobs the hypothesis search takes within pose.max_hypotheses.
+  size_t searchBlobs() const { return search_blobs_; }
   const geom::CameraModel& camera() const { return camera_; }
   const LedTrackerOptions& options() const { return options_; }
 
  private:
-  LedTracker(const geom::CameraModel& camera, const LedTrackerOptions& options, MotionFilter filter)
-      : camera_(camera), options_(options), filter_(std::move(filter)) {}
+  LedTracker(const geom::CameraModel& camera, const LedTrackerOptions& options, MotionFilter filter,
+             size_t search_blobs)
+      : camera_(camera),
+        options_(options),
+        filter_(std::move(filter)),
+        search_blobs_(search_blobs) {}
 
   geom::CameraModel camera_;
   LedTrackerOptions options_;
   MotionFilter filter_;
+  size_t search_blobs_;
   std::optional<geom::Pose> previous_;  // constellation -> camera, last good frame
 };
 

@@ -203,6 +203,31 @@ FilterRow benchPipeline(const fs::path& dir, int frames, FilterKind kind) {
           synthetic::lagBehind(times, raw_x, truth_x) / kFrame};
 }
 
+// A search frame (no previous pose) with the LEDs and `extra` weaker reflections: median
+// time of LedTracker::update over `reps` frames of the trajectory.
+double benchSearch(int extra, int reps) {
+  LedTrackerOptions o;
+  o.leds = synthetic::kCapLeds;
+  auto tracker = LedTracker::create(synthetic::capCamera(), o);
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> ux(0, 1279), uy(0, 1023);
+  const geom::CameraModel cam = synthetic::capCamera();
+  std::vector<double> t;
+  for (int k = 0; k < reps; ++k) {
+    Points2 c;
+    for (size_t i = 0; i < synthetic::kCapLeds.size(); ++i)
+      c.push_back(*cam.project(synthetic::headAt(k * 0.1).led(i)));
+    for (int i = 0; i < extra; ++i) c.emplace_back(ux(rng), uy(rng));
+    tracker->reset();
+    const double t0 = nowMs();
+    auto pose = tracker->update(c, k * 0.1);
+    t.push_back(nowMs() - t0);
+    if (!pose)
+      std::fprintf(stderr, "search with %d extra blobs: %s\n", extra, pose.error().message.c_str());
+  }
+  return median(t);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -246,5 +271,12 @@ int main(int argc, char** argv) {
                 << r.lag_frames << "," << r.raw_lag_frames << "\n";
   }
   fs::remove_all(dir);
+
+  std::printf("pose search without a previous pose (5 LEDs + reflections)\n");
+  for (int extra : {0, 1, 3, 5, 10}) {
+    const double ms = benchSearch(extra, extra >= 5 ? 3 : 10);
+    std::printf("  %2d blobs: %.1f ms\n", 5 + extra, ms);
+    tracker_csv << "search_" << 5 + extra << "_blobs,," << ms << ",,,\n";
+  }
   return 0;
 }

@@ -85,11 +85,12 @@ CamResult<procam_pose_sample> IrCameraTracker::read() {
   last_time_ = time;
   auto pose = tracker_.update(centres, time);
   if (!pose) {
+    // A frame without a pose is a frame's problem, never the device's.
     const bool unseen =
         pose.error().code == ErrorCode::kNotFound || pose.error().code == ErrorCode::kTooFewPoints;
-    return camera::camFail(
-        unseen ? Status::kAgain : Status::kInternal,
-        "LEDs not seen: " + std::to_string(centres.size()) + " blob(s), " + pose.error().message);
+    return camera::camFail(Status::kAgain, std::string(unseen ? "LEDs not seen: " : "no pose: ") +
+                                               std::to_string(centres.size()) + " blob(s), " +
+                                               pose.error().message);
   }
   last_ = *pose;
   procam_pose_sample s{};

@@ -55,7 +55,7 @@ class IrCameraTracker {
   // One frame: the viewer's predicted world position, the constellation's orientation
   // and the frame's timestamp. Camera errors pass through (PROCAM_ENODEV when it went
   // away, PROCAM_EAGAIN when no frame is waiting); PROCAM_EAGAIN with a reason when the
-  // LEDs are not seen in the frame.
+  // frame gives no pose ("LEDs not seen: ...").
   CamResult<procam_pose_sample> read();
   int pollFd() const;
 

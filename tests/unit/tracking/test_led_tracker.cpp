@@ -134,6 +134,30 @@ TEST(LedTracker, UnseenLedsFailTheFrameAndTrackingResumes) {
   EXPECT_TRUE(tracker->update(observe(capCamera(), headAt(0), 0.1, rng), 0));
 }
 
+// Reflections add blobs: the search then takes the strongest blobs that keep the
+// hypotheses, C(5, 4) x P(n, 4), within pose.max_hypotheses: with 4200, n = 7
+// (5 x 7*6*5*4 = 4200; 8 blobs would be 8400). With the default 200000, n = 15.
+TEST(LedTracker, ManyBlobsSearchTheStrongest) {
+  LedTrackerOptions o;
+  o.leds = kCapLeds;
+  EXPECT_EQ(LedTracker::create(capCamera(), o)->searchBlobs(), 15u);
+  o.pose.max_hypotheses = 4200;
+  auto tracker = LedTracker::create(capCamera(), o);
+  ASSERT_TRUE(tracker);
+  EXPECT_EQ(tracker->searchBlobs(), 7u);
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> ux(0, 1279), uy(0, 1023);
+  Points2 blobs = observe(capCamera(), headAt(0.5), 0.1, rng);
+  for (int i = 0; i < 10; ++i) blobs.emplace_back(ux(rng), uy(rng));  // weaker, listed after
+  auto pose = tracker->update(blobs, 0.5);
+  ASSERT_TRUE(pose) << pose.error().message;
+  EXPECT_EQ(pose->matched, 5);
+  EXPECT_LT((pose->raw - headAt(0.5).t).norm(), 5e-3);
+  // Too many LEDs for the budget even with 4 blobs (5 x 24 > 100).
+  o.pose.max_hypotheses = 100;
+  EXPECT_EQ(LedTracker::create(capCamera(), o).error().code, ErrorCode::kInvalidInput);
+}
+
 TEST(LedTracker, RejectsBadOptions) {
   LedTrackerOptions o;
   o.leds = Points3(kCapLeds.begin(), kCapLeds.begin() + 3);
