@@ -89,6 +89,38 @@ std::string calibrateText(const json& r) {
   return out;
 }
 
+std::string trackerText(const json& r) {
+  if (r.contains("tracker")) {  // a registration was made
+    const json& g = r["registration"];
+    char line[160];
+    std::snprintf(line, sizeof line, "%s registered from %s points (%s), rms %.3f mm\n",
+                  scalar(r["tracker"]).c_str(), scalar(g["points"]).c_str(),
+                  scalar(g["source"]).c_str(), g.value("rms_m", 0.0) * 1e3);
+    return line + field("written", scalar(r["path"]));
+  }
+  std::string out;
+  if (r["trackers"].empty()) out += "no trackers\n";
+  for (const auto& t : r["trackers"]) {
+    char line[256];
+    std::snprintf(line, sizeof line, "%-16s %-6s %s m, %.1f Hz, %s samples",
+                  scalar(t["name"]).c_str(), scalar(t["state"]).c_str(),
+                  pairList(t["position"]).c_str(), t.value("rate_hz", 0.0),
+                  scalar(t["samples"]).c_str());
+    out += line;
+    const json& g = t["registration"];
+    if (g.is_object()) {
+      std::snprintf(line, sizeof line, ", registered (%s, %s points, rms %.3f mm)",
+                    scalar(g["source"]).c_str(), scalar(g["points"]).c_str(),
+                    g.value("rms_m", 0.0) * 1e3);
+      out += line;
+    } else {
+      out += ", not registered";
+    }
+    out += "\n";
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string progressBar(double fraction, int width, const std::string& stage) {
@@ -128,6 +160,10 @@ std::string formatReply(const json& r) {
     out += field("pattern", scalar(r["pattern"]));
     out += field("content", contentText(r["content"]));
     out += field("log level", scalar(r["log_level"]));
+    if (r.contains("viewer") && r["viewer"].is_object()) {
+      out += field("viewer", pairList(r["viewer"]["position"]) + " m (tracker " +
+                                 scalar(r["viewer"]["tracker"]) + ")");
+    }
     std::string caps;
     for (const auto& [name, on] : r["capabilities"].items()) {
       caps += (caps.empty() ? "" : ", ") + name + (on.get<bool>() ? "" : " (not built)");
@@ -146,6 +182,12 @@ std::string formatReply(const json& r) {
                     scalar(d["state"]).c_str());
       out += line;
       if (d.contains("error")) out += ": " + scalar(d["error"]);
+      for (const char* count : {"frames", "samples"}) {
+        if (!d.contains(count)) continue;
+        std::snprintf(line, sizeof line, ", %s %s at %.1f Hz", scalar(d[count]).c_str(), count,
+                      d.value("rate_hz", 0.0));
+        out += line;
+      }
       out += "\n";
     }
     out += std::to_string(r["drivers"].size()) + " driver(s) available\n";
@@ -160,6 +202,7 @@ std::string formatReply(const json& r) {
   if (cls == "SAVE") return "saved " + scalar(r["path"]) + " (" + scalar(r["bytes"]) + " bytes)\n";
   if (cls == "RELOAD") return "reloaded " + scalar(r["config"]) + "\n";
   if (cls == "LOG-LEVEL") return "log level " + scalar(r["level"]) + "\n";
+  if (cls == "TRACKER") return trackerText(r);
   if (cls == "CALIBRATE") return calibrateText(r);
   if (cls == "CANCEL") return "cancelled " + pairList(r["cancelled"]) + "\n";
   if (cls == "WATCH") {

@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,9 @@ constexpr const char* kUsage =
     "                                 raw frames (with a size) or a video file\n"
     "  content pipeline 'GST-SOURCE'  video from a gst-launch source description\n"
     "  log-level [error|warning|info|debug]\n"
+    "  tracker [get]                  trackers: positions, rates, registrations\n"
+    "  tracker register FILE          FILE: the request's JSON, e.g. {\"points\": [{\"tracker\":\n"
+    "                                 [x,y,z], \"world\": [x,y,z]}, ...]} (daemon/PROTOCOL.md)\n"
     "exit codes: 0 ok, 1 daemon error, 2 usage, 3 cannot connect, 4 protocol, 5 unavailable\n";
 
 struct Options {
@@ -127,6 +131,22 @@ json buildRequest(const std::string& cmd, const std::vector<std::string>& a) {
       r["pipeline"] = a[1];
     } else {
       usage("unknown content action '" + action + "'");
+    }
+  } else if (cmd == "tracker") {
+    const std::string action = a.empty() ? "get" : a[0];
+    if (action == "get") {
+      arity(0, 1);
+    } else if (action == "register") {
+      arity(2, 2);
+      std::ifstream in(a[1]);
+      const json body = json::parse(in, nullptr, false);
+      if (!in.is_open() || !body.is_object())
+        usage("tracker register: " + a[1] + " is not a JSON object");
+      r.update(body);
+      r["cmd"] = "tracker";
+      r["action"] = "register";
+    } else {
+      usage("unknown tracker action '" + action + "'");
     }
   } else {
     usage("unknown command '" + cmd + "'");

@@ -214,6 +214,17 @@ TEST(SimTracker, RegistrationFromSixPointsIsUsedAndSurvivesARestart) {
   auto status = c.call({{"cmd", "status"}});
   ASSERT_TRUE(status);
   EXPECT_EQ((*status)["viewer"]["registered"], true);
+  // procamctl: the same registration from a file, and the tracker list.
+  dir.write("points.json", json{{"points", rc.points}}.dump());
+  auto reg = runProgram(
+      {PROCAMCTL_BIN, "--socket", d.socketPath(), "tracker", "register", dir.file("points.json")});
+  EXPECT_EQ(reg.status, 0) << reg.err;
+  EXPECT_NE(reg.out.find("ir_head registered from 6 points (points)"), std::string::npos)
+      << reg.out;
+  auto list = runProgram({PROCAMCTL_BIN, "--socket", d.socketPath(), "tracker"});
+  EXPECT_EQ(list.status, 0) << list.err;
+  EXPECT_NE(list.out.find("ir_head"), std::string::npos) << list.out;
+  EXPECT_NE(list.out.find("registered (points, 6 points"), std::string::npos) << list.out;
 }
 
 // PROCAM_SIM_UNPLUG: the camera (presence-checked through its format once a
