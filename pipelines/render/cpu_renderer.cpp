@@ -14,12 +14,13 @@ Result<WarpMap> mainPathMap(const RenderSetup& setup) {
     case RenderPath::kPlanar3d:
       break;
   }
-  return fail(ErrorCode::kNotFound, "cpu renderer: the planar 3D path needs the GL back-end");
+  return fail(ErrorCode::kInvalidInput, "cpu renderer: the planar 3D path draws triangles, no map");
 }
 
 Result<void> CpuRenderer::configure(const RenderSetup& setup) {
   if (auto ok = validateSetup(setup); !ok) return ok;
-  auto main = mainPathMap(setup);
+  const bool is3d = setup.path == RenderPath::kPlanar3d;  // triangles, drawn per frame
+  auto main = is3d ? Result<WarpMap>(WarpMap{}) : mainPathMap(setup);
   if (!main) return tl::unexpected(main.error());
   // The homography path warps straight from H (no map streamed per frame).
   std::optional<HomographyWarp> direct;
@@ -28,7 +29,7 @@ Result<void> CpuRenderer::configure(const RenderSetup& setup) {
     if (!w) return tl::unexpected(w.error());
     direct = *w;
   }
-  auto packed = direct ? PackedMap{} : packMap(*main, setup.content_size);
+  auto packed = direct || is3d ? PackedMap{} : packMap(*main, setup.content_size);
   if (!packed) return tl::unexpected(packed.error());
   PackedMap post;
   if (setup.post_warp) {
@@ -51,29 +52,42 @@ Result<void> CpuRenderer::configure(const RenderSetup& setup) {
 
 Result<bool> CpuRenderer::render(const Content& content) {
   if (!configured_) return fail(ErrorCode::kInvalidInput, "cpu renderer: not configured");
-  if (!content.image || content.image->type() != CV_8UC4 ||
-      content.image->size() != setup_.content_size) {
+  const bool is3d = setup_.path == RenderPath::kPlanar3d;
+  if (is3d && !content.mesh) return fail(ErrorCode::kInvalidInput, "cpu renderer: no 3D mesh");
+  if (!is3d && (!content.image || content.image->type() != CV_8UC4 ||
+                content.image->size() != setup_.content_size)) {
     return fail(ErrorCode::kInvalidInput, "cpu renderer: content must be CV_8UC4 of content_size");
   }
   if (!gate_.needsRender(content.version)) return false;
+  cv::Mat& main_out = setup_.post_warp ? stage_ : frame_;
+  if (is3d) {
+    auto ok =
+        rasterizeColoredMesh(*content.mesh, setup_.planar3d, setup_.output_size, main_out, depth_);
+    if (!ok) return tl::unexpected(ok.error());
+    return finish(content.version);
+  }
   if (!direct_ && static_cast<int>(content.image->step) != packed_.source_step) {
     auto repacked = packMap(map_, setup_.content_size, static_cast<int>(content.image->step));
     if (!repacked) return tl::unexpected(repacked.error());
     packed_ = std::move(*repacked);
   }
-  cv::Mat& main_out = setup_.post_warp ? stage_ : frame_;
   if (auto ok = direct_ ? warpHomographyRgba(*content.image, *direct_, main_out, kernel_)
                         : remapRgba(*content.image, packed_, main_out, kernel_);
       !ok) {
     return tl::unexpected(ok.error());
   }
+  return finish(content.version);
+}
+
+// The stages after the main path: post-render warp, then the final stage.
+Result<bool> CpuRenderer::finish(uint64_t version) {
   if (setup_.post_warp) {
     if (auto ok = remapRgba(stage_, post_, frame_, kernel_); !ok) return tl::unexpected(ok.error());
   }
   if (auto ok = applyFinalStage(setup_.final_stage, frame_); !ok) {
     return tl::unexpected(ok.error());
   }
-  gate_.rendered(content.version);
+  gate_.rendered(version);
   return true;
 }
 

@@ -3,16 +3,18 @@
 // top-left rule so that pixels on an edge shared by two triangles are drawn once.
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "core/types.hpp"
 
 namespace procam::render {
 
-// Calls fn(x, y, b0, b1, b2) for every pixel centre (x, y) of a width x height image
-// inside the triangle p0 p1 p2; b are the screen-space barycentric coordinates.
+// Calls fn(x, y, b0, b1, b2) for every pixel centre (x, y) with 0 <= x < width and
+// row_begin <= y < row_end inside the triangle p0 p1 p2; b are the screen-space
+// barycentric coordinates. Row ranges let callers split one image across threads.
 template <class Fn>
-void rasterizeTriangle(const Vec2& p0, const Vec2& p1, const Vec2& p2, int width, int height,
-                       Fn&& fn) {
+void rasterizeTriangleRows(const Vec2& p0, const Vec2& p1, const Vec2& p2, int width, int row_begin,
+                           int row_end, Fn&& fn) {
   auto edge = [](const Vec2& a, const Vec2& b, double x, double y) {
     return (b.x() - a.x()) * (y - a.y()) - (b.y() - a.y()) * (x - a.x());
   };
@@ -34,8 +36,8 @@ void rasterizeTriangle(const Vec2& p0, const Vec2& p1, const Vec2& p2, int width
   const double min_y = std::min({a.y(), b.y(), c.y()}), max_y = std::max({a.y(), b.y(), c.y()});
   const int x0 = std::max(0, static_cast<int>(std::ceil(min_x)));
   const int x1 = std::min(width - 1, static_cast<int>(std::floor(max_x)));
-  const int y0 = std::max(0, static_cast<int>(std::ceil(min_y)));
-  const int y1 = std::min(height - 1, static_cast<int>(std::floor(max_y)));
+  const int y0 = std::max(row_begin, static_cast<int>(std::ceil(min_y)));
+  const int y1 = std::min(row_end - 1, static_cast<int>(std::floor(max_y)));
   for (int y = y0; y <= y1; ++y) {
     for (int x = x0; x <= x1; ++x) {
       const double ea = edge(b, c, x, y), eb = edge(c, a, x, y), ec = edge(a, b, x, y);
@@ -50,6 +52,13 @@ void rasterizeTriangle(const Vec2& p0, const Vec2& p1, const Vec2& p2, int width
       }
     }
   }
+}
+
+// The whole width x height image.
+template <class Fn>
+void rasterizeTriangle(const Vec2& p0, const Vec2& p1, const Vec2& p2, int width, int height,
+                       Fn&& fn) {
+  rasterizeTriangleRows(p0, p1, p2, width, 0, height, std::forward<Fn>(fn));
 }
 
 }  // namespace procam::render

@@ -6,46 +6,19 @@
 #include <random>
 
 #include "headless/headless_output.hpp"
-#include "keystone/head_tracked.hpp"
+#include "planar3d_scenes.hpp"
 #include "render/gl_conventions.hpp"
-#include "render_test_rig.hpp"
 
 namespace procam::output {
 namespace {
 
 constexpr int kW = 1920, kH = 1080;
 
-struct Scene {
-  Mat34 P;   // projector, world -> pixels
-  Vec3 eye;  // tracked viewer
-  keystone::DisplayRect S;
-  Mat4 pixel3d;  // A'4x4 P_T in this project's pixel convention
-};
+using Scene = test::Planar3dScene;
+using test::onS;
 
-// Wall: plane y = 3 (world +Z up), viewer side y < 3; u = +X, v = +Z.
 std::optional<Scene> randomScene(std::mt19937& rng) {
-  std::uniform_real_distribution<double> U(-1, 1);
-  Scene s;
-  const Vec3 centre(0.5 * U(rng), 0.2 + 2.0 * (U(rng) + 1) / 2, 1.2 + 0.3 * U(rng));
-  const Vec3 target(0.8 * U(rng), 3.0, 1.3 + 0.5 * U(rng));
-  Vec3 up = Vec3::UnitZ() + 0.15 * Vec3(U(rng), U(rng), 0);
-  s.P = test::lookAtProjection(1.3 * kW, (kW - 1) / 2.0, (kH - 1) / 2.0, centre, target, up);
-  s.eye = Vec3(1.2 * U(rng), 0.3 + 1.5 * (U(rng) + 1) / 2, 1.6 + 0.4 * U(rng));
-  auto S = keystone::boundingDisplayRect(s.P, kW, kH, Vec3(0, 3, 0), Vec3::UnitX(), Vec3::UnitZ());
-  if (!S) return std::nullopt;
-  s.S = *S;
-  auto path = keystone::headTrackedPath(s.eye, s.S, 0.05, 50.0, s.P, kW, kH);
-  if (!path) return std::nullopt;  // |a31| + |a32| >= 1: eq. 4.9 cannot hold
-  // Keystone's projector NDC has y up with image row 0 at the top.
-  const Mat4 clip_top =
-      render::glConventions(kW, kH, render::GlOrigin::kRow0AtGlTop).clip_from_pixel;
-  s.pixel3d = clip_top.inverse() * path->single_pass;
-  return s;
-}
-
-// Point of S at normalised (a, b) in [0, 1]^2.
-Vec3 onS(const keystone::DisplayRect& S, double a, double b) {
-  return S.corner + a * S.width * S.u + b * S.height * S.v;
+  return test::randomPlanar3dScene(rng, kW, kH);
 }
 
 // GL's float32 vertex stage, captured with transform feedback: clip = uClip * (X, 1),

@@ -130,12 +130,20 @@ TEST(CpuRenderer, PlanarMeshTwoPassEqualsTheInducedHomography) {
   EXPECT_GT(cv::countNonZero(fa.reshape(1) > 0), 1000);
 }
 
-TEST(CpuRenderer, PlanarPath3dNeedsTheGlBackEndAndBadSetupsAreRejected) {
+TEST(CpuRenderer, PlanarPath3dTakesMeshesAndBadSetupsAreRejected) {
   CpuRenderer r;
   RenderSetup s;
   s.output_size = {8, 8};
   s.path = RenderPath::kPlanar3d;
-  EXPECT_EQ(r.configure(s).error().code, ErrorCode::kNotFound);
+  ASSERT_TRUE(r.configure(s));
+  EXPECT_EQ(r.render({nullptr, nullptr, 1}).error().code, ErrorCode::kInvalidInput);
+  ColoredMesh bad;
+  bad.vertices = {Vec3(0, 0, 0), Vec3(4, 0, 0), Vec3(0, 4, 0)};
+  bad.triangles = {{0, 1, 2}};
+  EXPECT_EQ(r.render({nullptr, &bad, 1}).error().code, ErrorCode::kInvalidInput);  // no colours
+  bad.colors.assign(3, cv::Vec4b(1, 2, 3, 4));
+  bad.triangles = {{0, 1, 3}};
+  EXPECT_EQ(r.render({nullptr, &bad, 1}).error().code, ErrorCode::kInvalidInput);  // index
   s.path = RenderPath::kTwoPassMesh;
   s.content_size = {8, 8};
   EXPECT_EQ(r.configure(s).error().code, ErrorCode::kInvalidInput);
