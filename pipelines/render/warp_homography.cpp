@@ -92,7 +92,7 @@ void rowPacked(const uint8_t* src, const RowGeometry& g, int width, RemapRowFn k
 
 #if defined(__x86_64__)
 // One axis of quantise() for eight lanes (the footprint test is done by the caller).
-PROCAM_AVX2 inline void quantise8(__m256 s, __m256i last, __m256i& i, __m256i& f) {
+PROCAM_AVX2_INLINE void quantise8(__m256 s, __m256i last, __m256i& i, __m256i& f) {
   const __m256i q = _mm256_cvtps_epi32(_mm256_mul_ps(s, _mm256_set1_ps(float(kSubpixelOne))));
   __m256i t = _mm256_srai_epi32(q, kSubpixelBits);
   __m256i frac = _mm256_and_si256(q, _mm256_set1_epi32(kSubpixelOne - 1));
