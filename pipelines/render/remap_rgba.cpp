@@ -90,6 +90,10 @@ PROCAM_AVX2 void rowAvx2(const uint8_t* src, size_t src_step, const PackedRow& r
   for (; x + 8 <= width; x += 8) {
     const __m256i off = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(row.offset + x));
     const __m256i valid = _mm256_cmpgt_epi32(off, minus_one);
+    if (_mm256_testz_si256(valid, valid)) {  // e.g. the black margin around a keystoned image
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + 4 * x), _mm256_setzero_si256());
+      continue;
+    }
     int64_t fx8, fy8;
     std::memcpy(&fx8, row.fx + x, 8);
     std::memcpy(&fy8, row.fy + x, 8);
