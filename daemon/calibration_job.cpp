@@ -4,6 +4,7 @@
 #include <opencv2/imgproc.hpp>
 #include <thread>
 
+#include "latency_probe.hpp"
 #include "output_frames.hpp"
 #include "protocol.hpp"
 #include "structured_light/decoder.hpp"
@@ -29,6 +30,8 @@ bool integerArg(const json& request, const char* key, int lo, int hi, int& out,
   return true;
 }
 
+}  // namespace
+
 CalibrationFailure deviceFailure(const char* family, const std::string& name, int rc,
                                  const char* what, const char* reason) {
   const std::string why = reason[0] ? reason : "no reason given";
@@ -42,9 +45,7 @@ CalibrationFailure deviceFailure(const char* family, const std::string& name, in
           rc};
 }
 
-// The driver's frame as a single-channel image the decoder takes (a copy: the
-// driver's buffer is reused by the next capture).
-cv::Mat toGray(const procam_image& img) {
+cv::Mat grayImage(const procam_image& img) {
   const int w = static_cast<int>(img.width), h = static_cast<int>(img.height);
   switch (img.format) {
     case PROCAM_PIXEL_GRAY8:
@@ -60,8 +61,7 @@ cv::Mat toGray(const procam_image& img) {
   return {};
 }
 
-// Waits `seconds`, waking every 20 ms to honour a cancel; false when cancelled.
-bool settle(double seconds, const CalibrationHooks& hooks) {
+bool waitCancellable(double seconds, const CalibrationHooks& hooks) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   while (std::chrono::steady_clock::now() < end) {
     if (hooks.cancelled()) return false;
@@ -70,10 +70,11 @@ bool settle(double seconds, const CalibrationHooks& hooks) {
   return !hooks.cancelled();
 }
 
-}  // namespace
-
-tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const json& request) {
+tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const json& request,
+                                                                const CalibrationConfig& defaults) {
   CalibrationArgs a;
+  a.settle_frames = defaults.settle_frames;
+  a.auto_settle = defaults.auto_settle;
   static const char* const kKeys[] = {"mode",          "step",   "phase_steps", "grid",
                                       "settle_frames", "output", "cameras"};
   for (const auto& [key, value] : request.items()) {
@@ -92,9 +93,15 @@ tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const json& requ
   }
   if (!integerArg(request, "step", 1, 256, a.step, error) ||
       !integerArg(request, "phase_steps", 3, 64, a.phase_steps, error) ||
-      !integerArg(request, "grid", 1, 1024, a.grid, error) ||
-      !integerArg(request, "settle_frames", 0, 600, a.settle_frames, error)) {
+      !integerArg(request, "grid", 1, 1024, a.grid, error)) {
     return tl::unexpected(error);
+  }
+  if (auto it = request.find("settle_frames"); it != request.end() && *it == "auto") {
+    a.auto_settle = true;
+  } else if (!integerArg(request, "settle_frames", 0, 600, a.settle_frames, error)) {
+    return tl::unexpected(error + " or \"auto\"");
+  } else if (it != request.end()) {
+    a.auto_settle = false;
   }
   if (request.contains("phase_steps") && a.mode != sl::Mode::kGrayPhase) {
     return tl::unexpected(std::string("\"phase_steps\" needs \"mode\": \"gray+phase\""));
@@ -120,6 +127,29 @@ tl::expected<CalibrationOutcome, CalibrationFailure> runCalibration(const Calibr
                                                                     const CalibrationHooks& hooks) {
   const CalibrationFailure cancelled{code::kCancelled, "calibration cancelled"};
   const int total = plan.captures();
+  CalibrationOutcome outcome;
+  outcome.settle_frames = plan.settle_frames;
+  double start = 0;  // progress fraction where the captures start
+  if (plan.auto_settle) {
+    // Settle by the measured display-to-capture latency of these cameras.
+    LatencyPlan probe{plan.output,
+                      static_cast<uint32_t>(plan.set.options.width),
+                      static_cast<uint32_t>(plan.set.options.height),
+                      plan.refresh_hz,
+                      {},
+                      plan.latency.latency_repeats,
+                      plan.latency.latency_timeout_s,
+                      plan.latency.margin_frames};
+    for (const auto& c : plan.cameras) probe.cameras.push_back(c.device);
+    CalibrationHooks probe_hooks{hooks.cancelled, [&](const CalibrationProgress& p) {
+                                   hooks.progress({0.1 * p.fraction, "latency", 0});
+                                 }};
+    auto measured = runLatencyProbe(probe, probe_hooks);
+    if (!measured) return tl::unexpected(measured.error());
+    outcome.settle_frames = measured->settle_frames;
+    outcome.latency = latencyJson(*measured, probe);
+    start = 0.1;
+  }
   const auto& out_raw = plan.output.device->raw();
   std::vector<std::vector<cv::Mat>> captures(plan.cameras.size());
   char err[256];
@@ -136,7 +166,8 @@ tl::expected<CalibrationOutcome, CalibrationFailure> runCalibration(const Calibr
     }
     // The frame reaches the screen within a few refreshes (seed §4.1.1 assumes a
     // static projected image per capture).
-    if (!settle(plan.settle_frames / plan.refresh_hz, hooks)) return tl::unexpected(cancelled);
+    if (!waitCancellable(outcome.settle_frames / plan.refresh_hz, hooks))
+      return tl::unexpected(cancelled);
     for (std::size_t c = 0; c < plan.cameras.size(); ++c) {
       const CalibrationCamera& cam = plan.cameras[c];
       const auto& raw = cam.device.device->raw();
@@ -146,18 +177,17 @@ tl::expected<CalibrationOutcome, CalibrationFailure> runCalibration(const Calibr
           rc != PROCAM_OK) {
         return tl::unexpected(deviceFailure("camera", cam.device.name, rc, "capture", err));
       }
-      cv::Mat gray = toGray(img);
+      cv::Mat gray = grayImage(img);
       if (gray.empty()) {
         return tl::unexpected(CalibrationFailure{
             code::kIo, "camera '" + cam.device.name + "' returned an unknown pixel format"});
       }
       captures[c].push_back(std::move(gray));
       ++done;
-      hooks.progress({0.9 * done / total, "capturing", done});
+      hooks.progress({start + (0.9 - start) * done / total, "capturing", done});
       if (hooks.cancelled()) return tl::unexpected(cancelled);
     }
   }
-  CalibrationOutcome outcome;
   std::vector<calib::DecodedView> views;
   for (std::size_t c = 0; c < plan.cameras.size(); ++c) {
     hooks.progress({0.9 + 0.05 * c / plan.cameras.size(), "decoding", total});

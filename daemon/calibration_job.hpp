@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "calibration/stereo_route.hpp"
+#include "config.hpp"
 #include "driver.hpp"
 #include "geometry/camera_model.hpp"
 #include "structured_light/pattern_set.hpp"
@@ -25,12 +26,15 @@ struct CalibrationArgs {
   int phase_steps = 8;
   int grid = 8;                      // projector pixels between solved nodes
   int settle_frames = 2;             // output frames to wait after showing a pattern
+  bool auto_settle = false;          // settle_frames "auto": measure the latency first
   std::string output;                // empty: the first usable output
   std::vector<std::string> cameras;  // empty: the first two usable cameras
 };
 
-// The message names the offending key.
-tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const nlohmann::json& request);
+// The message names the offending key; `defaults` ([calibration] of procamd.toml)
+// give settle_frames when the request has none.
+tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(
+    const nlohmann::json& request, const CalibrationConfig& defaults = {});
 
 // A device the run uses; the shared reference keeps it alive if the daemon
 // closes its entry meanwhile.
@@ -48,6 +52,8 @@ struct CalibrationPlan {
   sl::PatternSet set;
   int grid = 8;
   int settle_frames = 2;
+  bool auto_settle = false;   // measure the latency (latency_probe.hpp) and settle by it
+  CalibrationConfig latency;  // margin_frames, latency_repeats, latency_timeout_s
   double refresh_hz = 60;
   CalibrationDevice output;
   std::vector<CalibrationCamera> cameras;  // two: route (a)
@@ -76,7 +82,18 @@ struct CalibrationFailure {
 struct CalibrationOutcome {
   calib::StereoRouteResult route;
   std::vector<int> decoded;  // camera pixels decoded, per camera
+  int settle_frames = 0;     // waited after every pattern
+  nlohmann::json latency;    // the measured latency (auto_settle; latencyJson), else null
 };
+
+// Shared with the latency probe (latency_probe.hpp).
+CalibrationFailure deviceFailure(const char* family, const std::string& name, int rc,
+                                 const char* what, const char* reason);
+// The driver's frame as a single-channel image (a copy: the driver reuses its
+// buffer); empty for an unknown pixel format.
+cv::Mat grayImage(const procam_image& img);
+// Waits `seconds`, waking every 20 ms to honour a cancel; false when cancelled.
+bool waitCancellable(double seconds, const CalibrationHooks& hooks);
 
 // Runs on a worker: blocks on the devices; never touches daemon state.
 tl::expected<CalibrationOutcome, CalibrationFailure> runCalibration(const CalibrationPlan& plan,

@@ -51,7 +51,7 @@ void Daemon::handle(ClientId client, const proto::Request& req) {
       {"keystone", &Daemon::cmdKeystone},   {"pattern", &Daemon::cmdPattern},
       {"content", &Daemon::cmdContent},     {"save", &Daemon::cmdSave},
       {"reload", &Daemon::cmdReload},       {"log-level", &Daemon::cmdLogLevel},
-      {"tracker", &Daemon::cmdTracker},
+      {"tracker", &Daemon::cmdTracker},     {"latency", &Daemon::cmdLatency},
   };
   for (const auto& [name, fn] : kCommands) {
     if (req.cmd == name) {

@@ -81,6 +81,7 @@ tl::expected<geom::CameraModel, Failure> cameraModel(const DeviceEntry& e,
 
 // The devices and camera models of a run; everything but the capture itself.
 tl::expected<CalibrationPlan, Failure> makePlan(DeviceSet& devices, const CalibrationArgs& args,
+                                                const CalibrationConfig& latency,
                                                 const std::string& state_dir) {
   auto pick = [&](procam_family family, const std::string& name,
                   const std::vector<const DeviceEntry*>& taken) -> const DeviceEntry* {
@@ -130,6 +131,8 @@ tl::expected<CalibrationPlan, Failure> makePlan(DeviceSet& devices, const Calibr
   plan.set = std::move(*set);
   plan.grid = args.grid;
   plan.settle_frames = args.settle_frames;
+  plan.auto_settle = args.auto_settle;
+  plan.latency = latency;
   plan.output = {out->name, out->device.share()};
   for (const DeviceEntry* c : cams) {
     auto model = cameraModel(*c, state_dir);
@@ -146,22 +149,8 @@ json positionJson(const geom::Pose& pose) {
 
 }  // namespace
 
-void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
-  auto args = parseCalibrationArgs(req.body);
-  if (!args) return errorTo(client, req, code::kBadArgument, args.error());
-  if (!calibration_.op.empty()) {
-    return errorTo(client, req, code::kBusy,
-                   "calibration " + calibration_.op + " is running; wait for it or cancel it");
-  }
-  auto made = makePlan(devices_, *args, options_.state_dir);
-  if (!made) return errorTo(client, req, made.error().code, made.error().message);
-  auto plan = std::make_shared<const CalibrationPlan>(std::move(*made));
-
-  const std::string op_id = "op-" + std::to_string(next_operation_++);
-  auto cancelled = std::make_shared<std::atomic<bool>>(false);
-  operations_[op_id] = Operation{"calibrate", client, req.id, cancelled};
-  calibration_ = {op_id, {plan->output.name}, "", calibration_.hooked};
-  for (const auto& c : plan->cameras) calibration_.devices.push_back(c.device.name);
+void Daemon::beginCalibrationOp(const std::string& op_id, std::vector<std::string> devices) {
+  calibration_ = {op_id, std::move(devices), "", calibration_.hooked};
   if (!calibration_.hooked) {
     // A device the run uses was unplugged or lost: stop between two frames.
     device_manager_->onDeviceRemoved([this](const DeviceEntry& e) {
@@ -178,6 +167,25 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
     });
     calibration_.hooked = true;
   }
+}
+
+void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
+  auto args = parseCalibrationArgs(req.body, config_.calibration);
+  if (!args) return errorTo(client, req, code::kBadArgument, args.error());
+  if (!calibration_.op.empty()) {
+    return errorTo(client, req, code::kBusy,
+                   "calibration " + calibration_.op + " is running; wait for it or cancel it");
+  }
+  auto made = makePlan(devices_, *args, config_.calibration, options_.state_dir);
+  if (!made) return errorTo(client, req, made.error().code, made.error().message);
+  auto plan = std::make_shared<const CalibrationPlan>(std::move(*made));
+
+  const std::string op_id = "op-" + std::to_string(next_operation_++);
+  auto cancelled = std::make_shared<std::atomic<bool>>(false);
+  operations_[op_id] = Operation{"calibrate", client, req.id, cancelled};
+  std::vector<std::string> used{plan->output.name};
+  for (const auto& c : plan->cameras) used.push_back(c.device.name);
+  beginCalibrationOp(op_id, std::move(used));
   server_->hold(client);
   json cameras = json::array();
   for (const auto& c : plan->cameras) cameras.push_back(c.device.name);
@@ -189,7 +197,8 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
            {"cameras", cameras},
            {"mode", sl::toString(plan->set.options.mode)},
            {"frames", plan->set.frames.size()},
-           {"captures", captures}});
+           {"captures", captures},
+           {"settle_frames", plan->auto_settle ? json("auto") : json(plan->settle_frames)}});
   logInfo("calibration " + op_id + ": " + std::to_string(plan->set.frames.size()) +
           " pattern frames on '" + plan->output.name + "'");
   auto progress = [op_id, captures](const CalibrationProgress& p) {
@@ -253,7 +262,9 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
                     {"surface", surface},
                     {"surface_type", route.surface.planar ? "plane" : "mesh"},
                     {"triangulated", route.triangulated},
-                    {"decoded", result->decoded}};
+                    {"decoded", result->decoded},
+                    {"settle_frames", result->settle_frames}};
+      if (!result->latency.is_null()) reply["latency"] = result->latency;
       // fsync may block: the I/O worker writes the mesh first, then rig.json
       // (the previous versions stay as .bak).
       io_worker_->submit([dir = options_.state_dir, text, mesh, reply, finish] {

@@ -180,6 +180,30 @@ void parseKeystone(Checker& c, const toml::table& t, Config& cfg) {
     numbers(c, *n, "keystone.accel_scale", 0.5, 2.0, k.accel_scale);
 }
 
+void parseCalibration(Checker& c, const toml::table& t, Config& cfg) {
+  c.onlyKnown(t, "calibration.",
+              {"settle_frames", "margin_frames", "latency_repeats", "latency_timeout_s"});
+  CalibrationConfig& k = cfg.calibration;
+  if (auto* n = t.get("settle_frames")) {
+    if (n->is_string() && *n->value<std::string>() == "auto") {
+      k.auto_settle = true;
+    } else if (!n->is_integer()) {
+      c.error(n->source(), "calibration.settle_frames", "expected an integer or \"auto\"");
+    } else {
+      c.integer(*n, "calibration.settle_frames", 0, 600, k.settle_frames);
+    }
+  }
+  if (auto* n = t.get("margin_frames")) {
+    c.integer(*n, "calibration.margin_frames", 0, 60, k.margin_frames);
+  }
+  if (auto* n = t.get("latency_repeats")) {
+    c.integer(*n, "calibration.latency_repeats", 1, 20, k.latency_repeats);
+  }
+  if (auto* n = t.get("latency_timeout_s")) {
+    c.number(*n, "calibration.latency_timeout_s", 0.05, 10.0, k.latency_timeout_s);
+  }
+}
+
 void parseDevices(Checker& c, const toml::node& node, const std::string& section,
                   procam_family family, Config& cfg, std::set<std::string>& names) {
   const toml::array* list = node.as_array();
@@ -257,7 +281,8 @@ Result<Config> parseConfig(std::string_view text, const std::string& source) {
   cfg.source = source;
   Checker c(source);
   c.onlyKnown(root, "",
-              {"daemon", "policy", "keystone", "sim", "projector", "camera", "tilt", "tracker"});
+              {"daemon", "policy", "keystone", "calibration", "sim", "projector", "camera", "tilt",
+               "tracker"});
   auto section = [&](const char* name, void (*parse)(Checker&, const toml::table&, Config&)) {
     if (auto* n = root.get(name)) {
       if (const toml::table* t = n->as_table()) {
@@ -271,6 +296,7 @@ Result<Config> parseConfig(std::string_view text, const std::string& source) {
   section("policy", parsePolicy);
   section("sim", parseSim);
   section("keystone", parseKeystone);
+  section("calibration", parseCalibration);
   std::set<std::string> names;
   const std::pair<const char*, procam_family> families[] = {{"projector", PROCAM_FAMILY_OUTPUT},
                                                             {"camera", PROCAM_FAMILY_CAMERA},

@@ -39,6 +39,16 @@ struct KeystoneConfig {
   std::array<double, 3> accel_scale{1, 1, 1};
 };
 
+// [calibration]: the settle wait of `calibrate` and the display-to-capture latency
+// probe (daemon/latency_probe.hpp).
+struct CalibrationConfig {
+  int settle_frames = 2;           // output frames waited after showing a pattern
+  bool auto_settle = false;        // settle_frames = "auto": measure the latency first
+  int margin_frames = 1;           // added to ceil(latency * refresh) by "auto"
+  int latency_repeats = 3;         // black/white cycles per camera
+  double latency_timeout_s = 1.0;  // the longest latency looked for
+};
+
 struct Config {
   std::string source;  // file name, for messages
   LogLevel log_level = LogLevel::kInfo;
@@ -51,6 +61,7 @@ struct Config {
   RecalibratePolicy recalibrate = RecalibratePolicy::kOff;
   std::string sim_scene;
   KeystoneConfig keystone;
+  CalibrationConfig calibration;
   std::vector<DeviceConfig> devices;
 };
 

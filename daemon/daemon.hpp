@@ -70,6 +70,7 @@ class Daemon {
   void cmdDevices(ClientId, const proto::Request&);
   void cmdWatch(ClientId, const proto::Request&);
   void cmdCalibrate(ClientId, const proto::Request&);
+  void cmdLatency(ClientId, const proto::Request&);  // commands_latency.cpp
   void cmdCancel(ClientId, const proto::Request&);
   void cmdKeystone(ClientId, const proto::Request&);
   void cmdPattern(ClientId, const proto::Request&);
@@ -106,6 +107,8 @@ class Daemon {
   cv::Size currentSourceSize() const;
   void refreshOutputs(std::function<void(bool shown)> done = {});
   bool calibrating() const;
+  // Marks `op_id` as the calibration operation using `devices` (commands_calibrate.cpp).
+  void beginCalibrationOp(const std::string& op_id, std::vector<std::string> devices);
   void loadContentAtStart();
   nlohmann::json outputsJson() const;
   Result<void> reloadConfig();

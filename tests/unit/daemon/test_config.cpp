@@ -121,6 +121,45 @@ TEST(Config, BadValuesNameKeyAndLine) {
   }
 }
 
+TEST(Config, CalibrationSettleIsANumberOrAuto) {
+  auto cfg = parseConfig("", "rig.toml");
+  ASSERT_TRUE(cfg);
+  EXPECT_EQ(cfg->calibration.settle_frames, 2);
+  EXPECT_FALSE(cfg->calibration.auto_settle);
+  cfg = parseConfig(
+      "[calibration]\nsettle_frames = \"auto\"\nmargin_frames = 3\nlatency_repeats = 5\n"
+      "latency_timeout_s = 0.5\n",
+      "rig.toml");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_TRUE(cfg->calibration.auto_settle);
+  EXPECT_EQ(cfg->calibration.margin_frames, 3);
+  EXPECT_EQ(cfg->calibration.latency_repeats, 5);
+  EXPECT_EQ(cfg->calibration.latency_timeout_s, 0.5);
+  cfg = parseConfig("[calibration]\nsettle_frames = 12\n", "rig.toml");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_EQ(cfg->calibration.settle_frames, 12);
+  EXPECT_FALSE(cfg->calibration.auto_settle);
+  struct Case {
+    const char* text;
+    const char* expected;
+  } cases[] = {
+      {"[calibration]\nsettle_frames = \"soon\"",
+       "rig.toml:2: calibration.settle_frames: expected an integer or \"auto\""},
+      {"[calibration]\nsettle_frames = 601",
+       "rig.toml:2: calibration.settle_frames: 601 is out of range [0, 600]"},
+      {"[calibration]\nlatency_repeats = 0",
+       "rig.toml:2: calibration.latency_repeats: 0 is out of range [1, 20]"},
+      {"[calibration]\nlatency_timeout_s = 0.01",
+       "rig.toml:2: calibration.latency_timeout_s: 0.01 is out of range"},
+      {"[calibration]\nsettle = 2", "rig.toml:2: calibration.settle: unknown key"},
+  };
+  for (const auto& c : cases) {
+    auto e = parseError(c.text);
+    EXPECT_TRUE(contains(e.message, c.expected))
+        << "got: " << e.message << "\nwanted: " << c.expected;
+  }
+}
+
 TEST(Config, AllProblemsAreReportedAtOnce) {
   auto e = parseError("[daemon]\nfoo = 1\nmax_clients = -1\n[policy]\nbar = 2\n");
   EXPECT_TRUE(contains(e.message, "rig.toml:2: daemon.foo")) << e.message;
