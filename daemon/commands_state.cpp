@@ -1,5 +1,6 @@
 // Commands that change or persist settings: pattern, content, save, reload,
 // log-level (PROTOCOL.md).
+#include "content_mesh.hpp"
 #include "daemon.hpp"
 #include "log.hpp"
 #include "request_args.hpp"
@@ -34,6 +35,7 @@ void Daemon::cmdPattern(ClientId client, const proto::Request& req) {
 
 json Daemon::contentJson() const {
   if (live_content_) return liveContentJson();
+  if (!keystone_rt_.meshes.empty()) return keystone_rt_.mesh_info;
   if (settings_.content.empty()) return nullptr;
   json j = {{"path", settings_.content}};
   if (content_info_.width > 0) j["size"] = {content_info_.width, content_info_.height};
@@ -56,6 +58,7 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
       settings_.content.clear();
       content_info_ = {};
       keystone_rt_.content.reset();
+      keystone_rt_.meshes.clear();
       broadcast("content", {{"content", nullptr}});
       refreshOutputs();
     }
@@ -68,6 +71,47 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
   }
   if (!path || path->empty()) {
     return errorTo(client, req, code::kBadArgument, "content load needs \"path\"");
+  }
+  if (isMeshFile(*path)) {
+    // 3D content (content_mesh.hpp): prepared on a worker, then shown instead of any image.
+    const std::string file = *path;
+    std::vector<MeshOutput> outputs;
+    for (const auto& e : devices_.entries()) {
+      if (e.description.family != PROCAM_FAMILY_OUTPUT || !e.usable()) continue;
+      const bool sim = e.description.subsystem == "sim";
+      outputs.push_back({e.name, sim ? e.description.property("SIM_SCENE") : "",
+                         sim ? e.description.property("SIM_DEVICE") : ""});
+    }
+    // A tracked viewer (status `viewer`) wins over the scene's.
+    std::optional<Vec3> eye;
+    std::string tracker;
+    if (const json v = viewerJson(); v.is_object() && v["position"].is_array()) {
+      eye = Vec3(v["position"][0].get<double>(), v["position"][1].get<double>(),
+                 v["position"][2].get<double>());
+      tracker = v.value("tracker", "");
+    }
+    server_->hold(client);
+    compute_worker_->submit([this, client, req, file, outputs, eye, tracker] {
+      auto prepared = std::make_shared<tl::expected<PreparedMesh, MeshFailure>>(
+          prepareMeshContent(file, outputs, eye, tracker));
+      return [this, client, req, prepared] {
+        if (!*prepared) {
+          errorTo(client, req, (*prepared).error().code, (*prepared).error().message);
+        } else {
+          stopLiveContent();
+          settings_.content.clear();
+          content_info_ = {};
+          keystone_rt_.content.reset();
+          keystone_rt_.meshes = std::move((*prepared)->meshes);
+          keystone_rt_.mesh_info = std::move((*prepared)->info);
+          broadcast("content", {{"content", contentJson()}});
+          refreshOutputs();
+          replyTo(client, req, "CONTENT", {{"content", contentJson()}});
+        }
+        server_->release(client);
+      };
+    });
+    return;
   }
   // Decoding may take long: done on a worker, applied back on the loop.
   const std::string op_id = "op-" + std::to_string(next_operation_++);
@@ -107,6 +151,7 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
         settings_.content = file;
         content_info_ = {image->cols, image->rows};
         keystone_rt_.content = image;
+        keystone_rt_.meshes.clear();
         broadcast("content", {{"content", contentJson()}});
         refreshOutputs();
         replyTo(client, req, "CONTENT", {{"content", contentJson()}, {"operation", op_id}});

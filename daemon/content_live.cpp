@@ -2,13 +2,24 @@
 // fills in a sealed memfd passed with the request, SCM_RIGHTS) and `content
 // stream` (raw frames from a file or FIFO, video through GStreamer). The source
 // is read on a timer at its frame rate; each new frame goes through the keystone
-// warp like a loaded image.
+// warp like a loaded image. Also 3D content's preparation (content_mesh.hpp).
 #include <sys/epoll.h>
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
 
 #include "content/raw_source.hpp"
 #include "content/shm_frames.hpp"
+#include "content_mesh.hpp"
 #include "daemon.hpp"
 #include "request_args.hpp"
+#ifdef PROCAM_HAVE_SIM
+#include <variant>
+
+#include "content/mesh_placement.hpp"
+#include "sim/scene_library.hpp"
+#endif
 #if PROCAM_HAVE_GSTREAMER
 #include "content/gst_source.hpp"
 #endif
@@ -151,6 +162,7 @@ Result<void> Daemon::startLiveContent(std::unique_ptr<content::ContentSource> so
   settings_.content.clear();
   keystone_rt_.content.reset();
   content_info_ = {source->size().width, source->size().height};
+  keystone_rt_.meshes.clear();
   live_content_ = LiveContent{std::move(source), timer, fd, std::move(info), 0, false};
   pollLiveContent();  // a frame already there shows at once
   broadcast("content", {{"content", contentJson()}});
@@ -204,6 +216,85 @@ json Daemon::liveContentJson() const {
   j["ended"] = live_content_->ended;
   j["size"] = {content_info_.width, content_info_.height};
   return j;
+}
+
+bool isMeshFile(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  return ext == ".obj" || ext == ".ply";
+}
+
+tl::expected<PreparedMesh, MeshFailure> prepareMeshContent(const std::string& file,
+                                                           const std::vector<MeshOutput>& outputs,
+                                                           const std::optional<Vec3>& tracked_eye,
+                                                           const std::string& tracker) {
+#ifdef PROCAM_HAVE_SIM
+  if (outputs.empty())
+    return tl::unexpected(MeshFailure{code::kUnavailable, "no output to show 3D content on"});
+  auto loaded = content::loadMeshContent(file);
+  if (!loaded) {
+    const bool io = loaded.error().code == ErrorCode::kIo;
+    return tl::unexpected(MeshFailure{io ? code::kIo : code::kBadArgument, loaded.error().message});
+  }
+  PreparedMesh out;
+  json viewer = nullptr;
+  for (const MeshOutput& o : outputs) {
+    auto unavailable = [&](const std::string& why) {
+      return tl::unexpected(
+          MeshFailure{code::kUnavailable, "3D content on output '" + o.name + "': " + why});
+    };
+    // The projector's pose and the display surface are known on the virtual rig (the
+    // scene's truth at time 0); a calibrated real rig does not provide them here yet.
+    if (o.sim_scene.empty()) {
+      return unavailable(
+          "its projector pose and display surface are unknown (3D content needs the virtual rig)");
+    }
+    auto scene = sim::resolveScene(o.sim_scene);
+    if (!scene) return unavailable(scene.error().message);
+    const sim::SceneState state = scene->at(0);
+    const sim::ProjectorState* projector = state.projector(o.sim_device);
+    if (!projector)
+      return unavailable("scene '" + o.sim_scene + "' has no projector '" + o.sim_device + "'");
+    const geom::CameraModel& model = projector->model;
+    // The surface the projector's central ray lights is the display surface.
+    auto ray = model.backproject(Vec2((model.width - 1) / 2.0, (model.height - 1) / 2.0));
+    if (!ray) return unavailable(ray.error().message);
+    const auto hit = scene->world().intersect(*ray);
+    if (!hit) return unavailable("the projector lights no surface");
+    const sim::Surface& surface = scene->world().surfaces()[static_cast<size_t>(hit->surface)];
+    if (!std::holds_alternative<geom::Plane>(surface.shape) &&
+        !std::holds_alternative<geom::Rectangle>(surface.shape)) {
+      return unavailable("the surface it lights ('" + surface.name + "', a " + surface.type +
+                         ") is not planar; 3D content needs the planar 3D path");
+    }
+    content::PlanarView view;
+    view.projector = model.projectionMatrix();
+    view.size = {model.width, model.height};
+    view.plane_point = hit->hit.point;
+    view.plane_normal = hit->hit.normal;
+    view.eye = tracked_eye ? *tracked_eye : scene->viewerPosition(0);
+    viewer = tracked_eye ? json{{"source", "tracker"}, {"tracker", tracker}}
+                         : json{{"source", "scene"}, {"scene", o.sim_scene}};
+    viewer["position"] = {view.eye.x(), view.eye.y(), view.eye.z()};
+    auto placed = content::placeMeshContent(*loaded, view);
+    if (!placed) return unavailable(placed.error().message);
+    out.meshes[o.name] = Mesh3d{
+        std::make_shared<const render::ColoredMesh>(std::move(placed->mesh)), placed->planar3d};
+  }
+  out.info = {{"path", file},
+              {"mesh",
+               {{"triangles", loaded->mesh.faces.size()},
+                {"vertices", loaded->mesh.vertices.size()},
+                {"shading", "lambert"},
+                {"viewer", viewer}}}};
+  return out;
+#else
+  (void)file, (void)outputs, (void)tracked_eye, (void)tracker;
+  return tl::unexpected(
+      MeshFailure{code::kUnavailable,
+                  "3D content needs the virtual rig, which this procamd was built without"});
+#endif
 }
 
 }  // namespace procam::daemon

@@ -502,6 +502,7 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done) {
     r.output_size = *mode;
     r.pattern = settings_.pattern;
     r.content = k.content;
+    if (auto m = k.meshes.find(e.name); m != k.meshes.end()) r.mesh3d = m->second;
     r.homography = currentWarp(sourceSize(r));
     jobs.emplace_back(e.name, std::move(r));
   }

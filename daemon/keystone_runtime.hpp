@@ -5,6 +5,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
@@ -38,6 +39,8 @@ struct KeystoneRuntime {
 
   // Outputs.
   std::shared_ptr<const cv::Mat> content;  // RGBA, decoded on a worker
+  std::map<std::string, Mesh3d> meshes;    // 3D content: output name -> what it draws
+  nlohmann::json mesh_info;                // `content` in replies while meshes are shown
   bool rendering = false;
   bool render_again = false;
   std::vector<std::function<void(bool shown)>> frame_waiters;

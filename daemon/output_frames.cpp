@@ -75,6 +75,8 @@ Result<OutputFrame> renderOutputFrame(const FrameRequest& r) {
         content::renderTestPattern(r.pattern, r.output_size.width, r.output_size.height);
     cv::cvtColor(cv::Mat(p.height, p.width, CV_8UC3, p.pixels.data()), source, cv::COLOR_RGB2RGBA);
     out.stats.source = "pattern:" + r.pattern;
+  } else if (r.mesh3d && r.mesh3d->mesh) {
+    out.stats.source = "content";
   } else if (r.content) {
     if (r.content->type() != CV_8UC4 || r.content->cols < 2 || r.content->rows < 2) {
       return fail(ErrorCode::kInvalidInput, "content must be RGBA of at least 2x2 pixels");
@@ -88,12 +90,19 @@ Result<OutputFrame> renderOutputFrame(const FrameRequest& r) {
   }
   render::RenderSetup setup;
   setup.output_size = r.output_size;
-  setup.content_size = source.size();
-  setup.path = render::RenderPath::kHomography;
-  setup.homography = r.homography ? *r.homography : fitHomography(source.size(), r.output_size);
+  render::Content content{&source, nullptr, 1};
+  if (source.empty()) {
+    setup.path = render::RenderPath::kPlanar3d;
+    setup.planar3d = r.mesh3d->planar3d;
+    content = {nullptr, r.mesh3d->mesh.get(), 1};
+  } else {
+    setup.content_size = source.size();
+    setup.path = render::RenderPath::kHomography;
+    setup.homography = r.homography ? *r.homography : fitHomography(source.size(), r.output_size);
+  }
   render::CpuRenderer renderer;
   if (auto ok = renderer.configure(setup); !ok) return tl::unexpected(ok.error());
-  if (auto ok = renderer.render(render::Content{&source, nullptr, 1}); !ok) {
+  if (auto ok = renderer.render(content); !ok) {
     return tl::unexpected(ok.error());
   }
   cv::Mat rgba;

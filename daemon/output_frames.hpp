@@ -1,7 +1,8 @@
 #pragma once
-// What a projector output shows: the alignment pattern (when one is chosen) or
-// the content image, pre-warped by the keystone homography through the CPU
-// reference renderer (pipelines/render), as an RGB8 frame. Pure: runs on a worker.
+// What a projector output shows: the alignment pattern (when one is chosen), 3D
+// content (a mesh through the planar 3D path) or the content image, pre-warped by the keystone
+// homography through the CPU reference renderer (pipelines/render), as an RGB8 frame. Pure: runs on
+// a worker.
 #include <array>
 #include <memory>
 #include <opencv2/core.hpp>
@@ -11,8 +12,15 @@
 #include "core/error.hpp"
 #include "core/types.hpp"
 #include "procamd/procam_plugin.h"
+#include "render/render_setup.hpp"
 
 namespace procam::daemon {
+
+// 3D content for one output: drawn through the planar 3D path (RenderPath::kPlanar3d).
+struct Mesh3d {
+  std::shared_ptr<const render::ColoredMesh> mesh;
+  Mat4 planar3d = Mat4::Identity();  // RenderSetup::planar3d
+};
 
 struct FrameRequest {
   cv::Size output_size;
@@ -21,6 +29,7 @@ struct FrameRequest {
   // Content pixels -> framebuffer pixels; none: the source is fitted into the
   // frame, centred, aspect kept (identity when the sizes agree).
   std::optional<Mat3> homography;
+  std::optional<Mesh3d> mesh3d;  // shown instead of `content` when set
 };
 
 // A few numbers about a frame, reported in status so that a client can tell what

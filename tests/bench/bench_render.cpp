@@ -15,7 +15,8 @@
 // pixel inside the source, where every implementation reads real texels.
 //  - GLES 3 on the surfaceless EGL platform (Mesa llvmpipe here), per render path: frames
 //    per second with content upload + draw + glFinish ("render"), and the same plus
-//    glReadPixels of the frame ("render + read-back").
+//    glReadPixels of the frame ("render + read-back"); and the CPU renderer's planar 3D path
+//    on the same triangles, on one thread and on all.
 // Writes render_cpu.csv and render_gles.csv to --out DIR.
 //
 //   bench_render [--out DIR] [--runs N]
@@ -35,6 +36,7 @@
 
 #include "bench_timing.hpp"
 #include "render/bilinear.hpp"
+#include "render/cpu_renderer.hpp"
 #include "render/packed_map.hpp"
 #include "render/remap_rgba.hpp"
 #include "render/warp_homography.hpp"
@@ -245,6 +247,17 @@ void benchGles(const std::filesystem::path& out, cv::Size size, const cv::Mat& s
                 c.path, render.median_ms, 1000 / render.median_ms, readback.median_ms,
                 1000 / readback.median_ms);
   }
+  // The CPU back-end's planar 3D path on the same triangles, one thread and all.
+  const int threads = cv::getNumThreads();
+  for (int n : {1, threads}) {
+    cv::setNumThreads(n);
+    render::CpuRenderer cpu;
+    if (!cpu.configure(cases.back().setup)) continue;
+    const Timing t = measure(runs, [&] { (void)cpu.render({nullptr, &triangles, ++version}); });
+    std::printf("  CPU planar3d, %d thread(s): %7.2f ms %6.1f fps\n", n, t.median_ms,
+                1000 / t.median_ms);
+  }
+  cv::setNumThreads(threads);
 }
 #endif
 
@@ -318,17 +331,15 @@ int main(int argc, char** argv) {
   cv::Mat copy(size, CV_8UC4), dst(size, CV_8UC4);
   const size_t bytes = src.total() * src.elemSize();
   std::vector<Row> rows;
-  auto run = [&](const char* path, const char* name, const std::function<void()>& body,
+  struct Case {
+    std::string path, name;
+    std::function<void()> body;
+    const SourceOf* source_of;  // null: no error to measure
+  };
+  std::vector<Case> cases;
+  auto run = [&](const char* path, const char* name, std::function<void()> body,
                  const SourceOf* source_of) {
-    body();  // thread pool, lazy allocations
-    Row r{path, name, measure(runs, body), measure(runs, body, [&] { scrub(); }), {}, false};
-    if (source_of) {
-      dst.setTo(cv::Scalar::all(0));
-      body();
-      r.error = errorAgainstReference(src, dst, *source_of);
-      r.has_error = true;
-    }
-    rows.push_back(r);
+    cases.push_back({path, name, std::move(body), source_of});
   };
   using render::RemapKernel;
   run(
@@ -391,6 +402,27 @@ int main(int argc, char** argv) {
         if (m) (void)render::packMap(*m, size);
       },
       nullptr);
+
+  // Every case timed in turn, round after round, so that a load coming and going on this
+  // shared machine falls on all of them alike; the first call warms the thread pool and
+  // lazy allocations.
+  std::vector<std::function<void()>> bodies;
+  for (const Case& c : cases) {
+    c.body();
+    bodies.push_back(c.body);
+  }
+  const std::vector<Timing> warm = bench::measureInterleaved(runs, bodies);
+  const std::vector<Timing> cold = bench::measureInterleaved(runs, bodies, [&] { scrub(); });
+  for (size_t i = 0; i < cases.size(); ++i) {
+    Row r{cases[i].path, cases[i].name, warm[i], cold[i], {}, false};
+    if (cases[i].source_of) {
+      dst.setTo(cv::Scalar::all(0));
+      cases[i].body();
+      r.error = errorAgainstReference(src, dst, *cases[i].source_of);
+      r.has_error = true;
+    }
+    rows.push_back(r);
+  }
 
   auto find = [&](const char* path, const char* name) -> const Row& {
     for (const Row& r : rows)
