@@ -122,7 +122,8 @@ tl::expected<LatencyArgs, std::string> parseLatencyArgs(const json& request,
   a.timeout_s = defaults.latency_timeout_s;
   a.margin_frames = defaults.margin_frames;
   static const char* const kKeys[] = {"output", "cameras", "repeats", "timeout_s", "margin_frames"};
-  for (const auto& [key, value] : request.items()) {
+  for (const auto& item : request.items()) {
+    const std::string& key = item.key();
     if (key == "cmd" || key == "id") continue;
     if (std::none_of(std::begin(kKeys), std::end(kKeys), [&](const char* k) { return key == k; })) {
       return tl::unexpected("unknown argument \"" + key + "\" for latency");
