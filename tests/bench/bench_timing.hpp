@@ -27,4 +27,24 @@ inline Timing measure(int runs, const std::function<void()>& body,
   return {ms[ms.size() / 2], ms.front()};
 }
 
+// The bodies timed in turn, `runs` rounds of one call each (every call preceded by
+// untimed_before): a load that comes and goes on a shared machine falls on all of them
+// alike, so their ratios hold better than those of back-to-back measure() calls.
+inline std::vector<Timing> measureInterleaved(int runs,
+                                              const std::vector<std::function<void()>>& bodies,
+                                              const std::function<void()>& untimed_before = {}) {
+  std::vector<std::vector<double>> ms(bodies.size());
+  for (int i = 0; i < std::max(1, runs); ++i) {
+    for (size_t b = 0; b < bodies.size(); ++b) {
+      ms[b].push_back(measure(1, bodies[b], untimed_before).median_ms);
+    }
+  }
+  std::vector<Timing> out;
+  for (auto& m : ms) {
+    std::sort(m.begin(), m.end());
+    out.push_back({m[m.size() / 2], m.front()});
+  }
+  return out;
+}
+
 }  // namespace procam::bench
