@@ -15,7 +15,8 @@
 // pixel inside the source, where every implementation reads real texels.
 //  - GLES 3 on the surfaceless EGL platform (Mesa llvmpipe here), per render path: frames
 //    per second with content upload + draw + glFinish ("render"), and the same plus
-//    glReadPixels of the frame ("render + read-back").
+//    glReadPixels of the frame ("render + read-back"); and the CPU renderer's planar 3D path
+//    on the same triangles, on one thread and on all.
 // Writes render_cpu.csv and render_gles.csv to --out DIR.
 //
 //   bench_render [--out DIR] [--runs N]
@@ -35,6 +36,7 @@
 
 #include "bench_timing.hpp"
 #include "render/bilinear.hpp"
+#include "render/cpu_renderer.hpp"
 #include "render/packed_map.hpp"
 #include "render/remap_rgba.hpp"
 #include "render/warp_homography.hpp"
@@ -245,6 +247,17 @@ void benchGles(const std::filesystem::path& out, cv::Size size, const cv::Mat& s
                 c.path, render.median_ms, 1000 / render.median_ms, readback.median_ms,
                 1000 / readback.median_ms);
   }
+  // The CPU back-end's planar 3D path on the same triangles, one thread and all.
+  const int threads = cv::getNumThreads();
+  for (int n : {1, threads}) {
+    cv::setNumThreads(n);
+    render::CpuRenderer cpu;
+    if (!cpu.configure(cases.back().setup)) continue;
+    const Timing t = measure(runs, [&] { (void)cpu.render({nullptr, &triangles, ++version}); });
+    std::printf("  CPU planar3d, %d thread(s): %7.2f ms %6.1f fps\n", n, t.median_ms,
+                1000 / t.median_ms);
+  }
+  cv::setNumThreads(threads);
 }
 #endif
 
