@@ -90,8 +90,9 @@ void clipTriangle(const std::array<ClipVertex, 3>& tri, cv::Size size,
   }
 }
 
+// Round to nearest, as GL's conversion of a normalised float to 8 bits.
 uint8_t toUnorm8(float v) {
-  return static_cast<uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
+  return static_cast<uint8_t>(std::clamp(v, 0.0f, 1.0f) * 255.0f + 0.5f);
 }
 
 }  // namespace
@@ -143,7 +144,7 @@ Result<void> rasterizeColoredMesh(const ColoredMesh& mesh, const Mat4& pixel3d, 
                 d = z;
                 const float iw = w0 * s.inv_w[0] + w1 * s.inv_w[1] + w2 * s.inv_w[2];
                 const cv::Vec4f c =
-                    (w0 * s.color_iw[0] + w1 * s.color_iw[1] + w2 * s.color_iw[2]) / iw;
+                    (w0 * s.color_iw[0] + w1 * s.color_iw[1] + w2 * s.color_iw[2]) * (1.0f / iw);
                 cv::Vec4b& o = color.at<cv::Vec4b>(y, x);
                 for (int k = 0; k < 4; ++k) o[k] = toUnorm8(c[k]);
               });
