@@ -1,0 +1,195 @@
+// 3D content on the virtual rig: `content load` of an OBJ cube on `wall_oblique` (a
+// planar wall, the scene's viewer) is drawn through the planar 3D path, and the output's
+// statistics (status.outputs.shown) match a double-precision ray cast of the placed cube
+// seen by the viewer (seed §4.2.1: a projector pixel shows what the viewer's ray through
+// that pixel's wall point meets). A non-planar surface makes the load `unavailable`.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "content/mesh_placement.hpp"
+#include "daemon_harness.hpp"
+#include "sim/scene_library.hpp"
+
+namespace procam::itest {
+namespace {
+
+DaemonProcess::Launch sim(const std::string& scene) {
+  return DaemonProcess::Launch{{"--sim", scene}, {}, -1, true};
+}
+
+const char* kCubeObj = R"(# unit cube
+v -1 -1 -1
+v 1 -1 -1
+v 1 1 -1
+v -1 1 -1
+v -1 -1 1
+v 1 -1 1
+v 1 1 1
+v -1 1 1
+f 1 3 2
+f 1 4 3
+f 5 6 7
+f 5 7 8
+f 1 2 6
+f 1 6 5
+f 4 7 3
+f 4 8 7
+f 1 5 8
+f 1 8 4
+f 2 3 7
+f 2 7 6
+)";
+
+json shownStats(Connection& c) {
+  auto s = c.call({{"cmd", "status"}});
+  if (!s || (*s)["outputs"]["shown"].empty()) return nullptr;
+  return (*s)["outputs"]["shown"][0];
+}
+
+struct Expected {
+  double lit = 0, mean = 0;  // lit fraction, mean grey level (0..255)
+  double boundary = 0;       // fraction of pixels next to a change of the visible face
+};
+
+// Ray cast in double over every projector pixel: wall point, viewer ray, nearest face,
+// Lambert grey of that face as documented in content/mesh_placement.hpp.
+Expected rayCast(const content::PlacedMesh& placed, const Mat34& P, cv::Size size,
+                 const Vec3& eye) {
+  const Mat3 Minv = P.leftCols<3>().inverse();
+  const Vec3 C = -Minv * P.col(3);
+  const keystone::DisplayRect& S = placed.S;
+  const Vec3 n = S.u.cross(S.v);
+  const Vec3 light = (-0.3 * S.u + 0.5 * S.v + 0.8 * n).normalized();
+  const auto& m = placed.mesh;
+  cv::Mat face(size, CV_32S, cv::Scalar(-1));
+  Expected e;
+  for (int y = 0; y < size.height; ++y) {
+    for (int x = 0; x < size.width; ++x) {
+      const Vec3 d = Minv * Vec3(x, y, 1);
+      const Vec3 wall = C + (n.dot(S.corner - C) / n.dot(d)) * d;
+      const Vec3 D = wall - eye;
+      double best = INFINITY;
+      for (size_t t = 0; t < m.triangles.size(); ++t) {
+        const Vec3 &a = m.vertices[m.triangles[t][0]], &b = m.vertices[m.triangles[t][1]],
+                   &c = m.vertices[m.triangles[t][2]];
+        const Vec3 e1 = b - a, e2 = c - a, p = D.cross(e2);
+        const double det = e1.dot(p);
+        if (std::abs(det) < 1e-15) continue;
+        const Vec3 s = eye - a, q = s.cross(e1);
+        const double beta = s.dot(p) / det, gamma = D.dot(q) / det, l = e2.dot(q) / det;
+        if (beta < 0 || gamma < 0 || beta + gamma > 1 || l <= 0 || l >= best) continue;
+        best = l;
+        face.at<int>(y, x) = static_cast<int>(t);
+      }
+      if (face.at<int>(y, x) < 0) continue;
+      const auto& tri = m.triangles[face.at<int>(y, x)];
+      const Vec3 normal = (m.vertices[tri[1]] - m.vertices[tri[0]])
+                              .cross(m.vertices[tri[2]] - m.vertices[tri[0]])
+                              .normalized();
+      e.lit += 1;
+      e.mean +=
+          255 * (content::kMeshAmbient + (1 - content::kMeshAmbient) * std::abs(normal.dot(light)));
+    }
+  }
+  // Pixels whose right or lower neighbour shows another face (or none): where two
+  // rasterizations may legitimately differ by one pixel.
+  for (int y = 0; y + 1 < size.height; ++y) {
+    for (int x = 0; x + 1 < size.width; ++x) {
+      const int f = face.at<int>(y, x);
+      e.boundary += f != face.at<int>(y, x + 1) || f != face.at<int>(y + 1, x);
+    }
+  }
+  const double total = static_cast<double>(size.area());
+  e.lit /= total;
+  e.mean /= total;
+  e.boundary /= total;
+  return e;
+}
+
+TEST(SimMeshContent, ObjCubeOnTheObliqueWallIsDrawnForTheSceneViewer) {
+  TempDir dir;
+  dir.write("cube.obj", kCubeObj);
+  DaemonProcess d(dir, sim("wall_oblique"));
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  ASSERT_EQ((*c.call({{"cmd", "pattern"}, {"name", "off"}}))["pattern"], "off");
+  auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", dir.file("cube.obj")}}, 30s);
+  ASSERT_TRUE(load);
+  ASSERT_EQ((*load)["class"], "CONTENT") << load->dump();
+  const json info = (*load)["content"];
+  EXPECT_EQ(info["path"], dir.file("cube.obj"));
+  EXPECT_EQ(info["mesh"]["triangles"], 12);
+  EXPECT_EQ(info["mesh"]["viewer"]["source"], "scene");
+  json shown;
+  ASSERT_TRUE(eventually(
+      [&] {
+        shown = shownStats(c);
+        return shown.is_object() && shown["source"] == "content" &&
+               shown["lit_fraction"].get<double>() > 0;
+      },
+      20s))
+      << shown.dump();
+
+  // The truth: the scene at time 0, the cube placed by the documented rule.
+  auto scene = sim::resolveScene("wall_oblique");
+  ASSERT_TRUE(scene);
+  const sim::SceneState state = scene->at(0);
+  const geom::CameraModel& proj = state.projector("proj")->model;
+  auto cube = content::loadMeshContent(dir.file("cube.obj"));
+  ASSERT_TRUE(cube);
+  content::PlanarView view;
+  view.projector = proj.projectionMatrix();
+  view.size = {proj.width, proj.height};
+  view.plane_point = Vec3(0, 3, 1.5);  // the wall: y = 3, normal -Y
+  view.plane_normal = Vec3(0, -1, 0);
+  view.eye = scene->viewerPosition(0);
+  auto placed = content::placeMeshContent(*cube, view);
+  ASSERT_TRUE(placed) << placed.error().message;
+  // Placement: the back of the cube on the wall, centred on S, half S's smaller side wide.
+  double y_max = -INFINITY, y_min = INFINITY;
+  for (const Vec3& p : placed->mesh.vertices)
+    y_max = std::max(y_max, p.y()), y_min = std::min(y_min, p.y());
+  EXPECT_NEAR(y_max, 3.0, 1e-9);
+  EXPECT_LT(y_min, 3.0 - 0.05);
+
+  const Expected e = rayCast(*placed, view.projector, view.size, view.eye);
+  const double lit = shown["lit_fraction"].get<double>();
+  std::printf("cube: lit %.5f (ray cast %.5f), mean grey %.3f (ray cast %.3f), edge band %.5f\n",
+              lit, e.lit, shown["mean_rgb"][0].get<double>(), e.mean, e.boundary);
+  ASSERT_GT(e.lit, 0.01);  // the cube is in view
+  // Every pixel off the edge band is decided alike; a pixel of the band may flip,
+  // changing the lit fraction by one pixel and the mean by at most 255 per pixel, plus
+  // the rounding of each shade to an integer (0.5).
+  EXPECT_NEAR(lit, e.lit, e.boundary);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(shown["mean_rgb"][k].get<double>(), e.mean, 255 * e.boundary + 0.5) << k;
+  }
+
+  auto get = c.call({{"cmd", "content"}});
+  EXPECT_EQ((*get)["content"]["mesh"]["triangles"], 12);
+  ASSERT_TRUE(c.call({{"cmd", "content"}, {"action", "clear"}}));
+  ASSERT_TRUE(eventually([&] { return shownStats(c)["source"] == "none"; }));
+}
+
+TEST(SimMeshContent, NonPlanarSurfaceIsUnavailable) {
+  TempDir dir;
+  dir.write("cube.obj", kCubeObj);
+  DaemonProcess d(dir, sim("dome3"));
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", dir.file("cube.obj")}}, 30s);
+  ASSERT_TRUE(load);
+  EXPECT_EQ((*load)["class"], "ERROR") << load->dump();
+  EXPECT_EQ((*load)["code"], "unavailable") << load->dump();
+  EXPECT_NE((*load)["message"].get<std::string>().find("not planar"), std::string::npos)
+      << load->dump();
+  // A missing file is an I/O error, not `unavailable`.
+  auto missing =
+      c.call({{"cmd", "content"}, {"action", "load"}, {"path", dir.file("none.obj")}}, 30s);
+  ASSERT_TRUE(missing);
+  EXPECT_EQ((*missing)["code"], "io-error") << missing->dump();
+}
+
+}  // namespace
+}  // namespace procam::itest
