@@ -87,8 +87,8 @@ void Daemon::setupTrackers() {
   device_manager_->onReading([this](const DeviceEntry& e, const Reading& r) {
     if (const auto* pose = std::get_if<procam_pose_sample>(&r)) {
       onTrackerSample(e.name, *pose);
-    } else if (const auto* image = std::get_if<procam_image>(&r)) {
-      trackers_.stats[e.name].add(image->timestamp_ns);
+    } else if (const auto* frame = std::get_if<CameraFrame>(&r)) {
+      trackers_.stats[e.name].add(frame->timestamp_ns);
     }
   });
   device_manager_->onDeviceAdded([this](const DeviceEntry&) { syncTrackerPolls(); });

@@ -19,6 +19,37 @@ std::string describeFamily(const DeviceEntry& e) {
 
 }  // namespace
 
+DeviceManager::ReadResult DeviceManager::readOnce(const procam_device& raw, procam_family family) {
+  ReadResult r;
+  std::array<char, 256> err{};
+  switch (family) {
+    case PROCAM_FAMILY_TILT: {
+      procam_tilt_sample s{};
+      r.rc = raw.ops.tilt->read(raw.self, &s, err.data(), err.size() - 1);
+      r.reading = s;
+      break;
+    }
+    case PROCAM_FAMILY_TRACKER: {
+      procam_pose_sample s{};
+      r.rc = raw.ops.tracker->read(raw.self, &s, err.data(), err.size() - 1);
+      r.reading = s;
+      break;
+    }
+    case PROCAM_FAMILY_CAMERA: {
+      procam_image img{};
+      r.rc = raw.ops.camera->capture(raw.self, 0, &img, err.data(), err.size() - 1);
+      r.reading = CameraFrame{img.width, img.height, img.format, img.timestamp_ns};
+      break;
+    }
+    case PROCAM_FAMILY_OUTPUT:
+      break;
+  }
+  if (r.rc != PROCAM_OK) {
+    r.reason = err[0] ? err.data() : "read failed (code " + std::to_string(r.rc) + ")";
+  }
+  return r;
+}
+
 DeviceManager::DeviceManager(EventLoop& loop, const plugins::DriverRegistry& registry,
                              DeviceSet& devices, EventSink emit, WarnSink warn)
     : loop_(loop),
@@ -26,10 +57,12 @@ DeviceManager::DeviceManager(EventLoop& loop, const plugins::DriverRegistry& reg
       devices_(devices),
       emit_(std::move(emit)),
       warn_(std::move(warn)),
-      opener_(std::make_unique<WorkerPool>(loop, 1)) {}
+      opener_(std::make_unique<WorkerPool>(loop, 1)),
+      reader_(std::make_unique<WorkerPool>(loop, 1)) {}
 
 DeviceManager::~DeviceManager() {
   opener_.reset();
+  reader_.reset();  // a read still running ends first; its result is dropped
   *alive_ = false;
   for (const auto& [name, fd] : watched_) loop_.remove(fd);
   for (const auto& [id, name] : polls_) loop_.removeTimer(id);
@@ -293,7 +326,8 @@ void DeviceManager::watchFd(const DeviceEntry& e) {
   // Outputs have no read operation in the ABI: their fds stay with the driver.
   if (!e.usable() || e.description.family == PROCAM_FAMILY_OUTPUT) return;
   const int fd = e.device.pollFd();
-  if (fd < 0 || watched_.count(e.name)) return;
+  // A device being read is watched again when its result is back.
+  if (fd < 0 || watched_.count(e.name) || reading_.count(e.name)) return;
   const std::string name = e.name;
   if (auto ok = loop_.add(fd, EPOLLIN, [this, name](uint32_t) { readEntry(name); }); !ok) {
     warn_("device '" + name + "': cannot watch its fd: " + ok.error().message);
@@ -346,40 +380,82 @@ bool DeviceManager::readEntry(const std::string& name) {
     unwatchFd(name);
     return false;
   }
-  const procam_device& raw = e->device.raw();
-  std::array<char, 256> err{};
-  int rc = PROCAM_ENOTSUP;
-  Reading reading;
   switch (e->description.family) {
-    case PROCAM_FAMILY_TILT: {
-      procam_tilt_sample s{};
-      rc = raw.ops.tilt->read(raw.self, &s, err.data(), err.size() - 1);
-      reading = s;
-      break;
-    }
-    case PROCAM_FAMILY_TRACKER: {
-      procam_pose_sample s{};
-      rc = raw.ops.tracker->read(raw.self, &s, err.data(), err.size() - 1);
-      reading = s;
-      break;
-    }
-    case PROCAM_FAMILY_CAMERA: {
-      procam_image img{};
-      rc = raw.ops.camera->capture(raw.self, 0, &img, err.data(), err.size() - 1);
-      reading = img;
-      break;
-    }
     case PROCAM_FAMILY_OUTPUT:
       return false;
+    case PROCAM_FAMILY_TILT:
+      return deliver(name, readOnce(e->device.raw(), PROCAM_FAMILY_TILT));
+    case PROCAM_FAMILY_TRACKER:
+    case PROCAM_FAMILY_CAMERA:
+      if (reading_.count(name)) return false;  // one read per device at a time
+      startRead(*e);
+      return true;
   }
-  if (rc != PROCAM_OK) {
-    report(name, rc, err[0] ? err.data() : "read failed (code " + std::to_string(rc) + ")");
+  return false;
+}
+
+void DeviceManager::startRead(DeviceEntry& e) {
+  const std::string name = e.name;
+  auto ticket = std::make_shared<ReadTicket>();
+  reading_[name] = ticket;
+  unwatchFd(name);
+  // The worker's share keeps the device alive if the loop closes it meanwhile.
+  reader_->submit([this, name, ticket, device = e.device.share(),
+                   family = e.description.family]() -> WorkerPool::Completion {
+    auto result = std::make_shared<ReadResult>();
+    if (ticket->begin()) {
+      *result = readOnce(device->raw(), family);
+      ticket->end();
+    } else {
+      result->withdrawn = true;
+    }
+    return guarded(
+        [this, name, ticket, device, result] { finishRead(name, ticket, device, *result); });
+  });
+}
+
+void DeviceManager::finishRead(const std::string& name, const std::shared_ptr<ReadTicket>& ticket,
+                               const std::shared_ptr<plugins::Device>& device,
+                               const ReadResult& result) {
+  if (auto it = reading_.find(name); it != reading_.end() && it->second == ticket) {
+    reading_.erase(it);
+  }
+  DeviceEntry* e = devices_.find(name);
+  if (!e || !e->usable()) return;
+  // Re-armed, also when the entry holds a device reopened meanwhile.
+  if (gateOpen(name)) {
+    watchFd(*e);
+  } else if (e->device.pollFd() >= 0) {
+    gated_.insert(name);  // the presence check watches it again when the gate opens
+  }
+  // A reading of a device closed or reopened while it was read is dropped:
+  // the set no longer holds that device (a loss was reported when noticed).
+  if (result.withdrawn || e->device.share() != device) return;
+  deliver(name, result);
+}
+
+bool DeviceManager::deliver(const std::string& name, const ReadResult& result) {
+  if (result.rc != PROCAM_OK) {
+    report(name, result.rc, result.reason);
     return false;
   }
+  const DeviceEntry* e = devices_.find(name);
+  if (!e) return false;
   // Hooks may change the set: hand them a copy of the list and look nothing up after.
   const auto hooks = on_reading_;
-  for (const auto& h : hooks) h(*e, reading);
+  for (const auto& h : hooks) h(*e, result.reading);
   return true;
+}
+
+ReadFence DeviceManager::readFence(const std::vector<std::string>& names) {
+  std::vector<std::shared_ptr<ReadTicket>> tickets;
+  for (const auto& n : names) {
+    if (auto it = reading_.find(n); it != reading_.end()) {
+      it->second->withdraw();
+      tickets.push_back(it->second);
+    }
+  }
+  return ReadFence(std::move(tickets));
 }
 
 Result<int> DeviceManager::pollEvery(const std::string& name, std::chrono::nanoseconds interval) {
@@ -407,7 +483,7 @@ void DeviceManager::presenceCheck() {
   for (const auto& e : devices_.entries()) {
     const auto family = e.description.family;
     if (!e.usable() || family == PROCAM_FAMILY_OUTPUT || watched_.count(e.name) ||
-        gated_.count(e.name)) {
+        gated_.count(e.name) || reading_.count(e.name)) {
       continue;
     }
     if (family == PROCAM_FAMILY_CAMERA) {
@@ -424,7 +500,8 @@ void DeviceManager::presenceCheck() {
 
 void DeviceManager::checkCameraPresence(const std::string& name) {
   DeviceEntry* e = devices_.find(name);
-  if (!e || !e->usable() || !gateOpen(name)) return;
+  // A capture on the reader worker is a presence check of its own.
+  if (!e || !e->usable() || !gateOpen(name) || reading_.count(name)) return;
   const procam_device& raw = e->device.raw();
   uint32_t w = 0, h = 0;
   procam_pixel_format format{};

@@ -2,9 +2,12 @@
 // The device manager: finds procamd's devices with libudev at start, follows
 // hotplug through a udev monitor watched by the event loop, watches device
 // fds, and closes devices that fail with PROCAM_ENODEV ("lost") and reopens
-// them with back-off. Every method runs on the loop thread; only driver
-// create() calls for hotplugged and lost devices run on the manager's own
-// worker, so a slow open never blocks the loop.
+// them with back-off. Every method runs on the loop thread; driver create()
+// calls for hotplugged and lost devices run on the manager's opener worker and
+// tracker reads and camera captures on its reader worker (a tracker read may
+// detect blobs and search poses for a hundred milliseconds), so neither a slow
+// open nor a slow read blocks the loop. Tilt reads are cheap and stay on the
+// loop.
 #include <chrono>
 #include <functional>
 #include <map>
@@ -17,6 +20,7 @@
 
 #include "device_set.hpp"
 #include "event_loop.hpp"
+#include "read_fence.hpp"
 #include "registry.hpp"
 #include "udev_device.hpp"
 #include "worker_pool.hpp"
@@ -26,9 +30,18 @@ namespace procam::daemon {
 class Udev;
 class UdevMonitor;
 
-// What a device produced when read. A camera's image points into the
-// driver's buffer, valid only during the callback.
-using Reading = std::variant<procam_tilt_sample, procam_pose_sample, procam_image>;
+// A camera frame as the manager reports it: its metadata only. The pixels
+// live in the driver's buffer, valid only until the next capture, which the
+// reader worker may already be running when the loop sees the frame.
+struct CameraFrame {
+  uint32_t width = 0;
+  uint32_t height = 0;
+  procam_pixel_format format{};
+  uint64_t timestamp_ns = 0;  // CLOCK_MONOTONIC
+};
+
+// What a device produced when read.
+using Reading = std::variant<procam_tilt_sample, procam_pose_sample, CameraFrame>;
 
 struct DeviceManagerOptions {
   // Enumerate with libudev and follow hotplug (off on the virtual rig, whose
@@ -71,7 +84,8 @@ class DeviceManager {
   void onDeviceAdded(DeviceCallback callback);
   void onDeviceRemoved(DeviceCallback callback);
   // Every sample or frame the manager reads: on a readable device fd, from
-  // pollEvery() and from the presence reads.
+  // pollEvery() and from the presence reads. Always on the loop thread, also
+  // for the reads done on the reader worker.
   void onReading(ReadingCallback callback);
   // Devices an operation uses on its own thread (calibrate's cameras) must not
   // be read by the manager meanwhile: while `may_read(name)` is false the
@@ -79,9 +93,16 @@ class DeviceManager {
   // the loop (readable, it would wake the loop forever) until the next
   // presence check finds the gate open again.
   void setReadGate(std::function<bool(const std::string& name)> may_read);
+  // Call on the loop in the same turn as the gate closes for `names` (no read
+  // can start in between); wait on the fence on the operation's worker before
+  // its first call on those devices: a read running on the reader worker
+  // finishes first, one still queued is dropped (read_fence.hpp).
+  ReadFence readFence(const std::vector<std::string>& names);
 
-  // Reads a tilt sensor, tracker or camera (capture with timeout 0) once and
-  // hands the reading to the onReading hooks; false when nothing was read.
+  // Reads a tilt sensor at once, or starts a tracker read or camera capture
+  // (timeout 0) on the reader worker, at most one per device at a time; the
+  // reading reaches the onReading hooks on the loop. False when no read was
+  // done or started (gate closed, not usable, one in flight, read failed).
   bool read(const std::string& name);
   // Reads a device by timer (for devices whose poll fd is -1); returns an id
   // for stopPolling().
@@ -111,6 +132,18 @@ class DeviceManager {
   void watchFd(const DeviceEntry& entry);
   void unwatchFd(const std::string& name);
   bool readEntry(const std::string& name);
+  struct ReadResult {
+    int rc = PROCAM_ENOTSUP;
+    std::string reason;  // the driver's message when rc is not PROCAM_OK
+    Reading reading;
+    bool withdrawn = false;  // fenced before it started: nothing was read
+  };
+  // One driver call; on the loop for tilt sensors, on the reader worker otherwise.
+  static ReadResult readOnce(const procam_device& raw, procam_family family);
+  void startRead(DeviceEntry& entry);
+  void finishRead(const std::string& name, const std::shared_ptr<ReadTicket>& ticket,
+                  const std::shared_ptr<plugins::Device>& device, const ReadResult& result);
+  bool deliver(const std::string& name, const ReadResult& result);
   bool gateOpen(const std::string& name) const { return !may_read_ || may_read_(name); }
   void checkCameraPresence(const std::string& name);
   void presenceCheck();
@@ -134,6 +167,10 @@ class DeviceManager {
   std::map<int, std::string> polls_;    // pollEvery timer id -> device name
   std::set<std::string> gated_;         // fds taken out of the loop by the read gate
   std::set<std::string> pending_;       // syspaths being opened on the worker
+  // Devices with a read on the reader worker: their fds are out of the loop
+  // (level-triggered, a readable fd would wake it over and over) until the
+  // result is back.
+  std::map<std::string, std::shared_ptr<ReadTicket>> reading_;
   struct Retry {
     uint64_t token = 0;
     int timer = -1;  // -1 while the attempt runs on the worker
@@ -142,7 +179,11 @@ class DeviceManager {
   uint64_t next_token_ = 1;
   int presence_timer_ = -1;
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
-  std::unique_ptr<WorkerPool> opener_;  // last: joined first on destruction
+  std::unique_ptr<WorkerPool> opener_;  // joined first on destruction
+  // One thread: reads of different devices queue behind each other, which
+  // costs at most one slow read of latency on two cores and keeps every
+  // driver single-threaded.
+  std::unique_ptr<WorkerPool> reader_;
 };
 
 }  // namespace procam::daemon

@@ -1,14 +1,18 @@
 #pragma once
 // Drivers for device-manager tests: tilt sensors that can be "unplugged"
 // (every call returns PROCAM_ENODEV while fake::gone is set) and that expose
-// a pipe as poll fd when created with the option fd=pipe.
+// a pipe as poll fd when created with the option fd=pipe; and slow trackers
+// whose read blocks while fake::hold is set (as a blob search would), with
+// counters of the reads running at once.
 #include <fcntl.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <string>
+#include <thread>
 
 #include "procamd/procam_plugin.h"
 #include "registry.hpp"
@@ -22,6 +26,21 @@ inline std::string property(const procam_device_desc* d, const char* key) {
     if (std::strcmp(d->properties[i].key, key) == 0) return d->properties[i].value;
   }
   return {};
+}
+
+inline bool hasOption(const procam_config* c, const char* key, const char* value) {
+  for (size_t i = 0; i < c->n_options; ++i) {
+    if (std::strcmp(c->options[i].key, key) == 0 && std::strcmp(c->options[i].value, value) == 0) {
+      return true;
+    }
+  }
+  return false;
+}
+
+inline void closePipe(int (&pipe)[2]) {
+  for (int fd : pipe) {
+    if (fd >= 0) ::close(fd);
+  }
 }
 
 struct Tilt {
@@ -49,9 +68,7 @@ inline int tiltFd(void* self) {
 }
 inline void tiltDestroy(void* self) {
   auto* t = static_cast<Tilt*>(self);
-  for (int fd : t->pipe) {
-    if (fd >= 0) ::close(fd);
-  }
+  closePipe(t->pipe);
   delete t;
 }
 
@@ -72,13 +89,9 @@ inline int createTilt(const procam_device_desc*, const procam_config* config, pr
     return PROCAM_ENODEV;
   }
   auto* t = new Tilt;
-  for (size_t i = 0; i < config->n_options; ++i) {
-    if (std::strcmp(config->options[i].key, "fd") == 0 &&
-        std::strcmp(config->options[i].value, "pipe") == 0 &&
-        ::pipe2(t->pipe, O_NONBLOCK | O_CLOEXEC) != 0) {
-      delete t;
-      return PROCAM_EIO;
-    }
+  if (hasOption(config, "fd", "pipe") && ::pipe2(t->pipe, O_NONBLOCK | O_CLOEXEC) != 0) {
+    delete t;
+    return PROCAM_EIO;
   }
   out->family = PROCAM_FAMILY_TILT;
   out->self = t;
@@ -88,9 +101,85 @@ inline int createTilt(const procam_device_desc*, const procam_config* config, pr
   return PROCAM_OK;
 }
 
+// Slow trackers. A read started while `hold` is set blocks until it is
+// cleared (at most 10 s, so a failing test cannot hang).
+inline std::atomic<bool> hold{false};
+inline std::atomic<int> reads_running{0};       // over every tracker
+inline std::atomic<int> most_reads_running{0};  // the peak of reads_running
+inline std::atomic<int> destroyed_mid_read{0};  // destroy() while a read of it ran
+inline std::atomic<int> trackers_destroyed{0};
+
+struct Tracker {
+  int pipe[2] = {-1, -1};     // option fd=readable: a pipe that stays readable
+  std::atomic<int> reads{0};  // reads started
+  std::atomic<bool> in_read{false};
+};
+
+inline int trackerRead(void* self, procam_pose_sample* out, char* err, size_t len) {
+  auto* t = static_cast<Tracker*>(self);
+  t->in_read = true;
+  const int n = ++t->reads;
+  const int running = ++reads_running;
+  for (int peak = most_reads_running; running > peak;) {
+    if (most_reads_running.compare_exchange_weak(peak, running)) break;
+  }
+  const auto limit = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (hold && std::chrono::steady_clock::now() < limit) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  --reads_running;
+  t->in_read = false;
+  if (gone) {
+    std::snprintf(err, len, "fake tracker unplugged");
+    return PROCAM_ENODEV;
+  }
+  out->position[0] = n;  // the read's number identifies the sample
+  out->orientation[0] = 1;
+  out->timestamp_ns = static_cast<uint64_t>(n);
+  return PROCAM_OK;
+}
+inline const procam_tracker_ops kTrackerOps = {trackerRead};
+
+inline int trackerFd(void* self) {
+  return static_cast<Tracker*>(self)->pipe[0];
+}
+inline void trackerDestroy(void* self) {
+  auto* t = static_cast<Tracker*>(self);
+  if (t->in_read) ++destroyed_mid_read;
+  ++trackers_destroyed;
+  closePipe(t->pipe);
+  delete t;
+}
+
+inline int probeTracker(const procam_device_desc* d) {
+  return property(d, "PROCAM_ROLE") == "tracker" ? 10 : 0;
+}
+
+inline int createTracker(const procam_device_desc*, const procam_config* config, procam_device* out,
+                         char* err, size_t len) {
+  if (gone) {
+    std::snprintf(err, len, "no such device");
+    return PROCAM_ENODEV;
+  }
+  auto* t = new Tracker;
+  if (hasOption(config, "fd", "readable") &&
+      (::pipe2(t->pipe, O_NONBLOCK | O_CLOEXEC) != 0 || ::write(t->pipe[1], "x", 1) != 1)) {
+    closePipe(t->pipe);
+    delete t;
+    return PROCAM_EIO;
+  }
+  out->family = PROCAM_FAMILY_TRACKER;
+  out->self = t;
+  out->poll_fd = trackerFd;
+  out->destroy = trackerDestroy;
+  out->ops.tracker = &kTrackerOps;
+  return PROCAM_OK;
+}
+
 inline const procam_driver_factory kFactories[] = {
     {PROCAM_FAMILY_TILT, "generic-tilt", "weak match", probeGeneric, createTilt},
     {PROCAM_FAMILY_TILT, "fake-tilt", "test tilt sensor", probeTilt, createTilt},
+    {PROCAM_FAMILY_TRACKER, "slow-tracker", "test tracker", probeTracker, createTracker},
 };
 
 inline plugins::DriverRegistry registry() {

@@ -1,13 +1,17 @@
 // The device manager: udev records -> descriptions, matching, hotplug
 // add/remove (the handler called directly: no udev daemon here), device fds
-// in the loop, lost devices and their reopening.
+// in the loop, lost devices and their reopening, tracker reads on the reader
+// worker and the fence that hands a device to calibrate.
 #include <gtest/gtest.h>
+#include <sys/epoll.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cstdlib>
 #include <fstream>
 #include <regex>
 #include <set>
+#include <thread>
 
 #include "device_manager.hpp"
 #include "fake_drivers.hpp"
@@ -27,6 +31,14 @@ UdevRecord iioTilt(const std::string& sysname = "iio:device0") {
   r.devnode = "/dev/" + sysname;
   r.syspath = "/sys/devices/platform/accel/" + sysname;
   r.properties = {{"DEVNAME", r.devnode}, {"PROCAM_ROLE", "tilt"}, {"ID_VENDOR_ID", "abcd"}};
+  return r;
+}
+
+UdevRecord hidTracker(const std::string& sysname = "hidraw7") {
+  UdevRecord r = iioTilt(sysname);
+  r.subsystem = "hidraw";
+  r.syspath = "/sys/devices/usb/" + sysname;
+  r.properties = {{"DEVNAME", r.devnode}, {"PROCAM_ROLE", "tracker"}};
   return r;
 }
 
@@ -93,6 +105,11 @@ class ManagerTest : public ::testing::Test {
  protected:
   void SetUp() override {
     fake::gone = false;
+    fake::hold = false;
+    fake::reads_running = 0;
+    fake::most_reads_running = 0;
+    fake::destroyed_mid_read = 0;
+    fake::trackers_destroyed = 0;
     loop_ = std::move(*EventLoop::create());
     manager_ = std::make_unique<DeviceManager>(
         *loop_, registry_, devices_,
@@ -103,6 +120,7 @@ class ManagerTest : public ::testing::Test {
         [this](const std::string& m) { warnings_.push_back(m); });
   }
   void TearDown() override {
+    fake::hold = false;  // a read still blocked would hold up the reader's join
     manager_.reset();
     fake::gone = false;
   }
@@ -350,6 +368,155 @@ TEST_F(ManagerTest, AWorkersShareOutlivesAnUnplug) {
   char err[64] = {};
   EXPECT_EQ(held->raw().ops.tilt->read(held->raw().self, &s, err, sizeof err), PROCAM_OK);
   EXPECT_DOUBLE_EQ(s.specific_force[2], 9.81);
+}
+
+fake::Tracker* trackerState(DeviceSet& devices, const std::string& name) {
+  return static_cast<fake::Tracker*>(devices.find(name)->device.raw().self);
+}
+
+TEST_F(ManagerTest, SlowTrackerReadRunsOffTheLoopOneAtATime) {
+  devices_.open(registry_, *describeUdevDevice(iioTilt()), "", {{"fd", "pipe"}});
+  devices_.open(registry_, *describeUdevDevice(hidTracker()), "", {{"fd", "readable"}});
+  ASSERT_TRUE(devices_.find("hidraw7")->usable());
+  fake::Tracker* tracker = trackerState(devices_, "hidraw7");
+  const int tracker_fd = tracker->pipe[0];
+  fake::hold = true;  // the tracker's first read blocks until released
+  startWithoutUdev(60000ms);
+  std::vector<double> tilts, poses;
+  manager_->onReading([&](const DeviceEntry& e, const Reading& r) {
+    if (const auto* t = std::get_if<procam_tilt_sample>(&r)) tilts.push_back(t->specific_force[0]);
+    if (const auto* p = std::get_if<procam_pose_sample>(&r)) {
+      EXPECT_EQ(e.name, "hidraw7");
+      poses.push_back(p->position[0]);
+    }
+  });
+  int ticks = 0;
+  auto ticker = loop_->addTimer(5ms, true, [&] { ++ticks; });
+  ASSERT_TRUE(ticker);
+  const char samples[] = {1, 2, 3};
+  const int tilt_wfd =
+      static_cast<fake::Tilt*>(devices_.find("iio:device0")->device.raw().self)->pipe[1];
+  ASSERT_EQ(::write(tilt_wfd, samples, 3), 3);
+  // The loop serves the tilt sensor and a timer while the tracker read is blocked.
+  ASSERT_TRUE(
+      runUntil([&] { return tilts.size() == 3 && ticks >= 3 && fake::reads_running == 1; }));
+  EXPECT_EQ(tilts, (std::vector<double>{1, 2, 3}));
+  EXPECT_TRUE(poses.empty());
+  // Readable all along, the tracker's fd is out of the loop during its read
+  // and no second read starts.
+  EXPECT_FALSE(loop_->modify(tracker_fd, EPOLLIN));
+  EXPECT_FALSE(manager_->read("hidraw7"));
+  EXPECT_EQ(tracker->reads, 1);
+  fake::hold = false;
+  // Released: each result re-arms the fd, so reads follow one after another.
+  ASSERT_TRUE(runUntil([&] { return poses.size() >= 5; }));
+  EXPECT_EQ(std::vector<double>(poses.begin(), poses.begin() + 5),
+            (std::vector<double>{1, 2, 3, 4, 5}));
+  EXPECT_EQ(fake::most_reads_running, 1);
+  loop_->removeTimer(*ticker);
+}
+
+TEST_F(ManagerTest, UnplugDuringATrackerReadLeavesTheDeviceToTheReader) {
+  devices_.open(registry_, *describeUdevDevice(hidTracker()), "", {{"fd", "readable"}});
+  fake::hold = true;
+  startWithoutUdev(60000ms);
+  int readings = 0;
+  manager_->onReading([&](const DeviceEntry&, const Reading&) { ++readings; });
+  ASSERT_TRUE(runUntil([&] { return fake::reads_running == 1; }));
+  UdevRecord gone = hidTracker();
+  gone.action = "remove";
+  manager_->handleUdevEvent(gone);
+  EXPECT_EQ(devices_.find("hidraw7"), nullptr);
+  ASSERT_EQ(eventsNamed("device-removed").size(), 1u);
+  EXPECT_EQ(fake::trackers_destroyed, 0);  // the reader's share keeps it open
+  fake::hold = false;
+  ASSERT_TRUE(runUntil([&] { return fake::trackers_destroyed == 1; }));
+  EXPECT_EQ(fake::destroyed_mid_read, 0);
+  EXPECT_EQ(readings, 0);  // the result of a device closed meanwhile is dropped
+  EXPECT_TRUE(warnings_.empty());
+}
+
+TEST_F(ManagerTest, DeviceReopenedDuringAReadIsWatchedWhenTheReadEnds) {
+  const plugins::DeviceDescription desc = *describeUdevDevice(hidTracker());
+  devices_.open(registry_, desc, "", {{"fd", "readable"}});
+  fake::hold = true;
+  startWithoutUdev(60000ms);
+  std::vector<double> poses;
+  manager_->onReading([&](const DeviceEntry&, const Reading& r) {
+    poses.push_back(std::get<procam_pose_sample>(r).position[0]);
+  });
+  ASSERT_TRUE(runUntil([&] { return fake::reads_running == 1; }));
+  // As a configuration reload does: closed and opened again behind the manager.
+  devices_.close("hidraw7");
+  devices_.open(registry_, desc, "", {{"fd", "readable"}});
+  manager_->sync();
+  fake::Tracker* fresh = trackerState(devices_, "hidraw7");
+  EXPECT_EQ(fresh->reads, 0);  // not read while the old device's read runs
+  fake::hold = false;
+  ASSERT_TRUE(runUntil([&] { return fresh->reads >= 3 && poses.size() >= 2; }));
+  // Only the new device's readings (numbered from 1 again) reach the hooks.
+  EXPECT_EQ(poses[0], 1);
+  EXPECT_EQ(poses[1], 2);
+  EXPECT_EQ(fake::trackers_destroyed, 1);
+}
+
+TEST_F(ManagerTest, EnodevFromTheReaderMarksTheTrackerLost) {
+  devices_.open(registry_, *describeUdevDevice(hidTracker()), "", {});  // no fd: presence reads
+  startWithoutUdev(20ms);
+  fake::gone = true;
+  ASSERT_TRUE(runUntil([&] { return !eventsNamed("device-removed").empty(); }));
+  const DeviceEntry* e = devices_.find("hidraw7");
+  ASSERT_NE(e, nullptr);
+  EXPECT_EQ(std::string(e->state()), "lost");
+  EXPECT_EQ(e->error, "lost: fake tracker unplugged");
+  EXPECT_EQ(eventsNamed("device-removed")[0]["state"], "lost");
+  ASSERT_FALSE(warnings_.empty());
+  EXPECT_NE(warnings_.back().find("fake tracker unplugged"), std::string::npos) << warnings_.back();
+}
+
+TEST_F(ManagerTest, ReadFenceWaitsForTheRunningReadAndDropsTheQueuedOne) {
+  devices_.open(registry_, *describeUdevDevice(hidTracker("hidraw7")), "", {{"fd", "readable"}});
+  devices_.open(registry_, *describeUdevDevice(hidTracker("hidraw8")), "", {{"fd", "readable"}});
+  bool may_read = true;
+  manager_->setReadGate([&](const std::string&) { return may_read; });
+  fake::hold = true;
+  startWithoutUdev(20ms);
+  int poses = 0;
+  manager_->onReading([&](const DeviceEntry&, const Reading&) { ++poses; });
+  fake::Tracker* a = trackerState(devices_, "hidraw7");
+  fake::Tracker* b = trackerState(devices_, "hidraw8");
+  // Both reads handed to the one reader thread (both fds out of the loop):
+  // one runs, blocked, the other waits in the queue behind it.
+  ASSERT_TRUE(runUntil([&] {
+    return fake::reads_running == 1 && !loop_->modify(a->pipe[0], EPOLLIN) &&
+           !loop_->modify(b->pipe[0], EPOLLIN);
+  }));
+  fake::Tracker* running = a->reads == 1 ? a : b;
+  fake::Tracker* queued = running == a ? b : a;
+  ASSERT_EQ(queued->reads, 0);
+
+  // As calibrate does: close the gate, take the fence, wait on it off the loop.
+  may_read = false;
+  const ReadFence fence = manager_->readFence({"hidraw7", "hidraw8", "no-such-device"});
+  EXPECT_EQ(fence.size(), 2u);
+  std::atomic<bool> passed{false};
+  std::thread operation([&] {
+    fence.wait();
+    // Nothing of the manager's runs on either device from here on.
+    EXPECT_EQ(fake::reads_running, 0);
+    passed = true;
+  });
+  EXPECT_FALSE(runUntil([&] { return passed.load(); }, 200ms));  // the running read holds it
+  fake::hold = false;
+  ASSERT_TRUE(runUntil([&] { return passed.load(); }));
+  operation.join();
+  // The read that ran reports its pose; the withdrawn one never started and,
+  // with the gate closed, no read follows.
+  EXPECT_FALSE(runUntil([&] { return queued->reads > 0 || running->reads > 1; }, 200ms));
+  EXPECT_EQ(poses, 1);
+  // The gate opens: the presence check puts both fds back.
+  may_read = true;
+  ASSERT_TRUE(runUntil([&] { return queued->reads > 0 && running->reads > 1; }));
 }
 
 TEST(DeviceManagerBackOff, OneTwoFourEightThenEveryTenSeconds) {
