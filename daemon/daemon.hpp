@@ -3,6 +3,7 @@
 // drivers and devices together. All methods run on the loop thread.
 #include <atomic>
 #include <chrono>
+#include <functional>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -24,6 +25,9 @@
 #include "worker_pool.hpp"
 
 namespace procam::daemon {
+
+struct CalibrationHooks;  // calibration_job.hpp
+struct CalibrationProgress;
 
 struct DaemonOptions {
   std::string config_path;  // empty: built-in defaults
@@ -109,6 +113,11 @@ class Daemon {
   bool calibrating() const;
   // Marks `op_id` as the calibration operation using `devices` (commands_calibrate.cpp).
   void beginCalibrationOp(const std::string& op_id, std::vector<std::string> devices);
+  // Its worker's hooks: the cancel flag, and progress events posted to the loop
+  // while the operation exists.
+  CalibrationHooks operationHooks(
+      ClientId client, const std::string& op_id, std::shared_ptr<std::atomic<bool>> cancelled,
+      std::function<nlohmann::json(const CalibrationProgress&)> progress);
   void loadContentAtStart();
   nlohmann::json outputsJson() const;
   Result<void> reloadConfig();
