@@ -198,6 +198,9 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
   operations_[op_id] = Operation{"calibrate", client, req.id, cancelled};
   std::vector<std::string> used{plan->output.name};
   for (const auto& c : plan->cameras) used.push_back(c.device.name);
+  // The gate closes here; a read the device manager has running on one of
+  // these devices ends before the worker's first driver call (read_fence.hpp).
+  const ReadFence fence = device_manager_->readFence(used);
   beginCalibrationOp(op_id, std::move(used));
   server_->hold(client);
   json cameras = json::array();
@@ -221,7 +224,8 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
   operationEvent(client, "progress", progress({0, "starting", 0}));
 
   const CalibrationHooks hooks = operationHooks(client, op_id, cancelled, progress);
-  compute_worker_->submit([this, client, req, op_id, cancelled, plan, progress, hooks] {
+  compute_worker_->submit([this, client, req, op_id, cancelled, plan, progress, hooks, fence] {
+    fence.wait();
     auto result = runCalibration(*plan, hooks);
     return [this, client, req, op_id, cancelled, plan, result, progress] {
       auto finish = [this, client, req, op_id](const json& reply, const Failure* failure) {

@@ -79,6 +79,9 @@ void Daemon::cmdLatency(ClientId client, const proto::Request& req) {
     used.push_back(c.name);
     cameras.push_back(c.name);
   }
+  // The gate closes here; a read the device manager has running on one of
+  // these devices ends before the worker's first driver call (read_fence.hpp).
+  const ReadFence fence = device_manager_->readFence(used);
   beginCalibrationOp(op_id, std::move(used));
   server_->hold(client);
   replyTo(client, req, "LATENCY",
@@ -96,7 +99,8 @@ void Daemon::cmdLatency(ClientId client, const proto::Request& req) {
   operationEvent(client, "progress", progress({0, "starting", 0}));
 
   const CalibrationHooks hooks = operationHooks(client, op_id, cancelled, progress);
-  compute_worker_->submit([this, client, req, op_id, cancelled, plan, hooks] {
+  compute_worker_->submit([this, client, req, op_id, cancelled, plan, hooks, fence] {
+    fence.wait();
     auto result = runLatencyProbe(*plan, hooks);
     return [this, client, req, op_id, cancelled, plan, result] {
       operations_.erase(op_id);
