@@ -82,18 +82,21 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
       outputs.push_back({e.name, sim ? e.description.property("SIM_SCENE") : "",
                          sim ? e.description.property("SIM_DEVICE") : ""});
     }
-    // A tracked viewer (status `viewer`) wins over the scene's.
+    // The viewer: a tracker's (status `viewer`), else [content] viewer, else the scene's.
     std::optional<Vec3> eye;
-    std::string tracker;
+    json eye_source;
     if (const json v = viewerJson(); v.is_object() && v["position"].is_array()) {
       eye = Vec3(v["position"][0].get<double>(), v["position"][1].get<double>(),
                  v["position"][2].get<double>());
-      tracker = v.value("tracker", "");
+      eye_source = {{"source", "tracker"}, {"tracker", v.value("tracker", "")}};
+    } else if (const auto& c = config_.content_viewer) {
+      eye = Vec3((*c)[0], (*c)[1], (*c)[2]);
+      eye_source = {{"source", "config"}};
     }
     server_->hold(client);
-    compute_worker_->submit([this, client, req, file, outputs, eye, tracker] {
+    compute_worker_->submit([this, client, req, file, outputs, eye, eye_source] {
       auto prepared = std::make_shared<tl::expected<PreparedMesh, MeshFailure>>(
-          prepareMeshContent(file, outputs, eye, tracker));
+          prepareMeshContent(file, outputs, eye, eye_source));
       return [this, client, req, prepared] {
         if (!*prepared) {
           errorTo(client, req, (*prepared).error().code, (*prepared).error().message);

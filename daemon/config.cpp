@@ -160,6 +160,14 @@ bool numbers(Checker& c, const toml::node& node, const std::string& key, double 
   return true;
 }
 
+void parseContent(Checker& c, const toml::table& t, Config& cfg) {
+  c.onlyKnown(t, "content.", {"viewer"});
+  std::array<double, 3> eye{};
+  if (auto* n = t.get("viewer"); n && numbers(c, *n, "content.viewer", -1e4, 1e4, eye)) {
+    cfg.content_viewer = eye;
+  }
+}
+
 void parseKeystone(Checker& c, const toml::table& t, Config& cfg) {
   c.onlyKnown(t, "keystone.",
               {"cutoff_hz", "hysteresis_deg", "poll_hz", "mount", "accel_offset_g", "accel_scale"});
@@ -281,8 +289,8 @@ Result<Config> parseConfig(std::string_view text, const std::string& source) {
   cfg.source = source;
   Checker c(source);
   c.onlyKnown(root, "",
-              {"daemon", "policy", "keystone", "calibration", "sim", "projector", "camera", "tilt",
-               "tracker"});
+              {"daemon", "policy", "keystone", "calibration", "content", "sim", "projector",
+               "camera", "tilt", "tracker"});
   auto section = [&](const char* name, void (*parse)(Checker&, const toml::table&, Config&)) {
     if (auto* n = root.get(name)) {
       if (const toml::table* t = n->as_table()) {
@@ -297,6 +305,7 @@ Result<Config> parseConfig(std::string_view text, const std::string& source) {
   section("sim", parseSim);
   section("keystone", parseKeystone);
   section("calibration", parseCalibration);
+  section("content", parseContent);
   std::set<std::string> names;
   const std::pair<const char*, procam_family> families[] = {{"projector", PROCAM_FAMILY_OUTPUT},
                                                             {"camera", PROCAM_FAMILY_CAMERA},

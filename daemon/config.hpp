@@ -60,6 +60,9 @@ struct Config {
   bool auto_keystone = false;
   RecalibratePolicy recalibrate = RecalibratePolicy::kOff;
   std::string sim_scene;
+  // [content] viewer: the viewer's eye (world, metres) for 3D content when no tracker
+  // has reported one.
+  std::optional<std::array<double, 3>> content_viewer;
   KeystoneConfig keystone;
   CalibrationConfig calibration;
   std::vector<DeviceConfig> devices;

@@ -227,8 +227,8 @@ bool isMeshFile(const std::string& path) {
 
 tl::expected<PreparedMesh, MeshFailure> prepareMeshContent(const std::string& file,
                                                            const std::vector<MeshOutput>& outputs,
-                                                           const std::optional<Vec3>& tracked_eye,
-                                                           const std::string& tracker) {
+                                                           const std::optional<Vec3>& eye,
+                                                           const json& eye_source) {
 #ifdef PROCAM_HAVE_SIM
   if (outputs.empty())
     return tl::unexpected(MeshFailure{code::kUnavailable, "no output to show 3D content on"});
@@ -273,9 +273,8 @@ tl::expected<PreparedMesh, MeshFailure> prepareMeshContent(const std::string& fi
     view.size = {model.width, model.height};
     view.plane_point = hit->hit.point;
     view.plane_normal = hit->hit.normal;
-    view.eye = tracked_eye ? *tracked_eye : scene->viewerPosition(0);
-    viewer = tracked_eye ? json{{"source", "tracker"}, {"tracker", tracker}}
-                         : json{{"source", "scene"}, {"scene", o.sim_scene}};
+    view.eye = eye ? *eye : scene->viewerPosition(0);
+    viewer = eye ? eye_source : json{{"source", "scene"}, {"scene", o.sim_scene}};
     viewer["position"] = {view.eye.x(), view.eye.y(), view.eye.z()};
     auto placed = content::placeMeshContent(*loaded, view);
     if (!placed) return unavailable(placed.error().message);
@@ -290,7 +289,7 @@ tl::expected<PreparedMesh, MeshFailure> prepareMeshContent(const std::string& fi
                 {"viewer", viewer}}}};
   return out;
 #else
-  (void)file, (void)outputs, (void)tracked_eye, (void)tracker;
+  (void)file, (void)outputs, (void)eye, (void)eye_source;
   return tl::unexpected(
       MeshFailure{code::kUnavailable,
                   "3D content needs the virtual rig, which this procamd was built without"});

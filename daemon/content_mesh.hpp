@@ -35,13 +35,14 @@ struct MeshFailure {
 // True for the 3D content files `content load` takes (.obj, .ply, any case).
 bool isMeshFile(const std::string& path);
 
-// Reads the mesh and places it for each output. The viewer is `tracked_eye` (world,
-// from a tracker) when given, else the virtual rig's scene viewer. `unavailable` when
+// Reads the mesh and places it for each output. The viewer is `eye` (world: a tracker's
+// or the configuration's, described by `eye_source`, an object with "source") when
+// given, else the virtual rig's scene viewer. `unavailable` when
 // an output's projector pose or display surface is unknown or the surface it lights is
 // not planar; `io-error` / `bad-argument` when the file cannot be read or parsed.
 tl::expected<PreparedMesh, MeshFailure> prepareMeshContent(const std::string& file,
                                                            const std::vector<MeshOutput>& outputs,
-                                                           const std::optional<Vec3>& tracked_eye,
-                                                           const std::string& tracker);
+                                                           const std::optional<Vec3>& eye,
+                                                           const nlohmann::json& eye_source);
 
 }  // namespace procam::daemon

@@ -1,8 +1,9 @@
 // 3D content on the virtual rig: `content load` of an OBJ cube on `wall_oblique` (a
-// planar wall, the scene's viewer) is drawn through the planar 3D path, and the output's
-// statistics (status.outputs.shown) match a double-precision ray cast of the placed cube
-// seen by the viewer (seed §4.2.1: a projector pixel shows what the viewer's ray through
-// that pixel's wall point meets). A non-planar surface makes the load `unavailable`.
+// planar wall; the scene's viewer, or [content] viewer from the configuration) is drawn through the
+// planar 3D path, and the output's statistics (status.outputs.shown) match a double-precision ray
+// cast of the placed cube seen by the viewer (seed §4.2.1: a projector pixel shows what the
+// viewer's ray through that pixel's wall point meets). A non-planar surface makes the load
+// `unavailable`.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -107,12 +108,10 @@ Expected rayCast(const content::PlacedMesh& placed, const Mat34& P, cv::Size siz
   return e;
 }
 
-TEST(SimMeshContent, ObjCubeOnTheObliqueWallIsDrawnForTheSceneViewer) {
-  TempDir dir;
-  dir.write("cube.obj", kCubeObj);
-  DaemonProcess d(dir, sim("wall_oblique"));
-  ASSERT_TRUE(d.started()) << d.log();
-  Connection c(d.socketPath());
+// Loads the cube on a daemon running wall_oblique and checks what its output shows
+// against the ray cast for `eye` (reported as `source`).
+void expectCubeShown(Connection& c, const TempDir& dir, const Vec3& eye,
+                     const std::string& source) {
   ASSERT_EQ((*c.call({{"cmd", "pattern"}, {"name", "off"}}))["pattern"], "off");
   auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", dir.file("cube.obj")}}, 30s);
   ASSERT_TRUE(load);
@@ -120,7 +119,10 @@ TEST(SimMeshContent, ObjCubeOnTheObliqueWallIsDrawnForTheSceneViewer) {
   const json info = (*load)["content"];
   EXPECT_EQ(info["path"], dir.file("cube.obj"));
   EXPECT_EQ(info["mesh"]["triangles"], 12);
-  EXPECT_EQ(info["mesh"]["viewer"]["source"], "scene");
+  EXPECT_EQ(info["mesh"]["viewer"]["source"], source);
+  const json p = info["mesh"]["viewer"]["position"];
+  ASSERT_TRUE(p.is_array()) << info.dump();
+  EXPECT_LT((Vec3(p[0].get<double>(), p[1].get<double>(), p[2].get<double>()) - eye).norm(), 1e-12);
   json shown;
   ASSERT_TRUE(eventually(
       [&] {
@@ -143,20 +145,22 @@ TEST(SimMeshContent, ObjCubeOnTheObliqueWallIsDrawnForTheSceneViewer) {
   view.size = {proj.width, proj.height};
   view.plane_point = Vec3(0, 3, 1.5);  // the wall: y = 3, normal -Y
   view.plane_normal = Vec3(0, -1, 0);
-  view.eye = scene->viewerPosition(0);
+  view.eye = eye;
   auto placed = content::placeMeshContent(*cube, view);
   ASSERT_TRUE(placed) << placed.error().message;
-  // Placement: the back of the cube on the wall, centred on S, half S's smaller side wide.
+  // Placement: the back of the cube on the wall, its front toward the viewer.
   double y_max = -INFINITY, y_min = INFINITY;
-  for (const Vec3& p : placed->mesh.vertices)
-    y_max = std::max(y_max, p.y()), y_min = std::min(y_min, p.y());
+  for (const Vec3& q : placed->mesh.vertices)
+    y_max = std::max(y_max, q.y()), y_min = std::min(y_min, q.y());
   EXPECT_NEAR(y_max, 3.0, 1e-9);
   EXPECT_LT(y_min, 3.0 - 0.05);
 
   const Expected e = rayCast(*placed, view.projector, view.size, view.eye);
   const double lit = shown["lit_fraction"].get<double>();
-  std::printf("cube: lit %.5f (ray cast %.5f), mean grey %.3f (ray cast %.3f), edge band %.5f\n",
-              lit, e.lit, shown["mean_rgb"][0].get<double>(), e.mean, e.boundary);
+  std::printf(
+      "cube (%s viewer): lit %.5f (ray cast %.5f), mean grey %.3f (ray cast %.3f), "
+      "edge band %.5f\n",
+      source.c_str(), lit, e.lit, shown["mean_rgb"][0].get<double>(), e.mean, e.boundary);
   ASSERT_GT(e.lit, 0.01);  // the cube is in view
   // Every pixel off the edge band is decided alike; a pixel of the band may flip,
   // changing the lit fraction by one pixel and the mean by at most 255 per pixel, plus
@@ -165,11 +169,32 @@ TEST(SimMeshContent, ObjCubeOnTheObliqueWallIsDrawnForTheSceneViewer) {
   for (int k = 0; k < 3; ++k) {
     EXPECT_NEAR(shown["mean_rgb"][k].get<double>(), e.mean, 255 * e.boundary + 0.5) << k;
   }
-
   auto get = c.call({{"cmd", "content"}});
   EXPECT_EQ((*get)["content"]["mesh"]["triangles"], 12);
+}
+
+TEST(SimMeshContent, ObjCubeOnTheObliqueWallIsDrawnForTheSceneViewer) {
+  TempDir dir;
+  dir.write("cube.obj", kCubeObj);
+  DaemonProcess d(dir, sim("wall_oblique"));
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  auto scene = sim::resolveScene("wall_oblique");
+  ASSERT_TRUE(scene);
+  expectCubeShown(c, dir, scene->viewerPosition(0), "scene");
   ASSERT_TRUE(c.call({{"cmd", "content"}, {"action", "clear"}}));
   ASSERT_TRUE(eventually([&] { return shownStats(c)["source"] == "none"; }));
+}
+
+TEST(SimMeshContent, ConfiguredViewerWinsOverTheScenes) {
+  TempDir dir;
+  dir.write("cube.obj", kCubeObj);
+  dir.write("procamd.toml",
+            "[sim]\nscene = \"wall_oblique\"\n[content]\nviewer = [0.6, 0.9, 1.3]\n");
+  DaemonProcess d(dir, DaemonProcess::Launch{{"--config", dir.file("procamd.toml")}, {}, -1, true});
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  expectCubeShown(c, dir, Vec3(0.6, 0.9, 1.3), "config");
 }
 
 TEST(SimMeshContent, NonPlanarSurfaceIsUnavailable) {

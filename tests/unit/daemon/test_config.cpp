@@ -160,6 +160,20 @@ TEST(Config, CalibrationSettleIsANumberOrAuto) {
   }
 }
 
+TEST(Config, ContentViewerIsThreeNumbers) {
+  auto cfg = parseConfig("", "rig.toml");
+  ASSERT_TRUE(cfg);
+  EXPECT_FALSE(cfg->content_viewer);
+  cfg = parseConfig("[content]\nviewer = [0.5, -1, 1.75]\n", "rig.toml");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  ASSERT_TRUE(cfg->content_viewer);
+  EXPECT_EQ(*cfg->content_viewer, (std::array<double, 3>{0.5, -1, 1.75}));
+  EXPECT_TRUE(contains(parseError("[content]\nviewer = [1, 2]").message,
+                       "rig.toml:2: content.viewer: expected an array of 3 numbers"));
+  EXPECT_TRUE(contains(parseError("[content]\neye = [1, 2, 3]").message,
+                       "rig.toml:2: content.eye: unknown key"));
+}
+
 TEST(Config, AllProblemsAreReportedAtOnce) {
   auto e = parseError("[daemon]\nfoo = 1\nmax_clients = -1\n[policy]\nbar = 2\n");
   EXPECT_TRUE(contains(e.message, "rig.toml:2: daemon.foo")) << e.message;
