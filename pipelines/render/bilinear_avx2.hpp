@@ -60,6 +60,18 @@ PROCAM_AVX2_INLINE __m256i blend8(__m256i p00, __m256i p01, __m256i p10, __m256i
   return _mm256_and_si256(_mm256_packus_epi32(lo, hi), valid);
 }
 
+// How far ahead along an output row the kernels prefetch the source footprint. The
+// footprints of a warped row run diagonally through the source, a pattern the hardware
+// prefetchers miss: without this the kernels wait on L3 and DRAM (render bench: -35 to -45 %
+// time, warm and cold, at 32 to 256 pixels ahead).
+inline constexpr int kPrefetchPixels = 64;
+
+// Both source rows of a footprint at byte offset `off` into the L1 cache.
+inline void prefetchFootprint(const uint8_t* src, size_t src_step, int32_t off) {
+  _mm_prefetch(reinterpret_cast<const char*>(src + off), _MM_HINT_T0);
+  _mm_prefetch(reinterpret_cast<const char*>(src + off + src_step), _MM_HINT_T0);
+}
+
 // Blends eight pixels whose footprints start at byte offsets `off` (>= 0 everywhere;
 // outside pixels point at any texel and are cleared by `valid`) into out[0..32). One gather
 // per footprint corner (measured on Zen 4 against 8-byte pair loads: equal or faster).

@@ -1,5 +1,6 @@
 #include "render/remap_rgba.hpp"
 
+#include <algorithm>
 #include <cstring>
 
 #include "render/bilinear_avx2.hpp"
@@ -88,6 +89,8 @@ PROCAM_AVX2 void rowAvx2(const uint8_t* src, size_t src_step, const PackedRow& r
   const __m256i minus_one = _mm256_set1_epi32(-1);
   int x = 0;
   for (; x + 8 <= width; x += 8) {
+    const int32_t ahead = row.offset[std::min(x + avx2::kPrefetchPixels, width - 1)];
+    if (ahead >= 0) avx2::prefetchFootprint(src, src_step, ahead);
     const __m256i off = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(row.offset + x));
     const __m256i valid = _mm256_cmpgt_epi32(off, minus_one);
     if (_mm256_testz_si256(valid, valid)) {  // e.g. the black margin around a keystoned image
