@@ -1,7 +1,7 @@
 #pragma once
-// AVX2 building blocks of the integer bilinear kernels, shared by the packed-map remap and
-// the direct homography warp. Compiled for AVX2 per function (target attribute) so the rest
-// of the build stays baseline x86-64; callers check __builtin_cpu_supports("avx2") first.
+// AVX2 building blocks of the packed-map remap (remap_rgba.cpp). Compiled for AVX2 per
+// function (target attribute) so the rest of the build stays baseline x86-64; callers check
+// __builtin_cpu_supports("avx2") first.
 // Arithmetic (packed_map.hpp's 1/128 px weights): the horizontal blend
 // p0 * (128 - fx) + p1 * fx <= 255 * 128 fits a 16-bit lane; the vertical one
 // top * (128 - fy) + bottom * fy goes through madd in 32 bits, then (v + 2^13) >> 14: the

@@ -22,14 +22,7 @@ Result<void> CpuRenderer::configure(const RenderSetup& setup) {
   const bool is3d = setup.path == RenderPath::kPlanar3d;  // triangles, drawn per frame
   auto main = is3d ? Result<WarpMap>(WarpMap{}) : mainPathMap(setup);
   if (!main) return tl::unexpected(main.error());
-  // The homography path warps straight from H (no map streamed per frame).
-  std::optional<HomographyWarp> direct;
-  if (setup.path == RenderPath::kHomography) {
-    auto w = makeHomographyWarp(setup.homography, setup.output_size, setup.content_size);
-    if (!w) return tl::unexpected(w.error());
-    direct = *w;
-  }
-  auto packed = direct || is3d ? PackedMap{} : packMap(*main, setup.content_size);
+  auto packed = is3d ? PackedMap{} : packMap(*main, setup.content_size);
   if (!packed) return tl::unexpected(packed.error());
   PackedMap post;
   if (setup.post_warp) {
@@ -42,7 +35,6 @@ Result<void> CpuRenderer::configure(const RenderSetup& setup) {
   setup_ = setup;
   map_ = std::move(*main);
   packed_ = std::move(*packed);
-  direct_ = direct;
   post_ = std::move(post);
   frame_ = cv::Mat(setup.output_size, CV_8UC4, cv::Scalar::all(0));
   gate_.geometryChanged();
@@ -66,14 +58,12 @@ Result<bool> CpuRenderer::render(const Content& content) {
     if (!ok) return tl::unexpected(ok.error());
     return finish(content.version);
   }
-  if (!direct_ && static_cast<int>(content.image->step) != packed_.source_step) {
+  if (static_cast<int>(content.image->step) != packed_.source_step) {
     auto repacked = packMap(map_, setup_.content_size, static_cast<int>(content.image->step));
     if (!repacked) return tl::unexpected(repacked.error());
     packed_ = std::move(*repacked);
   }
-  if (auto ok = direct_ ? warpHomographyRgba(*content.image, *direct_, main_out, kernel_)
-                        : remapRgba(*content.image, packed_, main_out, kernel_);
-      !ok) {
+  if (auto ok = remapRgba(*content.image, packed_, main_out, kernel_); !ok) {
     return tl::unexpected(ok.error());
   }
   return finish(content.version);

@@ -5,13 +5,10 @@
 // second map applied to the rendered image, as the GL back-end does; the final stage
 // comes last. It is the specification the GL back-end is tested against and the
 // fallback output path.
-#include <optional>
-
 #include "render/packed_map.hpp"
 #include "render/raster_triangles.hpp"
 #include "render/remap_rgba.hpp"
 #include "render/renderer.hpp"
-#include "render/warp_homography.hpp"
 
 namespace procam::render {
 
@@ -28,10 +25,9 @@ class CpuRenderer final : public Renderer {
  private:
   RenderSetup setup_;
   WarpMap map_;
-  PackedMap packed_;                      // main path, unless direct_
-  std::optional<HomographyWarp> direct_;  // the homography path
-  PackedMap post_;                        // empty unless setup.post_warp
-  cv::Mat stage_;                         // main-path image when a post-render warp follows
+  PackedMap packed_;
+  PackedMap post_;  // empty unless setup.post_warp
+  cv::Mat stage_;   // main-path image when a post-render warp follows
   cv::Mat frame_;
   cv::Mat depth_;  // kPlanar3d depth buffer
   FrameGate gate_;

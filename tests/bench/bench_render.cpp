@@ -39,7 +39,6 @@
 #include "render/cpu_renderer.hpp"
 #include "render/packed_map.hpp"
 #include "render/remap_rgba.hpp"
-#include "render/warp_homography.hpp"
 #include "render/warp_map.hpp"
 #if PROCAM_BENCH_GLES
 #include "../unit/render/render_test_rig.hpp"  // test camera rigs
@@ -366,16 +365,6 @@ int main(int argc, char** argv) {
         "homography", k.name, [&] { (void)render::remapRgba(src, *hpacked, dst, k.kernel); },
         &homography_source);
   }
-  auto direct = render::makeHomographyWarp(H, size, size);
-  if (!direct) return 1;
-  run(
-      "homography", "procam_direct_best",
-      [&] { (void)render::warpHomographyRgba(src, *direct, dst, RemapKernel::kBest); },
-      &homography_source);
-  run(
-      "homography", "procam_direct_sse2",
-      [&] { (void)render::warpHomographyRgba(src, *direct, dst, RemapKernel::kSse2); },
-      &homography_source);
   const cv::Mat Hcv = toCv(H);
   run(
       "homography", "cv_warpPerspective",
