@@ -107,6 +107,7 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
           keystone_rt_.content.reset();
           keystone_rt_.meshes = std::move((*prepared)->meshes);
           keystone_rt_.mesh_info = std::move((*prepared)->info);
+          followMeshViewer(**prepared);
           broadcast("content", {{"content", contentJson()}});
           refreshOutputs();
           replyTo(client, req, "CONTENT", {{"content", contentJson()}});

@@ -161,7 +161,10 @@ bool numbers(Checker& c, const toml::node& node, const std::string& key, double 
 }
 
 void parseContent(Checker& c, const toml::table& t, Config& cfg) {
-  c.onlyKnown(t, "content.", {"viewer"});
+  c.onlyKnown(t, "content.", {"viewer", "viewer_threshold_m"});
+  if (auto* n = t.get("viewer_threshold_m")) {
+    c.number(*n, "content.viewer_threshold_m", 0.0, 1.0, cfg.content_viewer_threshold_m);
+  }
   std::array<double, 3> eye{};
   if (auto* n = t.get("viewer"); n && numbers(c, *n, "content.viewer", -1e4, 1e4, eye)) {
     cfg.content_viewer = eye;

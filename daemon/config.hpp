@@ -63,6 +63,9 @@ struct Config {
   // [content] viewer: the viewer's eye (world, metres) for 3D content when no tracker
   // has reported one.
   std::optional<std::array<double, 3>> content_viewer;
+  // [content] viewer_threshold_m: a tracked viewer who moved this far since the mesh was
+  // last drawn has it drawn again (content_follow.cpp says why 5 mm).
+  double content_viewer_threshold_m = 0.005;
   KeystoneConfig keystone;
   CalibrationConfig calibration;
   std::vector<DeviceConfig> devices;

@@ -2,14 +2,18 @@
 // 3D content in the daemon (`content load` of an .obj or .ply file): for every output,
 // the mesh placed in front of the planar surface its projector lights, shaded, with
 // the planar 3D path's matrix for the viewer (content/mesh_placement.hpp). Pure: runs
-// on a worker (content_live.cpp).
+// on a worker (content_live.cpp). While a tracker gives the viewer, the drawing follows it
+// (content_follow.cpp).
+#include <chrono>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "core/error.hpp"
 #include "core/types.hpp"
+#include "keystone/head_tracked.hpp"
 #include "output_frames.hpp"
 #include "tl/expected.hpp"
 
@@ -22,10 +26,38 @@ struct MeshOutput {
   std::string sim_scene, sim_device;
 };
 
-struct PreparedMesh {
-  std::map<std::string, Mesh3d> meshes;  // output name -> what it draws
-  nlohmann::json info;                   // the `content` object of replies
+// What an output's view-dependent matrix needs besides the viewer (content::PlanarView
+// without the eye, and S, fixed at placement).
+struct MeshView {
+  Mat34 projector = Mat34::Zero();
+  cv::Size size;
+  Vec3 plane_point = Vec3::Zero(), plane_normal = Vec3::UnitZ();
+  keystone::DisplayRect S;
 };
+
+struct PreparedMesh {
+  std::map<std::string, Mesh3d> meshes;   // output name -> what it draws
+  std::map<std::string, MeshView> views;  // output name -> its view
+  Vec3 eye = Vec3::Zero();                // the viewer it was placed for
+  nlohmann::json info;                    // the `content` object of replies
+};
+
+// The shown mesh following its tracker (loop thread only; content_follow.cpp).
+struct MeshFollow {
+  std::map<std::string, MeshView> views;
+  std::string tracker;      // the viewer's tracker; empty: the viewer does not move
+  Vec3 eye = Vec3::Zero();  // of the frame shown or in flight
+  uint64_t updates = 0;     // view updates shown
+  bool in_flight = false;   // a view update's frame is rendering
+  int timer = -1;           // one-shot: the next update, once a frame period has passed
+  std::chrono::steady_clock::time_point last_start;
+  std::chrono::nanoseconds frame_period{16'666'667};  // of the first output
+  uint64_t generation = 0;                            // of the loaded mesh
+};
+
+// RenderSetup::planar3d of every output for the viewer `eye` (the mesh not moved).
+Result<std::map<std::string, Mat4>> meshViewMatrices(const std::map<std::string, MeshView>& views,
+                                                     const Vec3& eye);
 
 struct MeshFailure {
   const char* code = "";  // a proto::code constant

@@ -12,6 +12,7 @@
 
 #include "config.hpp"
 #include "content/content_source.hpp"
+#include "content_mesh.hpp"
 #include "control_server.hpp"
 #include "control_socket.hpp"
 #include "device_manager.hpp"
@@ -128,6 +129,9 @@ class Daemon {
   void cmdTracker(ClientId, const proto::Request&);
   nlohmann::json trackersJson() const;
   nlohmann::json viewerJson() const;
+  // content_follow.cpp: 3D content drawn again for a tracked viewer who moved.
+  void followMeshViewer(PreparedMesh& prepared);
+  void onMeshViewerSample();
   void addReadingStats(const DeviceEntry& entry, nlohmann::json& json) const;
 
   struct Operation {
@@ -171,6 +175,7 @@ class Daemon {
   std::optional<LiveContent> live_content_;  // set by `content share` / `stream`
   KeystoneRuntime keystone_rt_;
   TrackerRuntime trackers_;
+  MeshFollow mesh_follow_;
   // Destroyed in reverse order: server and workers before the loop they use.
   std::unique_ptr<EventLoop> loop_;
   std::unique_ptr<WorkerPool> io_worker_;       // state writes (fsync)

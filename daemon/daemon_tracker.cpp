@@ -138,6 +138,7 @@ void Daemon::onTrackerSample(const std::string& name, const procam_pose_sample& 
   p.world = reg == trackers_.registrations.end() ? raw : reg->second.fit.toWorld(raw);
   p.timestamp_ns = s.timestamp_ns;
   p.received = std::chrono::steady_clock::now();
+  if (name == mesh_follow_.tracker) onMeshViewerSample();
 }
 
 json Daemon::viewerJson() const {

@@ -26,16 +26,11 @@ Result<PlacedMesh> placeMeshContent(const MeshContent& content, const PlanarView
   if (!S) return tl::unexpected(S.error());
   const Vec3 centre = S->corner + 0.5 * S->width * S->u + 0.5 * S->height * S->v;
   const double distance = n.dot(view.eye - centre);
-  // Depth range of P_T around the object: it lies between 0.75 and 1 times the plane
-  // distance from the viewer.
-  auto path =
-      keystone::headTrackedPath(view.eye, *S, 0.1 * distance, 2.0 * distance, view.projector, W, H);
-  if (!path) return tl::unexpected(path.error());
+  auto planar3d = planar3dForViewer(view, *S);
+  if (!planar3d) return tl::unexpected(planar3d.error());
   PlacedMesh out;
   out.S = *S;
-  // Keystone's projector NDC has y up with image row 0 at the top.
-  const Mat4 clip_top = render::glConventions(W, H, render::GlOrigin::kRow0AtGlTop).clip_from_pixel;
-  out.planar3d = clip_top.inverse() * path->single_pass;
+  out.planar3d = *planar3d;
 
   const Vec3 extent = content.max - content.min;
   double scale = 0.5 * std::min(S->width, S->height) / std::max({extent.x(), extent.y(), 1e-12});
@@ -67,6 +62,23 @@ Result<PlacedMesh> placeMeshContent(const MeshContent& content, const PlanarView
     return fail(ErrorCode::kInvalidInput, "mesh placement: every face is degenerate");
   }
   return out;
+}
+
+Result<Mat4> planar3dForViewer(const PlanarView& view, const keystone::DisplayRect& S) {
+  if (!view.eye.allFinite()) return fail(ErrorCode::kInvalidInput, "the viewer is not finite");
+  const Vec3 centre = S.corner + 0.5 * S.width * S.u + 0.5 * S.height * S.v;
+  const double distance = S.u.cross(S.v).dot(view.eye - centre);
+  if (!(distance > 1e-3))
+    return fail(ErrorCode::kDegenerate, "the viewer is not in front of the display plane");
+  // Depth range of P_T around the object: it lies between 0.75 and 1 times the plane
+  // distance from the viewer.
+  const int W = view.size.width, H = view.size.height;
+  auto path =
+      keystone::headTrackedPath(view.eye, S, 0.1 * distance, 2.0 * distance, view.projector, W, H);
+  if (!path) return tl::unexpected(path.error());
+  // Keystone's projector NDC has y up with image row 0 at the top.
+  const Mat4 clip_top = render::glConventions(W, H, render::GlOrigin::kRow0AtGlTop).clip_from_pixel;
+  return Mat4(clip_top.inverse() * path->single_pass);
 }
 
 }  // namespace procam::content

@@ -44,4 +44,10 @@ struct PlacedMesh {
 // it; kIllConditioned when eq. 4.9 cannot hold (see keystone::singlePassMatrix).
 Result<PlacedMesh> placeMeshContent(const MeshContent& content, const PlanarView& view);
 
+// The view-dependent part alone: RenderSetup::planar3d for the viewer `view.eye` with
+// S kept (A does not depend on the viewer, seed §4.2.2), so that a placed mesh is drawn
+// for a moved viewer where it stands. Depth range of P_T: 0.1 to 2 times the viewer's
+// distance to S's centre. kDegenerate when the viewer is on the plane or behind it.
+Result<Mat4> planar3dForViewer(const PlanarView& view, const keystone::DisplayRect& S);
+
 }  // namespace procam::content

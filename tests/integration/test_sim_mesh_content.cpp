@@ -3,10 +3,12 @@
 // planar 3D path, and the output's statistics (status.outputs.shown) match a double-precision ray
 // cast of the placed cube seen by the viewer (seed §4.2.1: a projector pixel shows what the
 // viewer's ray through that pixel's wall point meets). A non-planar surface makes the load
-// `unavailable`.
+// `unavailable`. With a tracker the drawing follows the viewer as they move, and not while
+// they stand still (noise below [content] viewer_threshold_m).
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <thread>
 
 #include "content/mesh_placement.hpp"
 #include "daemon_harness.hpp"
@@ -214,6 +216,147 @@ TEST(SimMeshContent, NonPlanarSurfaceIsUnavailable) {
       c.call({{"cmd", "content"}, {"action", "load"}, {"path", dir.file("none.obj")}}, 30s);
   ASSERT_TRUE(missing);
   EXPECT_EQ((*missing)["code"], "io-error") << missing->dump();
+}
+
+// wall_oblique's wall and projector (at half resolution) with a tracked viewer who stands
+// at A until t = 6 s, walks to B by t = 7 s and stays there; tracker noise 0.5 mm.
+const char* kFollowScene = R"([scene]
+name = "follow_viewer"
+ambient = 0.02
+
+[[projectors]]
+name = "proj"
+resolution = [960, 540]
+intrinsics = { fx = 1200.0, fy = 1200.0, cx = 479.5, cy = 269.5 }
+pose = { position = [1.3, 0.0, 0.5], yaw_deg = 30.0, pitch_deg = 15.0, roll_deg = 0.0 }
+gamma = 2.2
+brightness = 11.0
+
+[[surfaces]]
+name = "wall"
+type = "rectangle"
+center = [0.0, 3.0, 1.5]
+normal = [0.0, -1.0, 0.0]
+size = [8.0, 4.0]
+albedo = 0.85
+
+[[trajectories]]
+name = "head"
+loop = false
+keyframes = [
+  { t = 0.0, position = [0.0, 0.5, 1.6] },
+  { t = 6.0, position = [0.0, 0.5, 1.6] },
+  { t = 7.0, position = [0.45, 0.7, 1.45] },
+]
+
+[viewer]
+trajectory = "head"
+
+[[trackers]]
+name = "head_tracker"
+noise_sigma_m = 0.0005
+rate_hz = 60.0
+trajectory = "head"
+)";
+
+Vec3 vec(const json& p) {
+  return Vec3(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
+}
+
+TEST(SimMeshContent, DrawingFollowsTheTrackedViewerAndNotItsNoise) {
+  const Vec3 A(0.0, 0.5, 1.6), B(0.45, 0.7, 1.45);
+  constexpr double kThreshold = 0.005;  // [content] viewer_threshold_m (the default)
+  TempDir dir;
+  dir.write("cube.obj", kCubeObj);
+  dir.write("follow.toml", kFollowScene);
+  dir.write("procamd.toml", "[sim]\nscene = \"" + dir.file("follow.toml") +
+                                "\"\n[content]\nviewer_threshold_m = 0.005\n");
+  DaemonProcess d(dir, DaemonProcess::Launch{{"--config", dir.file("procamd.toml")}, {}, -1, true});
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  ASSERT_EQ((*c.call({{"cmd", "pattern"}, {"name", "off"}}))["pattern"], "off");
+  ASSERT_TRUE(eventually([&] { return (*c.call({{"cmd", "status"}}))["viewer"].is_object(); }));
+  auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", dir.file("cube.obj")}}, 30s);
+  ASSERT_TRUE(load);
+  ASSERT_EQ((*load)["class"], "CONTENT") << load->dump();
+  const json viewer = (*load)["content"]["mesh"]["viewer"];
+  EXPECT_EQ(viewer["source"], "tracker");
+  EXPECT_EQ(viewer["tracker"], "head_tracker");
+  const Vec3 placed_for = vec(viewer["position"]);
+  EXPECT_LT((placed_for - A).norm(), 0.004);  // 8 sigma of the noise
+  EXPECT_EQ((*load)["content"]["mesh"]["view_updates"], 0);
+
+  // Standing still: the noise stays below the threshold, so nothing is drawn again.
+  json status;
+  ASSERT_TRUE(eventually([&] {
+    status = *c.call({{"cmd", "status"}});
+    return !status["outputs"]["shown"].empty() &&
+           status["outputs"]["shown"][0]["source"] == "content";
+  }));
+  const auto frames_still = status["outputs"]["frames"].get<uint64_t>();
+  std::this_thread::sleep_for(1s);
+  status = *c.call({{"cmd", "status"}});
+  ASSERT_LT((vec(status["viewer"]["position"]) - A).norm(), 0.004)
+      << "the viewer started walking before the still check ended";
+  EXPECT_EQ(status["content"]["mesh"]["view_updates"], 0) << status["content"].dump();
+  EXPECT_EQ(status["outputs"]["frames"].get<uint64_t>(), frames_still);
+
+  // Walking to B: the drawing follows, the last one within the threshold of B.
+  json content;
+  ASSERT_TRUE(eventually(
+      [&] {
+        content = (*c.call({{"cmd", "content"}}))["content"];
+        return (vec(content["mesh"]["viewer"]["position"]) - B).norm() < kThreshold + 0.004;
+      },
+      15s))
+      << content.dump();
+  std::this_thread::sleep_for(500ms);  // the last update near B has been shown
+  status = *c.call({{"cmd", "status"}});
+  const auto updates = status["content"]["mesh"]["view_updates"].get<uint64_t>();
+  const auto frames_at_b = status["outputs"]["frames"].get<uint64_t>();
+  // The 0.52 m walk takes 1 s: at most one update per 60 Hz tracker sample (each moves
+  // 8.6 mm, above the threshold; the output refresh allows as many), plus one on arrival.
+  EXPECT_GE(updates, 2u);
+  EXPECT_LE(updates, 62u);
+  const Vec3 eye = vec(status["content"]["mesh"]["viewer"]["position"]);
+  const json shown = status["outputs"]["shown"][0];
+  std::this_thread::sleep_for(1s);
+  status = *c.call({{"cmd", "status"}});
+  EXPECT_EQ(status["content"]["mesh"]["view_updates"].get<uint64_t>(), updates);
+  EXPECT_EQ(status["outputs"]["frames"].get<uint64_t>(), frames_at_b);
+
+  // The frame shown: the cube where it was placed (for the load-time viewer), seen from
+  // the viewer position reported for this frame.
+  auto scene = sim::resolveScene(dir.file("follow.toml"));
+  ASSERT_TRUE(scene) << scene.error().message;
+  const geom::CameraModel& proj = scene->at(0).projector("proj")->model;
+  auto cube = content::loadMeshContent(dir.file("cube.obj"));
+  ASSERT_TRUE(cube);
+  content::PlanarView view;
+  view.projector = proj.projectionMatrix();
+  view.size = {proj.width, proj.height};
+  view.plane_point = Vec3(0, 3, 1.5);
+  view.plane_normal = Vec3(0, -1, 0);
+  view.eye = placed_for;
+  auto placed = content::placeMeshContent(*cube, view);
+  ASSERT_TRUE(placed) << placed.error().message;
+  const Expected now = rayCast(*placed, view.projector, view.size, eye);
+  const Expected stale = rayCast(*placed, view.projector, view.size, placed_for);
+  const double lit = shown["lit_fraction"].get<double>(), mean = shown["mean_rgb"][0].get<double>();
+  std::printf(
+      "followed viewer: %llu view updates; lit %.5f (ray cast %.5f, for the load-time viewer "
+      "%.5f), mean grey %.3f (ray cast %.3f, load-time %.3f), edge band %.5f\n",
+      static_cast<unsigned long long>(updates), lit, now.lit, stale.lit, mean, now.mean, stale.mean,
+      now.boundary);
+  ASSERT_GT(now.lit, 0.01);
+  EXPECT_NEAR(lit, now.lit, now.boundary);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(shown["mean_rgb"][k].get<double>(), now.mean, 255 * now.boundary + 0.5) << k;
+  }
+  // The move is large enough that the drawing for the load-time viewer would fail.
+  EXPECT_TRUE(std::abs(stale.lit - now.lit) > 2 * now.boundary ||
+              std::abs(stale.mean - now.mean) > 2 * (255 * now.boundary + 0.5))
+      << "lit " << stale.lit << " vs " << now.lit << ", mean " << stale.mean << " vs " << now.mean;
 }
 
 }  // namespace

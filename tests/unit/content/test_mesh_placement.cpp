@@ -90,6 +90,32 @@ TEST(MeshPlacement, BoxStandsOnTheWallCentredOnSAndShaded) {
   }
 }
 
+// The view-dependent part for a moved viewer: a point of the placed mesh (off the wall)
+// lands on the projector pixel that lights the wall where the new viewer's ray through
+// it meets the wall (seed §4.2.1), inside the depth range; a viewer behind the wall is
+// refused.
+TEST(MeshPlacement, Planar3dForAMovedViewerFollowsTheirRays) {
+  PlanarView view = wallView();
+  auto placed = placeMeshContent(box(), view);
+  ASSERT_TRUE(placed) << placed.error().message;
+  view.eye = Vec3(-0.6, 1.2, 1.3);
+  auto m = planar3dForViewer(view, placed->S);
+  ASSERT_TRUE(m) << m.error().message;
+  for (const Vec3& p : placed->mesh.vertices) {
+    const Vec4 c = *m * p.homogeneous();
+    ASSERT_GT(c.w(), 0);
+    EXPECT_LE(std::abs(c.z()), c.w());
+    const Vec3 d = p - view.eye;
+    const Vec3 wall = view.eye + ((3 - view.eye.y()) / d.y()) * d;  // the wall y = 3
+    const Vec2 truth = (view.projector * wall.homogeneous()).hnormalized();
+    EXPECT_LT((c.head<2>() / c.w() - truth).norm(), 1e-6);
+  }
+  view.eye = Vec3(0, 3.5, 1.5);
+  auto behind = planar3dForViewer(view, placed->S);
+  ASSERT_FALSE(behind);
+  EXPECT_EQ(behind.error().code, ErrorCode::kDegenerate);
+}
+
 TEST(MeshPlacement, ViewerOnThePlaneIsDegenerate) {
   PlanarView view = wallView();
   view.eye = Vec3(0.5, 3.0, 1.5);
