@@ -119,7 +119,10 @@ TEST(SimLatency, NoLatencyMeasuresNone) {
   auto done = finalReply(c, 1, 30s);
   ASSERT_TRUE(done) << d.log();
   ASSERT_EQ((*done)["class"], "LATENCY") << done->dump();
-  checkCamera((*done)["cameras"][0], 0.0, 1, 0.5 * kLatency);
+  // The estimate lies within one frame period after the truth; a period under
+  // kLatency keeps "no latency" apart from the 0.1 s of the other scenes while
+  // leaving room for a loaded machine's slower ray casting.
+  checkCamera((*done)["cameras"][0], 0.0, 1, kLatency);
 }
 
 // corner_stereo at half resolution (as in test_sim_calibrate.cpp), both
