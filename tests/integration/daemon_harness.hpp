@@ -93,6 +93,20 @@ struct RunResult {
 };
 RunResult runProgram(const std::vector<std::string>& argv, const std::string& stdin_text = "");
 
+// The virtual cameras ray-cast every capture: about 8x slower under
+// AddressSanitizer. Tests that wait on captures scale their times by this.
+#if defined(__SANITIZE_ADDRESS__)
+inline constexpr int kSlowdown = 8;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+inline constexpr int kSlowdown = 8;
+#else
+inline constexpr int kSlowdown = 1;
+#endif
+#else
+inline constexpr int kSlowdown = 1;
+#endif
+
 // Waits until `predicate` holds, polling; false on timeout.
 template <class F>
 bool eventually(F predicate, std::chrono::milliseconds timeout = 5s);

@@ -56,19 +56,6 @@ struct CalibrateRun {
   std::optional<json> reply;  // the final CALIBRATE or ERROR
 };
 
-// The virtual cameras ray-cast every capture: about 8x slower under AddressSanitizer.
-#if defined(__SANITIZE_ADDRESS__)
-constexpr int kSlowdown = 8;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr int kSlowdown = 8;
-#else
-constexpr int kSlowdown = 1;
-#endif
-#else
-constexpr int kSlowdown = 1;
-#endif
-
 // Reads until the final reply to `id` (none for id < 0: a watcher) and the
 // finished event arrive.
 void follow(Connection& c, int id, CalibrateRun& run, std::chrono::milliseconds timeout = 90s) {
