@@ -26,10 +26,10 @@ std::string withLatency(std::string text, double latency_s) {
   return text;
 }
 
-// handheld with its camera at 160x120 (a quarter): quick ray-cast captures.
+// handheld with its camera at 80x60 (an eighth): quick ray-cast captures.
 std::string handheldScene(const TempDir& dir, double latency_s) {
   std::string t = procam::testing::sceneText("handheld");
-  EXPECT_TRUE(procam::testing::scaleDevice(t, 640, 480, 0.25));
+  EXPECT_TRUE(procam::testing::scaleDevice(t, 640, 480, 0.125));
   dir.write("handheld_latency.toml", withLatency(t, latency_s));
   return dir.file("handheld_latency.toml");
 }
