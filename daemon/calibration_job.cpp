@@ -4,6 +4,7 @@
 #include <opencv2/imgproc.hpp>
 #include <thread>
 
+#include "device_set.hpp"
 #include "latency_probe.hpp"
 #include "output_frames.hpp"
 #include "protocol.hpp"
@@ -35,11 +36,11 @@ bool integerArg(const json& request, const char* key, int lo, int hi, int& out,
 CalibrationFailure deviceFailure(const char* family, const std::string& name, int rc,
                                  const char* what, const char* reason) {
   const std::string why = reason[0] ? reason : "no reason given";
-  if (rc == PROCAM_ENODEV) {
-    return {
-        code::kCancelled,
-        "calibration cancelled: " + std::string(family) + " '" + name + "' is gone (" + why + ")",
-        name, rc};
+  if (closesDevice(rc)) {
+    return {code::kCancelled,
+            "calibration cancelled: " + std::string(family) + " '" + name + "' " +
+                (rc == PROCAM_EEND ? "ended" : "is gone") + " (" + why + ")",
+            name, rc};
   }
   return {code::kIo, std::string(family) + " '" + name + "' failed to " + what + ": " + why, name,
           rc};

@@ -241,8 +241,8 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
         }
         operationEvent(client, "finished", finished);
         server_->release(client);  // after the reply: a half-closed client may close now
-        // The device manager closes a lost device and retries it.
-        if (failure && failure->rc == PROCAM_ENODEV) {
+        // The device manager closes a lost device and retries it (or an ended one).
+        if (failure && closesDevice(failure->rc)) {
           device_manager_->report(failure->device, failure->rc, failure->message);
         }
         refreshOutputs();  // what the outputs showed before the pattern frames

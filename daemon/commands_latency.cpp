@@ -128,7 +128,7 @@ void Daemon::cmdLatency(ClientId client, const proto::Request& req) {
       }
       operationEvent(client, "finished", finished);
       server_->release(client);
-      if (failure && failure->rc == PROCAM_ENODEV) {
+      if (failure && closesDevice(failure->rc)) {
         device_manager_->report(failure->device, failure->rc, failure->message);
       }
       refreshOutputs();  // what the output showed before the black and white frames

@@ -234,6 +234,8 @@ void DeviceManager::report(const std::string& name, int rc, const std::string& r
   if (!e || !e->usable()) return;
   if (rc == PROCAM_ENODEV) {
     markLost(name, reason.empty() ? "the device is gone" : reason);
+  } else if (rc == PROCAM_EEND) {
+    markEnded(name, reason.empty() ? "its stream ended" : reason);
   } else {
     logDebug(describeFamily(*e) + ": error " + std::to_string(rc) + ": " + reason);
   }
@@ -252,6 +254,20 @@ void DeviceManager::markLost(const std::string& name, const std::string& reason)
   emit_("device-removed", e->toJson());
   removed(name);
   scheduleRetry(name);
+}
+
+// Closed like a lost device, but there is nothing to reopen: a recording that
+// played to its end stays ended until `reload` (or a restart) opens it again.
+void DeviceManager::markEnded(const std::string& name, const std::string& reason) {
+  unwatchFd(name);
+  DeviceEntry* e = devices_.find(name);
+  if (!e) return;
+  e->device.reset();
+  e->ended = true;
+  e->error = "ended: " + reason;
+  logInfo(describeFamily(*e) + " ended (" + reason + ")");
+  emit_("device-removed", e->toJson());
+  removed(name);
 }
 
 void DeviceManager::scheduleRetry(const std::string& name) {

@@ -109,7 +109,8 @@ class DeviceManager {
   Result<int> pollEvery(const std::string& name, std::chrono::nanoseconds interval);
   void stopPolling(int id);
   // For users that call a device's operations themselves: PROCAM_ENODEV
-  // marks the device lost (closed, device-removed, reopened with back-off).
+  // marks the device lost (closed, device-removed, reopened with back-off),
+  // PROCAM_EEND ended (closed, device-removed, not reopened).
   void report(const std::string& name, int rc, const std::string& reason);
 
   // One udev event ("add"/"remove"; others are ignored). The monitor feeds
@@ -125,6 +126,7 @@ class DeviceManager {
   void addDiscovered(DeviceEntry entry);
   void removeUnplugged(const std::string& name);
   void markLost(const std::string& name, const std::string& reason);
+  void markEnded(const std::string& name, const std::string& reason);
   void scheduleRetry(const std::string& name);
   void retry(const std::string& name, uint64_t token);
   void finishRetry(const std::string& name, uint64_t token, DeviceEntry fresh);

@@ -11,6 +11,7 @@ const procam_device& DeviceHandle::raw() const {
 
 const char* DeviceEntry::state() const {
   if (usable()) return "open";
+  if (ended) return "ended";
   return lost ? "lost" : "error";
 }
 

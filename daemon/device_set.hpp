@@ -36,6 +36,12 @@ class DeviceHandle {
 
 using DeviceOptions = std::vector<std::pair<std::string, std::string>>;
 
+// A status that closes the device: gone (PROCAM_ENODEV, reopened with
+// back-off) or ended for good (PROCAM_EEND, a finished recording).
+inline bool closesDevice(int rc) {
+  return rc == PROCAM_ENODEV || rc == PROCAM_EEND;
+}
+
 struct DeviceEntry {
   std::string name;
   plugins::DeviceDescription description;
@@ -44,12 +50,13 @@ struct DeviceEntry {
   int score = 0;       // the driver's probe() score (0: chosen by name)
   DeviceOptions options;
   DeviceHandle device;
-  std::string error;  // non-empty: not usable
-  bool lost = false;  // was open, then failed with PROCAM_ENODEV; retried
-  int retries = 0;    // failed reopen attempts since it was lost
+  std::string error;   // non-empty: not usable
+  bool lost = false;   // was open, then failed with PROCAM_ENODEV; retried
+  bool ended = false;  // was open, then its stream ended (PROCAM_EEND); not retried
+  int retries = 0;     // failed reopen attempts since it was lost
 
   bool usable() const { return device.valid(); }
-  // "open", "error" or "lost".
+  // "open", "error", "lost" or "ended".
   const char* state() const;
   nlohmann::json toJson() const;
 };

@@ -23,6 +23,7 @@ enum class Status {
   kAgain = PROCAM_EAGAIN,
   kNotSupported = PROCAM_ENOTSUP,
   kInternal = PROCAM_EINTERNAL,
+  kEnded = PROCAM_EEND,
 };
 
 struct CameraError {

@@ -1,8 +1,9 @@
 // A replayed recording through the running daemon (drivers/camera/README.md,
 // "replay"): a [[camera]] with driver "replay" in procamd.toml is opened, its
 // frames are read as the recording's timerfd makes them due, `devices` counts
-// them and measures their rate, and at the end of the recording the camera is
-// lost while the daemon keeps answering.
+// them and measures their rate, and at the end of the recording the camera
+// ends (not reopened: the recording is not played again) while the daemon
+// keeps answering.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -91,7 +92,7 @@ TEST(ReplayDaemon, FramesArriveAtTheRecordedRateThenTheCameraIsLost) {
   const double dts = (*b)["last_timestamp"].get<double>() - (*a)["last_timestamp"].get<double>();
   EXPECT_NEAR(dts, frames / kFps, 1e-6) << a->dump() << "\n" << b->dump();
 
-  // The end of a non-looping recording: lost, and the daemon still answers.
+  // The end of a non-looping recording: ended, and the daemon still answers.
   std::optional<json> removed;
   const auto deadline = std::chrono::steady_clock::now() + 10s;
   while (!removed && std::chrono::steady_clock::now() < deadline) {
@@ -102,16 +103,21 @@ TEST(ReplayDaemon, FramesArriveAtTheRecordedRateThenTheCameraIsLost) {
     }
   }
   ASSERT_TRUE(removed) << d.log();
-  EXPECT_EQ((*removed)["state"], "lost");
+  EXPECT_EQ((*removed)["state"], "ended");
   EXPECT_NE((*removed)["error"].get<std::string>().find("end of the recording"), std::string::npos)
       << removed->dump();
   auto status = c.call({{"cmd", "status"}});
   ASSERT_TRUE(status);
   EXPECT_EQ((*status)["class"], "STATUS");
-  // Every frame was read once (the lost camera is reopened only a second later).
+  // Every frame was read once, and past the first reopen back-off of a lost
+  // device (1 s) and the rate window (2 s) the camera is still ended: the
+  // recording did not start over, and no frame arrives.
+  std::this_thread::sleep_for(2500ms);
   auto after = camera(c);
   ASSERT_TRUE(after);
+  EXPECT_EQ((*after)["state"], "ended") << after->dump();
   EXPECT_EQ((*after)["frames"].get<int>(), kFrames) << after->dump();
+  EXPECT_EQ((*after)["rate_hz"].get<double>(), 0.0) << after->dump();
 }
 
 }  // namespace

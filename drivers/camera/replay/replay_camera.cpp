@@ -154,8 +154,8 @@ CamResult<const Frame*> ReplayCamera::capture(int timeout_ms) {
   if (timer_fd_ < 0) return camFail(Status::kInvalid, "replay: not started");
   if (next_ >= entries_.size()) {
     if (!options_.loop)
-      return camFail(Status::kNoDevice, "replay " + options_.dir + ": end of the recording (" +
-                                            std::to_string(entries_.size()) + " frames)");
+      return camFail(Status::kEnded, "replay " + options_.dir + ": end of the recording (" +
+                                         std::to_string(entries_.size()) + " frames)");
     next_ = 0;
     start_ns_ = monotonicNs();
   }

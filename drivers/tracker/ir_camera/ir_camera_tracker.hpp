@@ -54,8 +54,8 @@ class IrCameraTracker {
 
   // One frame: the viewer's predicted world position, the constellation's orientation
   // and the frame's timestamp. Camera errors pass through (PROCAM_ENODEV when it went
-  // away, PROCAM_EAGAIN when no frame is waiting); PROCAM_EAGAIN with a reason when the
-  // frame gives no pose ("LEDs not seen: ...").
+  // away, PROCAM_EEND when a recording ended, PROCAM_EAGAIN when no frame is waiting);
+  // PROCAM_EAGAIN with a reason when the frame gives no pose ("LEDs not seen: ...").
   CamResult<procam_pose_sample> read();
   int pollFd() const;
 

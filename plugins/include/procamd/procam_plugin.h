@@ -43,6 +43,7 @@ extern "C" {
 #define PROCAM_EAGAIN (-5)   /* no data yet; poll the device fd */
 #define PROCAM_ENOTSUP (-6)  /* operation not supported by this driver */
 #define PROCAM_EINTERNAL (-7)
+#define PROCAM_EEND (-8)     /* the stream ended for good (a finished recording) */
 
 typedef enum procam_family {
   PROCAM_FAMILY_CAMERA = 1,

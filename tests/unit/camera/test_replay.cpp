@@ -81,7 +81,7 @@ TEST(Replay, DeliversEveryFrameInOrderThenReportsTheEnd) {
   EXPECT_EQ(::poll(&p, 1, 1000), 1);
   auto end = cam.capture(0);
   ASSERT_FALSE(end);
-  EXPECT_EQ(end.error().status, Status::kNoDevice);
+  EXPECT_EQ(end.error().status, Status::kEnded);
   EXPECT_NE(end.error().message.find("end of the recording"), std::string::npos);
 }
 

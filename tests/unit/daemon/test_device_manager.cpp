@@ -343,6 +343,28 @@ TEST_F(ManagerTest, ReportedEnodevMarksLostAndOtherErrorsDoNot) {
   EXPECT_FALSE(runUntil([&] { return !devices_.entries().empty(); }, 1500ms));
 }
 
+TEST_F(ManagerTest, ReportedEndMarksEndedAndIsNotReopened) {
+  devices_.open(registry_, *describeUdevDevice(iioTilt()), "", {});
+  startWithoutUdev(60000ms);
+  std::vector<std::string> removed;
+  manager_->onDeviceRemoved([&](const DeviceEntry& e) { removed.push_back(e.name); });
+  manager_->report("iio:device0", PROCAM_EEND, "end of the recording (3 frames)");
+  const DeviceEntry* e = devices_.find("iio:device0");
+  ASSERT_NE(e, nullptr);  // still listed, as ended
+  EXPECT_EQ(std::string(e->state()), "ended");
+  EXPECT_FALSE(e->usable());
+  EXPECT_EQ(e->error, "ended: end of the recording (3 frames)");
+  ASSERT_EQ(eventsNamed("device-removed").size(), 1u);
+  EXPECT_EQ(eventsNamed("device-removed")[0]["state"], "ended");
+  EXPECT_FALSE(eventsNamed("device-removed")[0].contains("retries"));
+  EXPECT_EQ(removed, std::vector<std::string>{"iio:device0"});
+  EXPECT_TRUE(warnings_.empty());  // the normal end of a recording, not a fault
+  // No reopen past the first back-off (1 s).
+  EXPECT_FALSE(runUntil([&] { return devices_.find("iio:device0")->usable(); }, 1500ms));
+  EXPECT_EQ(devices_.find("iio:device0")->retries, 0);
+  EXPECT_TRUE(eventsNamed("device-added").empty());
+}
+
 TEST_F(ManagerTest, LostDeviceAnnouncedAgainByUdevIsReopenedAtOnce) {
   devices_.open(registry_, *describeUdevDevice(iioTilt()), "", {});
   startWithoutUdev(60000ms);

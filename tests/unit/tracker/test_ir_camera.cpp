@@ -158,7 +158,7 @@ TEST(IrCameraTracker, ReplayMeetsTwoMillimetresAndOneFrameOfLag) {
     out_x.push_back(r.sample.position[0]);
   }
   const Read end = readOnce(*dev);
-  EXPECT_EQ(end.status, PROCAM_ENODEV) << end.reason;
+  EXPECT_EQ(end.status, PROCAM_EEND) << end.reason;
   EXPECT_NE(end.reason.find("end of the recording"), std::string::npos) << end.reason;
 
   auto truth_x = [](double t) { return headAt(t).t.x(); };
