@@ -44,7 +44,7 @@ std::optional<json> camera(Connection& c) {
   return std::nullopt;
 }
 
-TEST(ReplayDaemon, FramesArriveAtTheRecordedRateThenTheCameraIsLost) {
+TEST(ReplayDaemon, FramesArriveAtTheRecordedRateThenTheCameraEnds) {
   TempDir recording;
   writeRecording(recording);
   TempDir dir;
@@ -118,6 +118,19 @@ TEST(ReplayDaemon, FramesArriveAtTheRecordedRateThenTheCameraIsLost) {
   EXPECT_EQ((*after)["state"], "ended") << after->dump();
   EXPECT_EQ((*after)["frames"].get<int>(), kFrames) << after->dump();
   EXPECT_EQ((*after)["rate_hz"].get<double>(), 0.0) << after->dump();
+
+  // reload opens the configured camera again: the recording plays from the start.
+  auto reloaded = c.call({{"cmd", "reload"}});
+  ASSERT_TRUE(reloaded);
+  EXPECT_EQ((*reloaded)["class"], "RELOAD") << reloaded->dump();
+  ASSERT_TRUE(eventually(
+      [&] {
+        auto cam = camera(c);
+        return cam && (*cam)["state"] == "open" &&
+               (*cam)["last_timestamp"].get<double>() > (*after)["last_timestamp"].get<double>();
+      },
+      5s))
+      << d.log();
 }
 
 }  // namespace
