@@ -329,7 +329,8 @@ TEST(SimMeshContent, DrawingFollowsTheTrackedViewerAndNotItsNoise) {
   // the viewer position reported for this frame.
   auto scene = sim::resolveScene(dir.file("follow.toml"));
   ASSERT_TRUE(scene) << scene.error().message;
-  const geom::CameraModel& proj = scene->at(0).projector("proj")->model;
+  const sim::SceneState state = scene->at(0);  // by value: keep it while `proj` is used
+  const geom::CameraModel& proj = state.projector("proj")->model;
   auto cube = content::loadMeshContent(dir.file("cube.obj"));
   ASSERT_TRUE(cube);
   content::PlanarView view;
