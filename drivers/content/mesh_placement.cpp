@@ -24,7 +24,7 @@ Result<PlacedMesh> placeMeshContent(const MeshContent& content, const PlanarView
   const int W = view.size.width, H = view.size.height;
   auto S = keystone::boundingDisplayRect(view.projector, W, H, view.plane_point, u, v);
   if (!S) return tl::unexpected(S.error());
-  const Vec3 centre = S->corner + 0.5 * S->width * S->u + 0.5 * S->height * S->v;
+  const Vec3 centre = S->center();
   const double distance = n.dot(view.eye - centre);
   auto planar3d = planar3dForViewer(view, *S);
   if (!planar3d) return tl::unexpected(planar3d.error());
@@ -66,8 +66,7 @@ Result<PlacedMesh> placeMeshContent(const MeshContent& content, const PlanarView
 
 Result<Mat4> planar3dForViewer(const PlanarView& view, const keystone::DisplayRect& S) {
   if (!view.eye.allFinite()) return fail(ErrorCode::kInvalidInput, "the viewer is not finite");
-  const Vec3 centre = S.corner + 0.5 * S.width * S.u + 0.5 * S.height * S.v;
-  const double distance = S.u.cross(S.v).dot(view.eye - centre);
+  const double distance = S.u.cross(S.v).dot(view.eye - S.center());
   if (!(distance > 1e-3))
     return fail(ErrorCode::kDegenerate, "the viewer is not in front of the display plane");
   // Depth range of P_T around the object: it lies between 0.75 and 1 times the plane

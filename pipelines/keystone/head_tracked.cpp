@@ -18,7 +18,7 @@ Eigen::Matrix<double, 4, 3> ndcToPlane(const DisplayRect& S) {
   Eigen::Matrix<double, 4, 3> M = Eigen::Matrix<double, 4, 3>::Zero();
   M.block<3, 1>(0, 0) = 0.5 * S.width * S.u;
   M.block<3, 1>(0, 1) = 0.5 * S.height * S.v;
-  M.block<3, 1>(0, 2) = S.corner + 0.5 * S.width * S.u + 0.5 * S.height * S.v;
+  M.block<3, 1>(0, 2) = S.center();
   M(3, 2) = 1;
   return M;
 }

@@ -22,6 +22,8 @@ struct DisplayRect {
   Vec3 u = Vec3::UnitX();
   Vec3 v = Vec3::UnitY();
   double width = 1, height = 1;
+
+  Vec3 center() const { return corner + 0.5 * width * u + 0.5 * height * v; }
 };
 
 // S of §4.2.1: the rectangle with axes (u, v) through `origin` that bounds the
