@@ -17,9 +17,6 @@
 #include "content_mesh.hpp"
 #include "daemon.hpp"
 #include "log.hpp"
-#ifdef PROCAM_HAVE_SIM
-#include "content/mesh_placement.hpp"
-#endif
 
 namespace procam::daemon {
 
@@ -30,7 +27,8 @@ Result<std::map<std::string, Mat4>> meshViewMatrices(const std::map<std::string,
 #ifdef PROCAM_HAVE_SIM
   std::map<std::string, Mat4> out;
   for (const auto& [name, v] : views) {
-    const content::PlanarView view{v.projector, v.size, v.plane_point, v.plane_normal, eye};
+    content::PlanarView view = v.view;
+    view.eye = eye;
     auto m = content::planar3dForViewer(view, v.S);
     if (!m) return tl::unexpected(m.error());
     out[name] = *m;

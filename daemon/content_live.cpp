@@ -17,7 +17,6 @@
 #ifdef PROCAM_HAVE_SIM
 #include <variant>
 
-#include "content/mesh_placement.hpp"
 #include "sim/scene_library.hpp"
 #endif
 #if PROCAM_HAVE_GSTREAMER
@@ -278,8 +277,7 @@ tl::expected<PreparedMesh, MeshFailure> prepareMeshContent(const std::string& fi
     viewer["position"] = {view.eye.x(), view.eye.y(), view.eye.z()};
     auto placed = content::placeMeshContent(*loaded, view);
     if (!placed) return unavailable(placed.error().message);
-    out.views[o.name] =
-        MeshView{view.projector, view.size, view.plane_point, view.plane_normal, placed->S};
+    out.views[o.name] = MeshView{view, placed->S};
     out.eye = view.eye;
     out.meshes[o.name] = Mesh3d{
         std::make_shared<const render::ColoredMesh>(std::move(placed->mesh)), placed->planar3d};

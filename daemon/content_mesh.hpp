@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "content/mesh_placement.hpp"
 #include "core/error.hpp"
 #include "core/types.hpp"
 #include "keystone/head_tracked.hpp"
@@ -26,12 +27,10 @@ struct MeshOutput {
   std::string sim_scene, sim_device;
 };
 
-// What an output's view-dependent matrix needs besides the viewer (content::PlanarView
-// without the eye, and S, fixed at placement).
+// What an output's view-dependent matrix needs: the view it was placed for (its eye is
+// replaced by the moved viewer's) and S, fixed at placement.
 struct MeshView {
-  Mat34 projector = Mat34::Zero();
-  cv::Size size;
-  Vec3 plane_point = Vec3::Zero(), plane_normal = Vec3::UnitZ();
+  content::PlanarView view;
   keystone::DisplayRect S;
 };
 
