@@ -35,48 +35,6 @@ Result<TiltMount> mountFromConfig(const KeystoneConfig& config) {
   return m;
 }
 
-Result<ProjectorModel> projectorFromRigFile(const std::string& state_dir, const std::string& name) {
-  const std::string path = state_dir + "/rig.json";
-  auto text = readWholeFile(path);
-  if (!text) return tl::unexpected(text.error());
-  const nlohmann::json j = nlohmann::json::parse(*text, nullptr, false);
-  const auto bad = [&](const std::string& why) {
-    return fail(ErrorCode::kParse, path + ": " + why);
-  };
-  if (j.is_discarded() || !j.is_object()) return bad("not a JSON object");
-  const auto it = j.find("projectors");
-  if (it == j.end() || !it->is_array()) return bad("no \"projectors\" array");
-  const nlohmann::json* chosen = nullptr;
-  for (const auto& p : *it) {
-    if (p.is_object() && p.value("name", "") == name) chosen = &p;
-  }
-  if (!chosen && it->size() == 1) chosen = &(*it)[0];
-  if (!chosen) return fail(ErrorCode::kNotFound, path + " has no projector '" + name + "'");
-  const auto& p = *chosen;
-  const auto K = p.find("K");
-  if (K == p.end() || !K->is_array() || K->size() != 9)
-    return bad("projector \"K\" needs 9 numbers");
-  Mat3 M;
-  for (int i = 0; i < 9; ++i) {
-    if (!(*K)[i].is_number()) return bad("projector \"K\" needs 9 numbers");
-    M(i / 3, i % 3) = (*K)[i].get<double>();
-  }
-  if (!p.contains("width") || !p.contains("height") || !p["width"].is_number_integer() ||
-      !p["height"].is_number_integer()) {
-    return bad("projector needs integer \"width\" and \"height\"");
-  }
-  if (!M.allFinite() || M(2, 2) == 0) return bad("projector \"K\" is not finite");
-  ProjectorModel out;
-  out.K = geom::Intrinsics::fromMatrix(M);
-  out.width = p["width"].get<int>();
-  out.height = p["height"].get<int>();
-  out.source = path;
-  if (out.K.fx <= 0 || out.K.fy <= 0 || out.width <= 0 || out.height <= 0) {
-    return bad("projector intrinsics or size are not positive");
-  }
-  return out;
-}
-
 Result<TiltTracker> TiltTracker::create(const KeystoneConfig& config, TiltMount mount) {
   keystone::TiltFilterOptions o;
   o.cutoff_hz = config.cutoff_hz;
@@ -104,54 +62,6 @@ void TiltTracker::setCalibration(const keystone::AccelCalibration& calibration,
 std::optional<std::pair<Vec3, long>> TiltTracker::stillMean() const {
   if (!still_ || raw_count_ == 0) return std::nullopt;
   return std::pair<Vec3, long>(raw_sum_ / double(raw_count_), raw_count_);
-}
-
-namespace {
-constexpr const char* kPoseNames[6] = {"+x", "-x", "+y", "-y", "+z", "-z"};
-}
-
-Result<std::string> SixPositionCollector::add(const Vec3& mean_g) {
-  if (!mean_g.allFinite() || mean_g.norm() < 0.5) {
-    return fail(ErrorCode::kInvalidInput, "the reading is not a still 1 g");
-  }
-  Eigen::Index axis = 0;
-  mean_g.cwiseAbs().maxCoeff(&axis);
-  const Vec3 u = mean_g.normalized();
-  if (std::abs(u[axis]) < std::cos(10.0 * std::numbers::pi / 180.0)) {
-    return fail(ErrorCode::kInvalidInput,
-                "no sensor axis is within 10 degrees of vertical: hold one straight up or down");
-  }
-  const int slot = 2 * static_cast<int>(axis) + (u[axis] > 0 ? 0 : 1);
-  poses_[slot] = mean_g;
-  return std::string(kPoseNames[slot]);
-}
-
-std::vector<std::string> SixPositionCollector::filled() const {
-  std::vector<std::string> out;
-  for (int i = 0; i < 6; ++i) {
-    if (poses_[i]) out.emplace_back(kPoseNames[i]);
-  }
-  return out;
-}
-
-std::vector<std::string> SixPositionCollector::missing() const {
-  std::vector<std::string> out;
-  for (int i = 0; i < 6; ++i) {
-    if (!poses_[i]) out.emplace_back(kPoseNames[i]);
-  }
-  return out;
-}
-
-Result<keystone::CalibrationFit> SixPositionCollector::solve() const {
-  if (const auto m = missing(); !m.empty()) {
-    std::string list;
-    for (const auto& name : m) list += (list.empty() ? "" : ", ") + name;
-    return fail(ErrorCode::kTooFewPoints,
-                "six-position calibration still needs the holds with " + list + " up");
-  }
-  std::vector<Vec3> readings;
-  for (const auto& p : poses_) readings.push_back(*p);
-  return keystone::calibrateSixPosition(readings);
 }
 
 std::optional<Vec3> TiltTracker::add(const procam_tilt_sample& s) {

@@ -16,6 +16,7 @@
 #include "geometry/camera_model.hpp"
 #include "keystone/accel_calibration.hpp"
 #include "keystone/orientation.hpp"
+#include "keystone/six_position.hpp"
 #include "keystone/tilt_filter.hpp"
 #include "procamd/procam_plugin.h"
 #include "tilt/sample_gate.hpp"
@@ -39,10 +40,6 @@ struct TiltMount {
 // The mount and calibration of [keystone] in procamd.toml; kInvalidInput when
 // the mount is not a rotation.
 Result<TiltMount> mountFromConfig(const KeystoneConfig& config);
-
-// The projector of `state_dir`/rig.json (the one named `name`, or the only one);
-// kNotFound without the file or the projector, kParse for a malformed file.
-Result<ProjectorModel> projectorFromRigFile(const std::string& state_dir, const std::string& name);
 
 // The sensor side of the loop; runs on the event loop (cheap per sample).
 class TiltTracker {
@@ -77,24 +74,7 @@ class TiltTracker {
   long raw_count_ = 0;
 };
 
-// The six still holds of keystone::calibrateSixPosition, one per sensor axis
-// pointing up or down, collected one at a time (a real rig: the user turns the
-// projector; the virtual rig: the scene is posed).
-class SixPositionCollector {
- public:
-  // A still mean (sensor frame, g, uncalibrated). The pose it fills ("+x" ...
-  // "-z": the axis pointing up); kInvalidInput when no axis is within 10
-  // degrees of vertical.
-  Result<std::string> add(const Vec3& mean_g);
-  std::vector<std::string> filled() const;
-  std::vector<std::string> missing() const;
-  // kTooFewPoints naming the missing poses; the fit's own errors.
-  Result<keystone::CalibrationFit> solve() const;
-  void clear() { poses_ = {}; }
-
- private:
-  std::array<std::optional<Vec3>, 6> poses_;  // +x, -x, +y, -y, +z, -z
-};
+using keystone::SixPositionCollector;
 
 // One keystone solution for the content size in use.
 struct KeystoneEstimate {

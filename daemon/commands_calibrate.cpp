@@ -1,17 +1,16 @@
 // The calibrate operation (PROTOCOL.md): chooses the devices, runs the
 // structured-light capture and route (a) on the compute worker, and writes
-// rig.json (and surface.ply for a non-planar surface) through StateFile.
+// what it learnt into the rig model (rig_store.hpp): the projector bound to the
+// output, and its surface (a plane, or a mesh file for a non-planar surface).
 #include <algorithm>
 
 #include "calibration_job.hpp"
 #include "daemon.hpp"
 #include "device_manager.hpp"
 #include "log.hpp"
-#include "rig_file.hpp"
-
-#ifdef PROCAM_HAVE_SIM
-#include "sim/scene_library.hpp"
-#endif
+#include "rig/rig_json.hpp"
+#include "rig_store.hpp"
+#include "surface/surface_model.hpp"
 
 namespace procam::daemon {
 
@@ -20,69 +19,24 @@ namespace code = proto::code;
 
 namespace {
 
-constexpr const char* kRigFile = "rig.json";
-constexpr const char* kMeshFile = "surface.ply";
-
 using Failure = CalibrationFailure;
 
-StateFile rigFile(const std::string& state_dir) {
-  return StateFile(state_dir, kRigFile, [](std::string_view text) -> Result<void> {
-    auto j = json::parse(text, nullptr, false);
-    if (j.is_discarded() || !j.is_object() || !j.contains("projectors") ||
-        !j["projectors"].is_array()) {
-      return fail(ErrorCode::kParse, "not a rig.json document (an object with \"projectors\")");
-    }
-    return {};
-  });
-}
-
-StateFile meshFile(const std::string& state_dir) {
-  return StateFile(state_dir, kMeshFile, [](std::string_view text) -> Result<void> {
-    if (text.substr(0, 4) != "ply\n") return fail(ErrorCode::kParse, "not an ASCII PLY file");
-    return {};
-  });
-}
-
-// A camera's K, distortion and pose. On the virtual rig: the scene's truth (the
-// pose at time 0; the mock camera renders with exactly this model). Elsewhere: the
-// camera of that name in the state directory's rig.json, as procam-calibrate
-// camera/stereo (or an earlier calibrate) wrote it.
+// A camera's K, distortion and pose: the camera of that name in the rig model, as
+// procam-calibrate camera/stereo, `procamd --rig` or an earlier calibrate put it.
 tl::expected<geom::CameraModel, Failure> cameraModel(const DeviceEntry& e,
-                                                     const std::string& state_dir) {
-  if (e.description.subsystem == "sim") {
-#ifdef PROCAM_HAVE_SIM
-    auto scene = sim::resolveScene(e.description.property("SIM_SCENE"));
-    if (!scene) return tl::unexpected(Failure{code::kUnavailable, scene.error().message});
-    const sim::SceneState state = scene->at(0);
-    if (const auto* c = state.camera(e.description.property("SIM_DEVICE"))) return c->model;
-#endif
-    return tl::unexpected(
-        Failure{code::kUnavailable, "no scene truth for virtual camera '" + e.name + "'"});
-  }
-  const StateFile rig = rigFile(state_dir);
-  auto loaded = rig.read();
-  if (!loaded) {
-    return tl::unexpected(Failure{
-        code::kUnavailable, "camera '" + e.name + "' is not calibrated: " + loaded.error().message +
-                                " (calibrate the cameras with procam-calibrate stereo and put "
-                                "them in " +
-                                rig.path() + ")"});
-  }
-  auto cameras = rig::camerasFromJson(json::parse(loaded->contents), rig.path());
-  if (cameras) {
-    for (const auto& c : *cameras) {
-      if (c.name == e.name) return c.model;
-    }
-  }
+                                                     const rig::RigModel& rig) {
+  if (const rig::RigCamera* c = rig.camera(e.name)) return c->model;
   return tl::unexpected(Failure{
-      code::kUnavailable,
-      "camera '" + e.name + "' is not calibrated: " + rig.path() + " has no camera of that name"});
+      code::kUnavailable, "camera '" + e.name +
+                              "' is not calibrated: the rig model has no camera of that name "
+                              "(calibrate the cameras with procam-calibrate stereo and install "
+                              "the result with procamd --rig)"});
 }
 
 // The devices and camera models of a run; everything but the capture itself.
 tl::expected<CalibrationPlan, Failure> makePlan(DeviceSet& devices, const CalibrationArgs& args,
                                                 const CalibrationConfig& latency,
-                                                const std::string& state_dir) {
+                                                const rig::RigModel& rig) {
   auto pick = [&](procam_family family, const std::string& name,
                   const std::vector<const DeviceEntry*>& taken) -> const DeviceEntry* {
     for (const auto& e : devices.entries()) {
@@ -135,7 +89,7 @@ tl::expected<CalibrationPlan, Failure> makePlan(DeviceSet& devices, const Calibr
   plan.latency = latency;
   plan.output = {out->name, out->device.share()};
   for (const DeviceEntry* c : cams) {
-    auto model = cameraModel(*c, state_dir);
+    auto model = cameraModel(*c, rig);
     if (!model) return tl::unexpected(model.error());
     plan.cameras.push_back({{c->name, c->device.share()}, *model});
   }
@@ -189,7 +143,7 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
     return errorTo(client, req, code::kBusy,
                    "calibration " + calibration_.op + " is running; wait for it or cancel it");
   }
-  auto made = makePlan(devices_, *args, config_.calibration, options_.state_dir);
+  auto made = makePlan(devices_, *args, config_.calibration, rig_);
   if (!made) return errorTo(client, req, made.error().code, made.error().message);
   auto plan = std::make_shared<const CalibrationPlan>(std::move(*made));
 
@@ -258,16 +212,38 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
       operations_.erase(op_id);
       operationEvent(client, "progress", progress({0.98, "writing", plan->captures()}));
       const calib::StereoRouteResult& route = result->route;
-      std::vector<rig::NamedCamera> cameras;
-      for (const auto& c : plan->cameras) cameras.push_back({c.device.name, c.model, -1});
-      const rig::NamedProjector projector{plan->output.name, plan->set.options.width,
-                                          plan->set.options.height, route.projector};
-      const json surface = rig::surfaceJson(route.surface, kMeshFile);
-      const std::string text = rig::rigJson(cameras, projector, surface).dump(2) + "\n";
-      const std::string mesh = route.surface.planar ? "" : surface::toPly(route.surface.mesh);
+      // What this run learnt, merged into the rig model: the cameras keep their
+      // models, the projector bound to the output gets K, pose and its surface.
+      rig::RigModel update;
+      rig::RigProjector projector;
+      projector.name = projector.output = plan->output.name;
+      projector.width = plan->set.options.width;
+      projector.height = plan->set.options.height;
+      projector.K = route.projector.K;
+      projector.pose = route.projector.pose;
+      projector.scale_known = route.projector.scale_known;
+      projector.rms_px = route.projector.rms_px;
+      projector.points = route.projector.points;
+      std::string how = "structured light, route (a): cameras";
+      for (const auto& c : plan->cameras) how += " " + c.device.name;
+      projector.calibrated = {how, utcNow()};
+      update.projectors.push_back(projector);
+      std::map<std::string, std::string> meshes;
+      if (route.surface.planar) {
+        update.surface.plane = route.surface.plane;
+        update.surface.plane_rms_m = route.surface.plane_rms;
+      } else {
+        const std::string file = meshFileName(projector.name);
+        update.surface.meshes[projector.name] = file;
+        meshes[file] = surface::toPly(route.surface.mesh);
+      }
+      const rig::NamedProjector named{plan->output.name, plan->set.options.width,
+                                      plan->set.options.height, route.projector};
+      const json surface = route.surface.planar ? rig::surfaceJson(route.surface, "")
+                                                : json{{"mesh", meshFileName(projector.name)}};
       json reply = {{"operation", op_id},
                     {"state", "done"},
-                    {"projector", rig::projectorJson(projector)},
+                    {"projector", rig::projectorJson(named)},
                     {"position", positionJson(route.projector.pose)},
                     {"reprojection_rms_px", route.projector.rms_px},
                     {"surface", surface},
@@ -277,20 +253,20 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
                     {"settle_frames", result->settle_frames}};
       if (!result->latency.is_null()) reply["latency"] = result->latency;
       // fsync may block: the I/O worker writes the mesh first, then rig.json
-      // (the previous versions stay as .bak).
-      io_worker_->submit([dir = options_.state_dir, text, mesh, reply, finish] {
-        Result<void> ok;
-        if (!mesh.empty()) ok = meshFile(dir).write(mesh);
-        const StateFile rig = rigFile(dir);
-        if (ok) ok = rig.write(text);
-        return [ok, reply, finish, path = rig.path()]() mutable {
-          if (!ok) {
-            const Failure f{code::kIo, "rig.json not written: " + ok.error().message};
+      // (the previous versions stay as .bak; a failure leaves rig.json as it was).
+      io_worker_->submit([this, dir = options_.state_dir, update, meshes, reply, finish] {
+        auto merged = mergeIntoRig(dir, update, meshes);
+        return [this, merged, reply, finish, path = rigStateFile(dir).path()]() mutable {
+          if (!merged) {
+            const Failure f{code::kIo, "rig.json not written: " + merged.error().message};
             return finish({}, &f);
           }
+          rig_ = *merged;
           reply["path"] = path;
+          reply["rig"] = {{"cameras", rig_.cameras.size()}, {"projectors", rig_.projectors.size()}};
           logInfo("calibration written to " + path);
           finish(reply, nullptr);
+          onRigChanged();
         };
       });
     };

@@ -78,11 +78,12 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
     std::vector<MeshOutput> outputs;
     for (const auto& e : devices_.entries()) {
       if (e.description.family != PROCAM_FAMILY_OUTPUT || !e.usable()) continue;
-      const bool sim = e.description.subsystem == "sim";
-      outputs.push_back({e.name, sim ? e.description.property("SIM_SCENE") : "",
-                         sim ? e.description.property("SIM_DEVICE") : ""});
+      MeshOutput o{e.name, std::nullopt, rig_.surface.plane, !rig_.surface.empty()};
+      const rig::RigProjector* p = rig_.projectorForOutput(e.name);
+      if (p && p->pose_known && p->scale_known) o.projector = p->model();
+      outputs.push_back(std::move(o));
     }
-    // The viewer: a tracker's (status `viewer`), else [content] viewer, else the scene's.
+    // The viewer: a tracker's (status `viewer`), else [content] viewer, else the rig's.
     std::optional<Vec3> eye;
     json eye_source;
     if (const json v = viewerJson(); v.is_object() && v["position"].is_array()) {
@@ -92,6 +93,9 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
     } else if (const auto& c = config_.content_viewer) {
       eye = Vec3((*c)[0], (*c)[1], (*c)[2]);
       eye_source = {{"source", "config"}};
+    } else if (rig_.viewer.position) {
+      eye = *rig_.viewer.position;
+      eye_source = {{"source", "rig"}};
     }
     server_->hold(client);
     compute_worker_->submit([this, client, req, file, outputs, eye, eye_source] {

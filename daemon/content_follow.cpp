@@ -24,7 +24,6 @@ using nlohmann::json;
 
 Result<std::map<std::string, Mat4>> meshViewMatrices(const std::map<std::string, MeshView>& views,
                                                      const Vec3& eye) {
-#ifdef PROCAM_HAVE_SIM
   std::map<std::string, Mat4> out;
   for (const auto& [name, v] : views) {
     content::PlanarView view = v.view;
@@ -34,10 +33,6 @@ Result<std::map<std::string, Mat4>> meshViewMatrices(const std::map<std::string,
     out[name] = *m;
   }
   return out;
-#else
-  (void)views, (void)eye;
-  return fail(ErrorCode::kInvalidInput, "3D content needs the virtual rig");
-#endif
 }
 
 void Daemon::followMeshViewer(PreparedMesh& prepared) {

@@ -14,11 +14,6 @@
 #include "content_mesh.hpp"
 #include "daemon.hpp"
 #include "request_args.hpp"
-#ifdef PROCAM_HAVE_SIM
-#include <variant>
-
-#include "sim/scene_library.hpp"
-#endif
 #if PROCAM_HAVE_GSTREAMER
 #include "content/gst_source.hpp"
 #endif
@@ -228,53 +223,57 @@ tl::expected<PreparedMesh, MeshFailure> prepareMeshContent(const std::string& fi
                                                            const std::vector<MeshOutput>& outputs,
                                                            const std::optional<Vec3>& eye,
                                                            const json& eye_source) {
-#ifdef PROCAM_HAVE_SIM
   if (outputs.empty())
     return tl::unexpected(MeshFailure{code::kUnavailable, "no output to show 3D content on"});
+  // Geometry before the file: an uncalibrated rig is the common case to report.
+  for (const MeshOutput& o : outputs) {
+    auto unavailable = [&](const std::string& why) {
+      return tl::unexpected(
+          MeshFailure{code::kUnavailable, "3D content on output '" + o.name + "': " + why});
+    };
+    if (!o.projector) {
+      return unavailable("the rig model has no calibrated projector pose for it (run calibrate)");
+    }
+    if (!o.surface_known) {
+      return unavailable("the rig model has no display surface (run calibrate)");
+    }
+    if (!o.plane) {
+      return unavailable("the display surface is not planar; 3D content needs the planar 3D path");
+    }
+  }
+  if (!eye) {
+    return tl::unexpected(
+        MeshFailure{code::kUnavailable,
+                    "3D content needs a viewer: a tracker, [content] viewer in the "
+                    "configuration, or the rig model's viewer"});
+  }
   auto loaded = content::loadMeshContent(file);
   if (!loaded) {
     const bool io = loaded.error().code == ErrorCode::kIo;
     return tl::unexpected(MeshFailure{io ? code::kIo : code::kBadArgument, loaded.error().message});
   }
   PreparedMesh out;
-  json viewer = nullptr;
   for (const MeshOutput& o : outputs) {
     auto unavailable = [&](const std::string& why) {
       return tl::unexpected(
           MeshFailure{code::kUnavailable, "3D content on output '" + o.name + "': " + why});
     };
-    // The projector's pose and the display surface are known on the virtual rig (the
-    // scene's truth at time 0); a calibrated real rig does not provide them here yet.
-    if (o.sim_scene.empty()) {
-      return unavailable(
-          "its projector pose and display surface are unknown (3D content needs the virtual rig)");
-    }
-    auto scene = sim::resolveScene(o.sim_scene);
-    if (!scene) return unavailable(scene.error().message);
-    const sim::SceneState state = scene->at(0);
-    const sim::ProjectorState* projector = state.projector(o.sim_device);
-    if (!projector)
-      return unavailable("scene '" + o.sim_scene + "' has no projector '" + o.sim_device + "'");
-    const geom::CameraModel& model = projector->model;
-    // The surface the projector's central ray lights is the display surface.
+    const geom::CameraModel& model = *o.projector;
+    // The display surface is where the projector's central ray meets the plane.
     auto ray = model.backproject(Vec2((model.width - 1) / 2.0, (model.height - 1) / 2.0));
     if (!ray) return unavailable(ray.error().message);
-    const auto hit = scene->world().intersect(*ray);
-    if (!hit) return unavailable("the projector lights no surface");
-    const sim::Surface& surface = scene->world().surfaces()[static_cast<size_t>(hit->surface)];
-    if (!std::holds_alternative<geom::Plane>(surface.shape) &&
-        !std::holds_alternative<geom::Rectangle>(surface.shape)) {
-      return unavailable("the surface it lights ('" + surface.name + "', a " + surface.type +
-                         ") is not planar; 3D content needs the planar 3D path");
-    }
+    const geom::Plane& plane = *o.plane;
+    const double along = plane.n.dot(ray->dir);
+    if (std::abs(along) < 1e-9) return unavailable("the projector's central ray misses the plane");
+    const double s = -plane.signedDistance(ray->origin) / along;
+    if (!(s > 0)) return unavailable("the display plane is behind the projector");
     content::PlanarView view;
     view.projector = model.projectionMatrix();
     view.size = {model.width, model.height};
-    view.plane_point = hit->hit.point;
-    view.plane_normal = hit->hit.normal;
-    view.eye = eye ? *eye : scene->viewerPosition(0);
-    viewer = eye ? eye_source : json{{"source", "scene"}, {"scene", o.sim_scene}};
-    viewer["position"] = {view.eye.x(), view.eye.y(), view.eye.z()};
+    view.plane_point = ray->origin + s * ray->dir;
+    // Facing the projector, as the lit side of a wall does.
+    view.plane_normal = along < 0 ? plane.n : Vec3(-plane.n);
+    view.eye = *eye;
     auto placed = content::placeMeshContent(*loaded, view);
     if (!placed) return unavailable(placed.error().message);
     out.views[o.name] = MeshView{view, placed->S};
@@ -282,6 +281,8 @@ tl::expected<PreparedMesh, MeshFailure> prepareMeshContent(const std::string& fi
     out.meshes[o.name] = Mesh3d{
         std::make_shared<const render::ColoredMesh>(std::move(placed->mesh)), placed->planar3d};
   }
+  json viewer = eye_source;
+  viewer["position"] = {eye->x(), eye->y(), eye->z()};
   out.info = {{"path", file},
               {"mesh",
                {{"triangles", loaded->mesh.faces.size()},
@@ -289,12 +290,6 @@ tl::expected<PreparedMesh, MeshFailure> prepareMeshContent(const std::string& fi
                 {"shading", "lambert"},
                 {"viewer", viewer}}}};
   return out;
-#else
-  (void)file, (void)outputs, (void)eye, (void)eye_source;
-  return tl::unexpected(
-      MeshFailure{code::kUnavailable,
-                  "3D content needs the virtual rig, which this procamd was built without"});
-#endif
 }
 
 }  // namespace procam::daemon

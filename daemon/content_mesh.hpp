@@ -14,17 +14,21 @@
 #include "content/mesh_placement.hpp"
 #include "core/error.hpp"
 #include "core/types.hpp"
+#include "geometry/camera_model.hpp"
+#include "geometry/plane_fit.hpp"
 #include "keystone/head_tracked.hpp"
 #include "output_frames.hpp"
 #include "tl/expected.hpp"
 
 namespace procam::daemon {
 
-// An output device as the loop sees it: its name and, on the virtual rig, which
-// scene and which projector of it (SIM_SCENE, SIM_DEVICE; empty elsewhere).
+// An output and what the rig model knows of it: its projector's model (when
+// calibrated with a pose) and the display surface's plane (when planar).
 struct MeshOutput {
   std::string name;
-  std::string sim_scene, sim_device;
+  std::optional<geom::CameraModel> projector;
+  std::optional<geom::Plane> plane;
+  bool surface_known = false;  // the rig has a surface (a plane or a mesh)
 };
 
 // What an output's view-dependent matrix needs: the view it was placed for (its eye is
@@ -66,11 +70,11 @@ struct MeshFailure {
 // True for the 3D content files `content load` takes (.obj, .ply, any case).
 bool isMeshFile(const std::string& path);
 
-// Reads the mesh and places it for each output. The viewer is `eye` (world: a tracker's
-// or the configuration's, described by `eye_source`, an object with "source") when
-// given, else the virtual rig's scene viewer. `unavailable` when
-// an output's projector pose or display surface is unknown or the surface it lights is
-// not planar; `io-error` / `bad-argument` when the file cannot be read or parsed.
+// Reads the mesh and places it for each output. The viewer is `eye` (world: a
+// tracker's, the configuration's or the rig model's, described by `eye_source`, an
+// object with "source"). `unavailable` when there is no viewer, or an output's
+// projector pose or display surface is unknown or the surface is not planar;
+// `io-error` / `bad-argument` when the file cannot be read or parsed.
 tl::expected<PreparedMesh, MeshFailure> prepareMeshContent(const std::string& file,
                                                            const std::vector<MeshOutput>& outputs,
                                                            const std::optional<Vec3>& eye,

@@ -8,7 +8,6 @@
 
 #include "loader.hpp"
 #include "log.hpp"
-#include "sim_rig.hpp"
 #include "systemd_notify.hpp"
 
 namespace procam::daemon {
@@ -100,18 +99,10 @@ Result<void> Daemon::setup() {
                                                });
   if (auto ok = settings_file_->ensureDirectory(); !ok) return ok;
   loadSettings();
+  if (auto ok = loadRigModel(); !ok) return ok;
   loadDrivers();
   if (!options_.sim_scene.empty()) {
-    auto sim = simDevices(options_.sim_scene);
-    if (!sim) return tl::unexpected(sim.error());
-    for (auto& desc : *sim) {
-      const DeviceEntry& e = devices_.open(registry_, std::move(desc), "", {});
-      if (!e.usable()) {
-        return fail(ErrorCode::kIo, "virtual rig device '" + e.name + "': " + e.error);
-      }
-    }
-    logInfo("virtual rig '" + options_.sim_scene +
-            "': " + std::to_string(devices_.entries().size()) + " device(s)");
+    if (auto ok = openVirtualRig(); !ok) return ok;
   }
   openDevices();
   device_manager_ = std::make_unique<DeviceManager>(
@@ -175,6 +166,56 @@ void Daemon::loadDrivers() {
   for (const auto& e : errors) warn(e.message);
   for (const auto& r : refused) warn(r);
   logInfo(std::to_string(registry_.drivers().size()) + " driver(s) available");
+}
+
+Result<void> Daemon::loadRigModel() {
+  if (!options_.rig_path.empty()) {
+    auto imported = importRig(options_.state_dir, options_.rig_path);
+    if (!imported) return fail(imported.error().code, "--rig: " + imported.error().message);
+    logInfo("rig model from " + options_.rig_path + ": " +
+            std::to_string(imported->cameras.size()) + " camera(s), " +
+            std::to_string(imported->projectors.size()) + " projector(s)");
+  }
+  auto loaded = loadRig(options_.state_dir);
+  if (!loaded) {
+    // A damaged rig is not fatal: the daemon runs without geometry until calibrate.
+    warn("rig model not loaded: " + loaded.error().message);
+    return {};
+  }
+  if (!loaded->warning.empty()) warn(loaded->warning);
+  rig_ = std::move(loaded->rig);
+  if (rig_.empty()) {
+    logInfo("no rig model yet (" + loaded->path + "): calibrate writes it");
+  } else if (options_.rig_path.empty()) {
+    logInfo("rig model " + loaded->path + ": " + std::to_string(rig_.cameras.size()) +
+            " camera(s), " + std::to_string(rig_.projectors.size()) + " projector(s)");
+  }
+  return {};
+}
+
+// The virtual rig is a set of drivers like any other: every driver that lists
+// devices by itself is asked for the scene's, and each is opened through
+// probe/create. The daemon learns nothing of the scene but the devices.
+Result<void> Daemon::openVirtualRig() {
+  const std::vector<std::pair<std::string, std::string>> options = {{"scene", options_.sim_scene}};
+  size_t opened = 0;
+  for (const plugins::Driver& driver : registry_.drivers()) {
+    auto listed = plugins::enumerateDevices(driver, options);
+    if (!listed) return tl::unexpected(listed.error());
+    for (auto& desc : *listed) {
+      const DeviceEntry& e = devices_.open(registry_, std::move(desc), driver.name(), {});
+      if (!e.usable()) {
+        return fail(ErrorCode::kIo, "virtual rig device '" + e.name + "': " + e.error);
+      }
+      ++opened;
+    }
+  }
+  if (opened == 0) {
+    return fail(ErrorCode::kNotFound, "no driver provides the virtual rig '" + options_.sim_scene +
+                                          "' (built without the simulator?)");
+  }
+  logInfo("virtual rig '" + options_.sim_scene + "': " + std::to_string(opened) + " device(s)");
+  return {};
 }
 
 void Daemon::openDevices() {

@@ -20,6 +20,7 @@
 #include "event_loop.hpp"
 #include "keystone_runtime.hpp"
 #include "registry.hpp"
+#include "rig_store.hpp"
 #include "settings.hpp"
 #include "state_file.hpp"
 #include "tracker_state.hpp"
@@ -36,6 +37,7 @@ struct DaemonOptions {
   std::string state_dir = "/var/lib/procamd";
   std::string plugin_dir;  // overrides the config and the built-in default
   std::string sim_scene;   // non-empty: run on the virtual rig
+  std::string rig_path;    // non-empty: install this rig.json in the state directory at start
 };
 
 inline constexpr const char* kRelease = PROCAM_RELEASE;
@@ -55,6 +57,10 @@ class Daemon {
   void loadSettings();
   void loadDrivers();
   void openDevices();
+  Result<void> openVirtualRig();
+  Result<void> loadRigModel();
+  // After calibrate changed rig_: consumers that read it pick it up.
+  void onRigChanged();
   void onSignal(int signo);
   void housekeeping();
   void warn(const std::string& message);
@@ -145,6 +151,7 @@ class Daemon {
   Config config_;
   Settings settings_;
   std::unique_ptr<StateFile> settings_file_;
+  rig::RigModel rig_;  // the state directory's rig.json: the only source of geometry
   std::vector<std::string> warnings_;
   plugins::DriverRegistry registry_;
   std::chrono::steady_clock::time_point started_;

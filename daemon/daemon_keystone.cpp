@@ -10,8 +10,6 @@
 #include "geometry/homography.hpp"
 #include "log.hpp"
 #include "request_args.hpp"
-#include "sim_keystone.hpp"
-#include "sim_rig.hpp"
 
 namespace procam::daemon {
 
@@ -53,16 +51,15 @@ std::optional<cv::Size> outputMode(const DeviceEntry& e) {
 }  // namespace
 
 void Daemon::setupAutoKeystone() {
-  // Policy and the virtual rig's default scene turn it on at start; a saved
-  // setting may too.
-  if (config_.auto_keystone || options_.sim_scene == kDefaultSimScene) {
-    settings_.auto_keystone = true;
-  }
+  // Policy turns it on at start; a saved setting may too.
+  if (config_.auto_keystone) settings_.auto_keystone = true;
   probeKeystoneInputs();
 }
 
-// Finds the tilt sensor, the output and the intrinsics; again on `auto on`
-// while they are missing (a rig.json written by calibrate, a sensor plugged in).
+// Finds the tilt sensor, the output, the projector's intrinsics and the sensor's
+// mount; again on `auto on` while they are missing (a rig model written by
+// calibrate, a sensor plugged in). Geometry comes from the rig model only; the
+// mount from the rig's projector entry, else from [keystone] in the configuration.
 void Daemon::probeKeystoneInputs() {
   KeystoneRuntime& k = keystone_rt_;
   DeviceEntry* tilt = devices_.firstUsable(PROCAM_FAMILY_TILT);
@@ -77,49 +74,38 @@ void Daemon::probeKeystoneInputs() {
   k.tilt_device = tilt->name;
   if (!k.hooked) watchTiltSensor();
   k.hooked = true;
-  auto rig = projectorFromRigFile(options_.state_dir, out->name);
-  if (!rig && rig.error().code != ErrorCode::kNotFound) warn(rig.error().message);
-  const std::string scene = tilt->description.property("SIM_SCENE");
-  if (tilt->description.subsystem == "sim" && !scene.empty()) {
-    // The virtual rig: intrinsics from the scene (rig.json wins when present),
-    // the accelerometer calibrated by posing the simulated projector.
-    k.unavailable = "calibrating the accelerometer (six positions)";
-    k.preparing = true;
-    std::optional<ProjectorModel> from_rig;
-    if (rig) from_rig = *rig;
-    compute_worker_->submit([this, scene, proj = out->name, sensor = tilt->name, from_rig] {
-      auto setup = simKeystoneSetup(scene, proj, sensor);
-      return [this, setup = std::move(setup), from_rig] {
-        keystone_rt_.preparing = false;
-        if (!setup) {
-          keystone_rt_.unavailable = "automatic keystone: " + setup.error().message;
-          warn(keystone_rt_.unavailable);
-          settings_.auto_keystone = false;
-          return;
-        }
-        keystone_rt_.calibration_rms_g = setup->calibration_rms_g;
-        logInfo("accelerometer: " + setup->mount.calibration_source + ", fit RMS " +
-                std::to_string(setup->calibration_rms_g * 1e3) + " mg");
-        useKeystoneInputs(from_rig ? *from_rig : setup->projector, setup->mount);
-      };
-    });
-    return;
-  }
-  if (!rig) {
-    k.unavailable = "automatic keystone needs the projector's intrinsics: " + rig.error().message +
-                    " (calibrate writes it)";
+  const rig::RigProjector* proj = rig_.projectorForOutput(out->name);
+  if (!proj) {
+    k.unavailable = "automatic keystone needs the intrinsics of the projector on output '" +
+                    out->name + "': the rig model has none (calibrate writes it)";
     if (settings_.auto_keystone) warn(k.unavailable + "; it stays off");
     settings_.auto_keystone = false;
     return;
   }
-  auto mount = mountFromConfig(config_.keystone);
+  ProjectorModel model;
+  model.K = proj->K;
+  model.width = proj->width;
+  model.height = proj->height;
+  model.source =
+      "rig model (" +
+      (proj->calibrated.method.empty() ? std::string("rig.json") : proj->calibrated.method) + ")";
+  Result<TiltMount> mount = mountFromConfig(config_.keystone);
+  if (proj->tilt && (proj->tilt->sensor.empty() || proj->tilt->sensor == tilt->name)) {
+    TiltMount m;
+    m.sensor_from_projector = proj->tilt->sensor_from_projector;
+    m.calibration = proj->tilt->calibration;
+    m.calibration_source =
+        proj->tilt->calibration_source.empty() ? "rig model" : proj->tilt->calibration_source;
+    k.calibration_rms_g = proj->tilt->fit_rms_g;
+    mount = m;
+  }
   if (!mount) {
     k.unavailable = mount.error().message;
     warn(k.unavailable);
     settings_.auto_keystone = false;
     return;
   }
-  useKeystoneInputs(*rig, *mount);
+  useKeystoneInputs(std::move(model), *mount);
 }
 
 void Daemon::useKeystoneInputs(ProjectorModel projector, TiltMount mount) {
@@ -141,8 +127,8 @@ void Daemon::useKeystoneInputs(ProjectorModel projector, TiltMount mount) {
 
 Result<void> Daemon::setAutoKeystone(bool enable) {
   KeystoneRuntime& k = keystone_rt_;
-  if (enable && !k.tracker && !k.preparing) probeKeystoneInputs();
-  if (enable && !k.tracker && !k.preparing) return fail(ErrorCode::kNotFound, k.unavailable);
+  if (enable && !k.tracker) probeKeystoneInputs();
+  if (enable && !k.tracker) return fail(ErrorCode::kNotFound, k.unavailable);
   settings_.auto_keystone = enable;
   if (!enable || !k.tracker) {
     stopTiltPolling();
@@ -583,6 +569,24 @@ json Daemon::outputsJson() const {
                     {"mean_rgb", {st.mean_rgb[0], st.mean_rgb[1], st.mean_rgb[2]}}});
   }
   return {{"frames", keystone_rt_.frames}, {"shown", list}};
+}
+
+}  // namespace procam::daemon
+
+namespace procam::daemon {
+
+void Daemon::onRigChanged() {
+  // Auto keystone keeps its tilt state and takes the new intrinsics; when it had
+  // none, `keystone auto on` reads the rig again.
+  KeystoneRuntime& k = keystone_rt_;
+  if (!k.projector) return;
+  const DeviceEntry* out = devices_.firstUsable(PROCAM_FAMILY_OUTPUT);
+  const rig::RigProjector* p = out ? rig_.projectorForOutput(out->name) : nullptr;
+  if (!p) return;
+  k.projector->K = p->K;
+  k.projector->width = p->width;
+  k.projector->height = p->height;
+  k.projector->source = "rig model (" + p->calibrated.method + ")";
 }
 
 }  // namespace procam::daemon

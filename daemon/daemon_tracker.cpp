@@ -10,10 +10,6 @@
 #include "log.hpp"
 #include "request_args.hpp"
 
-#ifdef PROCAM_HAVE_SIM
-#include "sim/scene_library.hpp"
-#endif
-
 namespace procam::daemon {
 
 using nlohmann::json;
@@ -33,20 +29,9 @@ StateFile trackerFile(const std::string& state_dir) {
   });
 }
 
-// The tracker's sample rate: the scene's on the virtual rig.
+// The tracker's sample rate, as its driver reports it (procam_tracker_ops::get_rate).
 double trackerPollHz(const DeviceEntry& e) {
-#ifdef PROCAM_HAVE_SIM
-  if (e.description.subsystem == "sim") {
-    if (auto scene = sim::resolveScene(e.description.property("SIM_SCENE"))) {
-      for (const auto& t : scene->trackers()) {
-        if (t.name == e.description.property("SIM_DEVICE") && t.rate_hz > 0) return t.rate_hz;
-      }
-    }
-  }
-#else
-  (void)e;
-#endif
-  return kDefaultTrackerPollHz;
+  return plugins::trackerRate(e.device.raw()).value_or(kDefaultTrackerPollHz);
 }
 
 json vec3(const Vec3& v) {

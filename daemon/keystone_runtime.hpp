@@ -22,8 +22,7 @@ struct KeystoneRuntime {
   std::optional<TiltTracker> tracker;
   std::string tilt_device;
   std::string unavailable = "no tilt sensor and projector intrinsics yet";
-  bool preparing = false;  // the virtual rig's accelerometer calibration is running
-  bool hooked = false;     // the device manager's hooks are registered
+  bool hooked = false;  // the device manager's hooks are registered
   double calibration_rms_g = -1;
   SixPositionCollector accel_holds;  // keystone accel-sample / accel-solve
   bool listening = false;            // samples of tilt_device feed the tracker

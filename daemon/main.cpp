@@ -10,15 +10,20 @@
 #include "loader.hpp"
 #include "log.hpp"
 #include "registry.hpp"
-#include "sim_rig.hpp"
 
 namespace {
+
+// `--sim` without a scene: a handheld projector with an accelerometer.
+constexpr const char* kDefaultSimScene = "handheld";
 
 constexpr const char* kUsage =
     "usage: procamd [options]\n"
     "  --config PATH       configuration (default /etc/procamd/procamd.toml when it exists)\n"
     "  --sim [SCENE]       run on the virtual rig: a shipped scene name or a file\n"
-    "                      (default: handheld)\n"
+    "                      (default: handheld); selects the mock drivers only: the\n"
+    "                      geometry comes from the rig model, as on hardware\n"
+    "  --rig FILE          install FILE (a rig.json, e.g. from procam-sim truth\n"
+    "                      --rig-json) as the state directory's rig model at start\n"
     "  --runtime-dir DIR   control socket directory (default $RUNTIME_DIRECTORY or /run/procamd)\n"
     "  --state-dir DIR     saved settings (default $STATE_DIRECTORY or /var/lib/procamd)\n"
     "  --plugin-dir DIR    driver plugins (default " PROCAM_DEFAULT_PLUGIN_DIR
@@ -76,8 +81,10 @@ int main(int argc, char** argv) {
       if (i + 1 < argc && argv[i + 1][0] != '-') {
         opts.sim_scene = argv[++i];
       } else {
-        opts.sim_scene = procam::daemon::kDefaultSimScene;
+        opts.sim_scene = kDefaultSimScene;
       }
+    } else if (a == "--rig") {
+      value(opts.rig_path);
     } else if (a == "--runtime-dir") {
       value(opts.runtime_dir);
     } else if (a == "--state-dir") {

@@ -1,6 +1,7 @@
 #include "driver.hpp"
 
 #include <array>
+#include <cmath>
 #include <cstring>
 
 namespace procam::plugins {
@@ -94,19 +95,34 @@ int Device::pollFd() const {
 
 namespace {
 
+// Every table starts at version 1; a newer table than this daemon knows is
+// fine (the daemon only reads the operations it knows).
 bool opsComplete(const procam_device& d) {
   switch (d.family) {
     case PROCAM_FAMILY_CAMERA:
-      return d.ops.camera && d.ops.camera->get_format && d.ops.camera->set_exposure &&
-             d.ops.camera->capture;
+      return d.ops.camera && d.ops.camera->version >= 1 && d.ops.camera->get_format &&
+             d.ops.camera->set_exposure && d.ops.camera->capture;
     case PROCAM_FAMILY_TILT:
-      return d.ops.tilt && d.ops.tilt->read;
+      return d.ops.tilt && d.ops.tilt->version >= 1 && d.ops.tilt->read;
     case PROCAM_FAMILY_TRACKER:
-      return d.ops.tracker && d.ops.tracker->read;
+      return d.ops.tracker && d.ops.tracker->version >= 1 && d.ops.tracker->read;
     case PROCAM_FAMILY_OUTPUT:
-      return d.ops.output && d.ops.output->get_mode && d.ops.output->show;
+      return d.ops.output && d.ops.output->version >= 1 && d.ops.output->get_mode &&
+             d.ops.output->show;
   }
   return false;
+}
+
+procam_config configView(const std::vector<std::pair<std::string, std::string>>& options,
+                         std::vector<procam_kv>& kv) {
+  kv.clear();
+  kv.reserve(options.size());
+  for (const auto& [k, v] : options) kv.push_back({k.c_str(), v.c_str()});
+  return procam_config{kv.empty() ? nullptr : kv.data(), kv.size()};
+}
+
+std::string text(const char* s) {
+  return s ? std::string(s) : std::string();
 }
 
 }  // namespace
@@ -114,9 +130,7 @@ bool opsComplete(const procam_device& d) {
 Result<Device> createDevice(const Driver& driver, DeviceDescription& desc,
                             const std::vector<std::pair<std::string, std::string>>& options) {
   std::vector<procam_kv> kv;
-  kv.reserve(options.size());
-  for (const auto& [k, v] : options) kv.push_back({k.c_str(), v.c_str()});
-  procam_config config{kv.empty() ? nullptr : kv.data(), kv.size()};
+  const procam_config config = configView(options, kv);
   procam_device out{};
   std::array<char, 512> err{};
   const int rc = driver.factory->create(&desc.view(), &config, &out, err.data(), err.size() - 1);
@@ -142,6 +156,67 @@ Result<Device> createDevice(const Driver& driver, DeviceDescription& desc,
                 who + " returned a device with missing " + familyName(out.family) + " operations");
   }
   return device;
+}
+
+// Bounds what one plugin may list, so that a broken one cannot flood the daemon.
+constexpr size_t kMaxEnumerated = 256;
+
+Result<std::vector<DeviceDescription>> enumerateDevices(
+    const Driver& driver, const std::vector<std::pair<std::string, std::string>>& options) {
+  std::vector<DeviceDescription> out;
+  if (!driver.factory->enumerate) return out;
+  std::vector<procam_kv> kv;
+  const procam_config config = configView(options, kv);
+  const procam_device_desc* list = nullptr;
+  size_t n = 0;
+  std::array<char, 512> err{};
+  const int rc = driver.factory->enumerate(&config, &list, &n, err.data(), err.size() - 1);
+  const std::string who = std::string("driver '") + driver.factory->name + "'";
+  if (rc != PROCAM_OK) {
+    const std::string reason = err[0] ? std::string(err.data()) : "no reason given";
+    return fail(ErrorCode::kIo, who + " could not list its devices: " + reason);
+  }
+  if (n > kMaxEnumerated || (n > 0 && !list)) {
+    return fail(ErrorCode::kInvalidInput, who + " listed " + std::to_string(n) +
+                                              " devices (at most " +
+                                              std::to_string(kMaxEnumerated) + ")");
+  }
+  for (size_t i = 0; i < n; ++i) {
+    const procam_device_desc& d = list[i];
+    if (rawFamily(d.family) != rawFamily(driver.factory->family)) {
+      return fail(ErrorCode::kInvalidInput,
+                  who + " listed a device of another family than its own");
+    }
+    DeviceDescription desc;
+    desc.family = d.family;
+    desc.subsystem = text(d.subsystem);
+    desc.devnode = text(d.devnode);
+    desc.syspath = text(d.syspath);
+    desc.name = text(d.name);
+    if (desc.name.empty())
+      return fail(ErrorCode::kInvalidInput, who + " listed a device without a name");
+    for (size_t k = 0; k < d.n_properties && d.properties; ++k) {
+      desc.properties.emplace_back(text(d.properties[k].key), text(d.properties[k].value));
+    }
+    out.push_back(std::move(desc));
+  }
+  return out;
+}
+
+}  // namespace procam::plugins
+
+namespace procam::plugins {
+
+std::optional<double> trackerRate(const procam_device& d) {
+  if (d.family != PROCAM_FAMILY_TRACKER || !d.ops.tracker || !d.ops.tracker->get_rate) {
+    return std::nullopt;
+  }
+  double hz = 0;
+  if (d.ops.tracker->get_rate(d.self, &hz) != PROCAM_OK || !std::isfinite(hz) || hz <= 0 ||
+      hz > 10000) {
+    return std::nullopt;
+  }
+  return hz;
 }
 
 }  // namespace procam::plugins

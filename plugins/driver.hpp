@@ -2,6 +2,7 @@
 // C++ side of the plugin ABI: owning wrappers for drivers, device descriptions
 // and created devices. Nothing here throws; failures are procam::Result.
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -78,5 +79,14 @@ class Device {
 // every operation of that family present).
 Result<Device> createDevice(const Driver& driver, DeviceDescription& desc,
                             const std::vector<std::pair<std::string, std::string>>& options);
+
+// The devices the driver provides by itself (procam_driver_factory::enumerate)
+// for these options; none when the driver has no enumerate. kIo when the driver
+// fails, kInvalidInput for a malformed list.
+Result<std::vector<DeviceDescription>> enumerateDevices(
+    const Driver& driver, const std::vector<std::pair<std::string, std::string>>& options);
+
+// The tracker's own sample rate when its driver reports one.
+std::optional<double> trackerRate(const procam_device& device);
 
 }  // namespace procam::plugins

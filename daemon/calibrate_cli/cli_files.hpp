@@ -10,7 +10,7 @@
 #include "calibration/projector_calibration.hpp"
 #include "core/error.hpp"
 #include "geometry/camera_model.hpp"
-#include "rig_file.hpp"
+#include "rig/rig_json.hpp"
 #include "structured_light/decoder.hpp"
 #include "structured_light/pattern_set.hpp"
 

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -22,6 +23,7 @@
 #include "keystone/keystone_solver.hpp"
 #include "keystone/orientation.hpp"
 #include "sim/scene_library.hpp"
+#include "sim/truth_rig.hpp"
 
 namespace {
 
@@ -151,11 +153,38 @@ int main(int argc, char** argv) {
     return demo::runToEnd(args);
   };
 
+  // procamd learns nothing from the simulator but its devices: the rig model (the
+  // projector's intrinsics and the accelerometer's mount and calibration) is handed
+  // over explicitly, as a calibrated rig's rig.json would be.
+  section("the rig model: the scene's truth, handed to procamd explicitly");
+  const std::string rig_file = dir + "/rig.json";
+  std::printf("$ procam-sim truth --scene %s --rig-json %s\n", opt.scene.c_str(), rig_file.c_str());
+  {
+    auto rig = sim::truthRig(scene, 0.0);
+    if (!rig) {
+      std::fprintf(stderr, "procam-demo: %s\n", rig.error().message.c_str());
+      return 1;
+    }
+    std::ofstream f(rig_file);
+    f << procam::rig::rigToJson(*rig).dump(2) << "\n";
+    if (!f.flush()) {
+      std::fprintf(stderr, "procam-demo: cannot write %s\n", rig_file.c_str());
+      return 1;
+    }
+    for (const auto& p : rig->projectors) {
+      if (p.tilt) {
+        std::printf("projector '%s': K fx=%.1f fy=%.1f; tilt sensor '%s': %s, fit RMS %.3f mg\n",
+                    p.name.c_str(), p.K.fx, p.K.fy, p.tilt->sensor.c_str(),
+                    p.tilt->calibration_source.c_str(), p.tilt->fit_rms_g * 1e3);
+      }
+    }
+  }
+
   section("start procamd on the virtual rig");
-  std::printf("$ procamd --sim %s --runtime-dir %s/run --state-dir %s/state  (log: %s)\n",
-              opt.scene.c_str(), dir.c_str(), dir.c_str(), log.c_str());
-  auto daemon = demo::Child::start({opt.procamd, "--sim", opt.scene, "--runtime-dir", dir + "/run",
-                                    "--state-dir", dir + "/state"},
+  std::printf("$ procamd --sim %s --rig %s --runtime-dir %s/run --state-dir %s/state  (log: %s)\n",
+              opt.scene.c_str(), rig_file.c_str(), dir.c_str(), dir.c_str(), log.c_str());
+  auto daemon = demo::Child::start({opt.procamd, "--sim", opt.scene, "--rig", rig_file,
+                                    "--runtime-dir", dir + "/run", "--state-dir", dir + "/state"},
                                    log, false);
   if (!daemon) {
     std::fprintf(stderr, "procam-demo: cannot start %s\n", opt.procamd.c_str());

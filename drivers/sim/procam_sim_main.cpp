@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
@@ -17,6 +18,7 @@
 #include "sim/renderer.hpp"
 #include "sim/scene_library.hpp"
 #include "sim/truth_json.hpp"
+#include "sim/truth_rig.hpp"
 
 namespace {
 
@@ -28,9 +30,11 @@ constexpr const char* kUsage = R"(usage:
       resolution); projectors not listed are dark. Writes an 8-bit PNG for cameras of
       <= 8 bits, else 16-bit with codes 0..2^bits-1. --seed picks the noise,
       --no-noise turns it off, --threads 1 renders on one core (default: all).
-  procam-sim truth --scene S [--json] [--time T]
+  procam-sim truth --scene S [--json] [--time T] [--rig-json OUT]
       Print the true K, R, t (world -> device), distortion and resolution of every
       device, the tilt-sensor mounts, trackers, viewer and surfaces as JSON.
+      --rig-json OUT writes the truth as a rig model (rig.json, version 2) for
+      `procamd --rig OUT` instead: a known rig a test hands procamd explicitly.
   procam-sim scenes
       List the built-in scenes.
   procam-sim --help
@@ -44,7 +48,7 @@ struct UsageError {
 };
 
 struct Args {
-  std::string command, scene, camera, out;
+  std::string command, scene, camera, out, rig_json;
   std::vector<std::pair<std::string, std::string>> shows;
   double time = 0;
   std::uint64_t seed = 1;
@@ -94,6 +98,8 @@ Args parseArgs(int argc, char** argv) {
       if (a.threads < 0) throw UsageError{"--threads must be >= 0"};
     } else if (flag == "--no-noise") {
       a.noise = false;
+    } else if (flag == "--rig-json") {
+      a.rig_json = value();
     } else if (flag == "--json") {
       a.json = true;
     } else {
@@ -141,9 +147,24 @@ int render(const Args& a) {
 int truth(const Args& a) {
   if (a.scene.empty()) throw UsageError{"truth needs --scene"};
   if (!a.shows.empty() || !a.camera.empty() || !a.out.empty())
-    throw UsageError{"truth takes only --scene, --json and --time"};
+    throw UsageError{"truth takes only --scene, --json, --time and --rig-json"};
   auto scene = procam::sim::resolveScene(a.scene);
   if (!scene) return fail(scene.error().message);
+  if (!a.rig_json.empty()) {
+    auto rig = procam::sim::truthRig(*scene, a.time);
+    if (!rig) return fail(rig.error().message);
+    // Written whole to a temporary file and renamed: a reader never sees half a rig.
+    const std::string tmp = a.rig_json + ".tmp";
+    {
+      std::ofstream f(tmp, std::ios::trunc);
+      f << procam::rig::rigToJson(*rig).dump(2) << "\n";
+      if (!f.flush()) return fail("cannot write '" + tmp + "'");
+    }
+    std::error_code ec;
+    std::filesystem::rename(tmp, a.rig_json, ec);
+    if (ec) return fail("cannot write '" + a.rig_json + "': " + ec.message());
+    return 0;
+  }
   std::cout << procam::sim::truthJson(*scene, scene->at(a.time)).dump(2) << "\n";
   return 0;
 }

@@ -53,7 +53,7 @@ TEST(Control, BannerIsTheVersionLine) {
   ASSERT_TRUE(v);
   EXPECT_EQ((*v)["class"], "VERSION");
   EXPECT_EQ((*v)["id"], "v1");
-  EXPECT_EQ((*v)["plugin_abi"], 1);
+  EXPECT_EQ((*v)["plugin_abi"], 2);
 }
 
 TEST(Control, StatusAndDevicesListTheRig) {

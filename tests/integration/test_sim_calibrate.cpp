@@ -11,6 +11,9 @@
 #include <sstream>
 
 #include "daemon_harness.hpp"
+#include "rig/rig_model.hpp"
+#include "sim/truth_rig.hpp"
+#include "truth_rig_file.hpp"
 #include "unit/calibration/rig_capture.hpp"
 
 namespace procam::itest {
@@ -73,11 +76,17 @@ void follow(Connection& c, int id, CalibrateRun& run, std::chrono::milliseconds 
   }
 }
 
-// A rig.json from an earlier calibration; returns its bytes.
-std::string writePreviousRig(const TempDir& dir) {
+// A rig.json from an earlier calibration (the scene's cameras and a projector
+// "old" on another output); returns its bytes.
+std::string writePreviousRig(const TempDir& dir, const std::string& scene) {
   std::filesystem::create_directories(dir.path() + "/state");
-  const std::string previous = R"({"cameras": [], "projectors": [{"name": "old"}]})"
-                               "\n";
+  auto s = sim::resolveScene(scene);
+  EXPECT_TRUE(s);
+  auto rig = sim::truthRig(*s, 0.0);
+  EXPECT_TRUE(rig);
+  rig->projectors.at(0).name = rig->projectors.at(0).output = "old";
+  rig->surface = {};
+  const std::string previous = rig::rigToJson(*rig).dump(2) + "\n";
   dir.write("state/rig.json", previous);
   return previous;
 }
@@ -91,11 +100,19 @@ void expectRigMatchesTruth(const TempDir& dir, const json& reply, const std::str
   const std::string path = reply["path"];
   EXPECT_EQ(path, dir.path() + "/state/rig.json");
   const json rig = json::parse(readFile(path));
-  ASSERT_EQ(rig["projectors"].size(), 1u);
-  const json& p = rig["projectors"][0];
-  EXPECT_EQ(p["name"], "proj");
+  EXPECT_EQ(rig["version"], 2);
+  const json* found = nullptr;
+  for (const json& q : rig["projectors"]) {
+    if (q["name"] == "proj") found = &q;
+  }
+  ASSERT_NE(found, nullptr) << rig.dump();
+  const json& p = *found;
+  EXPECT_EQ(p["output"], "proj");
   EXPECT_EQ(p["width"], projector_width);
-  EXPECT_EQ(p, reply["projector"]);
+  for (const char* key : {"K", "R", "t", "width", "height", "points"}) {
+    EXPECT_EQ(p[key], reply["projector"][key]) << key;
+  }
+  EXPECT_NE(p["calibrated"]["method"].get<std::string>().find("route (a)"), std::string::npos);
   const geom::CameraModel truth = projectorTruth(scene);
   const double fx = p["K"][0], fy = p["K"][4], cx = p["K"][2], cy = p["K"][5];
   EXPECT_NEAR(fx, truth.K.fx, 0.005 * truth.K.fx);
@@ -112,10 +129,10 @@ void expectRigMatchesTruth(const TempDir& dir, const json& reply, const std::str
   EXPECT_LT(rotation_deg, 0.05);
   const double rms = reply["reprojection_rms_px"];
   EXPECT_LE(rms, 0.15);
-  // Two walls: a mesh, written beside rig.json.
+  // Two walls: a mesh of the projector, written beside rig.json.
   EXPECT_EQ(reply["surface_type"], "mesh");
-  EXPECT_EQ(rig["surface"], json({{"mesh", "surface.ply"}}));
-  EXPECT_EQ(readFile(dir.path() + "/state/surface.ply").substr(0, 4), "ply\n");
+  EXPECT_EQ(rig["surface"], json({{"meshes", {{"proj", "surface-proj.ply"}}}}));
+  EXPECT_EQ(readFile(dir.path() + "/state/surface-proj.ply").substr(0, 4), "ply\n");
   EXPECT_EQ(rig["cameras"].size(), 2u);
   std::printf(
       "[ figures  ] fx %.2f (truth %.2f, %.3f%%), fy %.2f (%.3f%%), cx %.2f (%+.2f px), "
@@ -125,8 +142,10 @@ void expectRigMatchesTruth(const TempDir& dir, const json& reply, const std::str
       rotation_deg, rms, static_cast<int>(reply["triangulated"]));
 }
 
-DaemonProcess::Launch sim(const std::string& scene) {
-  return DaemonProcess::Launch{{"--sim", scene}, {}, -1, true};
+// The scene's cameras handed over as calibrated (what procam-calibrate stereo gives);
+// calibrate finds the projector and the surface.
+DaemonProcess::Launch sim(const TempDir& dir, const std::string& scene) {
+  return simWithTruth(dir, scene, TruthParts::kCamerasOnly);
 }
 
 // Waits for the operation's progress event with at least `captures` captures done.
@@ -142,7 +161,7 @@ bool waitForCaptures(Connection& c, CalibrateRun& run, int captures) {
 TEST(SimCalibrate, WritesRigJsonWithTheProjectorsIntrinsics) {
   TempDir dir;
   const std::string scene = sceneFile(dir);
-  DaemonProcess d(dir, sim(scene));
+  DaemonProcess d(dir, sim(dir, scene));
   ASSERT_TRUE(d.started()) << d.log();
   Connection watcher(d.socketPath());
   ASSERT_TRUE(watcher.call({{"cmd", "watch"}}));
@@ -199,12 +218,20 @@ TEST(SimCalibrate, WritesRigJsonWithTheProjectorsIntrinsics) {
 
 // The projector at its full 1280x800 with the cameras at 512x384: one camera pixel
 // spans ~3.3 projector pixels, and the same tolerances hold.
+// Also: the run merges into a rig that holds another projector and keeps it, and 3D
+// content then finds the calibrated surface non-planar (two walls).
 TEST(SimCalibrate, CamerasCoarserThanTheProjector) {
   TempDir dir;
   const std::string scene = sceneFile(dir, 1.0);
-  DaemonProcess d(dir, sim(scene));
+  const std::string previous = writePreviousRig(dir, scene);
+  DaemonProcess d(dir, DaemonProcess::Launch{{"--sim", scene}, {}, -1, true});
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
+  dir.write("cube.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  auto before =
+      c.call({{"cmd", "content"}, {"action", "load"}, {"path", dir.file("cube.obj")}}, 30s);
+  ASSERT_TRUE(before);
+  EXPECT_EQ((*before)["code"], "unavailable") << before->dump();  // no projector on 'proj' yet
   auto started = c.call(calibrateRequest(1));
   ASSERT_TRUE(started);
   ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
@@ -213,13 +240,24 @@ TEST(SimCalibrate, CamerasCoarserThanTheProjector) {
   ASSERT_TRUE(run.reply) << d.log();
   ASSERT_EQ((*run.reply)["class"], "CALIBRATE") << run.reply->dump();
   expectRigMatchesTruth(dir, *run.reply, scene, 1280);
+  const json was = json::parse(previous);
+  const json now = json::parse(readFile(dir.path() + "/state/rig.json"));
+  ASSERT_EQ(now["projectors"].size(), 2u);
+  EXPECT_EQ(now["projectors"][0], was["projectors"][0]);  // "old", untouched
+  EXPECT_EQ(now["cameras"], was["cameras"]);
+  auto after =
+      c.call({{"cmd", "content"}, {"action", "load"}, {"path", dir.file("cube.obj")}}, 30s);
+  ASSERT_TRUE(after);
+  EXPECT_EQ((*after)["code"], "unavailable") << after->dump();
+  EXPECT_NE((*after)["message"].get<std::string>().find("not planar"), std::string::npos)
+      << after->dump();
 }
 
 TEST(SimCalibrate, CancelMidRunKeepsThePreviousRigJson) {
   TempDir dir;
   const std::string scene = sceneFile(dir);
-  const std::string previous = writePreviousRig(dir);
-  DaemonProcess d(dir, sim(scene));
+  const std::string previous = writePreviousRig(dir, scene);
+  DaemonProcess d(dir, DaemonProcess::Launch{{"--sim", scene}, {}, -1, true});
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
   auto started = c.call(calibrateRequest(1));
@@ -251,7 +289,7 @@ TEST(SimCalibrate, CancelMidRunKeepsThePreviousRigJson) {
   EXPECT_LT(static_cast<int>(run.progress.back()["capture"]),
             static_cast<int>((*started)["captures"]));
   EXPECT_EQ(readFile(dir.path() + "/state/rig.json"), previous);
-  EXPECT_FALSE(std::filesystem::exists(dir.path() + "/state/surface.ply"));
+  EXPECT_FALSE(std::filesystem::exists(dir.path() + "/state/surface-proj.ply"));
   // A new calibration may start at once.
   auto again = c.call(calibrateRequest(3));
   ASSERT_TRUE(again);
@@ -264,7 +302,7 @@ TEST(SimCalibrate, CancelMidRunKeepsThePreviousRigJson) {
 TEST(SimCalibrate, CameraGoneMidRunCancelsNamingIt) {
   TempDir dir;
   const std::string scene = sceneFile(dir);
-  const std::string previous = writePreviousRig(dir);
+  const std::string previous = writePreviousRig(dir, scene);
   DaemonProcess d(dir, {{"--sim", scene}, {"PROCAM_SIM_UNPLUG=cam_right@4-1000"}, -1, true});
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
@@ -281,7 +319,7 @@ TEST(SimCalibrate, CameraGoneMidRunCancelsNamingIt) {
   ASSERT_TRUE(run.finished);
   EXPECT_EQ((*run.finished)["ok"], false);
   EXPECT_EQ(readFile(dir.path() + "/state/rig.json"), previous);
-  EXPECT_FALSE(std::filesystem::exists(dir.path() + "/state/surface.ply"));
+  EXPECT_FALSE(std::filesystem::exists(dir.path() + "/state/surface-proj.ply"));
   auto devices = c.call({{"cmd", "devices"}});
   ASSERT_TRUE(devices);
   std::map<std::string, std::string> state;
@@ -292,7 +330,7 @@ TEST(SimCalibrate, CameraGoneMidRunCancelsNamingIt) {
 
 TEST(SimCalibrate, SecondCalibrateWhileOneRunsIsBusy) {
   TempDir dir;
-  DaemonProcess d(dir, sim(sceneFile(dir)));
+  DaemonProcess d(dir, sim(dir, sceneFile(dir)));
   ASSERT_TRUE(d.started()) << d.log();
   std::optional<Connection> first;
   first.emplace(d.socketPath());
@@ -323,7 +361,8 @@ TEST(SimCalibrate, SecondCalibrateWhileOneRunsIsBusy) {
 
 TEST(SimCalibrate, MalformedArgumentsAreRefused) {
   TempDir dir;
-  DaemonProcess d(dir, sim(sceneFile(dir)));
+  DaemonProcess d(dir, sim(dir, sceneFile(dir)));
+  const std::string installed = readFile(dir.path() + "/state/rig.json");
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
   const std::vector<json> bad = {
@@ -363,13 +402,13 @@ TEST(SimCalibrate, MalformedArgumentsAreRefused) {
   auto status = c.call({{"cmd", "status"}});
   ASSERT_TRUE(status);
   EXPECT_EQ((*status)["operations"], json::array());
-  EXPECT_FALSE(std::filesystem::exists(dir.path() + "/state/rig.json"));
+  EXPECT_EQ(readFile(dir.path() + "/state/rig.json"), installed);  // byte for byte
 }
 
 // The handheld rig has one camera: route (a) is unavailable there.
 TEST(SimCalibrate, OneCameraIsUnavailable) {
   TempDir dir;
-  DaemonProcess d(dir, sim("handheld"));
+  DaemonProcess d(dir, sim(dir, "handheld"));
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
   auto r = c.call({{"cmd", "calibrate"}});

@@ -17,12 +17,15 @@
 #include "keystone/keystone_solver.hpp"
 #include "sim/embedded_scenes.hpp"
 #include "sim/scene.hpp"
+#include "truth_rig_file.hpp"
 
 namespace procam::itest {
 namespace {
 
-DaemonProcess::Launch sim(const std::string& scene) {
-  return DaemonProcess::Launch{{"--sim", scene}, {}, -1, true};
+// The scene's devices and, handed over explicitly, its truth as the rig model (the
+// projector's intrinsics, the accelerometer's mount and six-position calibration).
+DaemonProcess::Launch sim(const TempDir& dir, const std::string& scene) {
+  return simWithTruth(dir, scene);
 }
 
 std::string handheldText() {
@@ -122,7 +125,7 @@ TEST(SimKeystone, AutoKeystoneFollowsTheHeldPosesOfTheHandheldProjector) {
   auto scene = sim::Scene::parse(text, "held.toml", {});
   ASSERT_TRUE(scene) << scene.error().message;
 
-  DaemonProcess d(dir, sim(dir.file("held.toml")));
+  DaemonProcess d(dir, sim(dir, dir.file("held.toml")));
   ASSERT_TRUE(d.started()) << d.log();
   Connection watcher(d.socketPath()), c(d.socketPath());
   ASSERT_TRUE(watcher.call({{"cmd", "watch"}}));
@@ -166,7 +169,10 @@ TEST(SimKeystone, AutoKeystoneFollowsTheHeldPosesOfTheHandheldProjector) {
 
 TEST(SimKeystone, AutoOffStopsTheUpdates) {
   TempDir dir;
-  DaemonProcess d(dir, sim("handheld"));  // the default scene: auto keystone on
+  dir.write("procamd.toml", "[policy]\nauto_keystone = true\n");
+  DaemonProcess::Launch launch = sim(dir, "handheld");
+  launch.args.insert(launch.args.end(), {"--config", dir.file("procamd.toml")});
+  DaemonProcess d(dir, launch);  // auto keystone on by policy
   ASSERT_TRUE(d.started()) << d.log();
   Connection watcher(d.socketPath()), c(d.socketPath());
   ASSERT_TRUE(watcher.call({{"cmd", "watch"}}));
@@ -201,7 +207,7 @@ double quadFraction(const std::array<Vec2, 4>& q) {
 TEST(SimKeystone, SixPositionCalibrationStepsOverTheSocket) {
   TempDir dir;
   dir.write("level.toml", levelScene());
-  DaemonProcess d(dir, sim(dir.file("level.toml")));
+  DaemonProcess d(dir, sim(dir, dir.file("level.toml")));
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
   // Without auto keystone nothing reads the sensor.
@@ -238,14 +244,16 @@ TEST(SimKeystone, SixPositionCalibrationStepsOverTheSocket) {
   EXPECT_TRUE((*reset)["accel_calibration"]["filled"].empty());
 }
 
-TEST(SimKeystone, IntrinsicsOfRigJsonWinOverTheScene) {
+// A version 1 rig.json in the state directory (one projector, no output binding)
+// gives the intrinsics; the mount comes from the configuration's defaults.
+TEST(SimKeystone, IntrinsicsComeFromTheRigModel) {
   TempDir dir;
   ::mkdir(dir.file("state").c_str(), 0750);
   dir.write("state/rig.json",
             R"({"cameras": [], "projectors": [{"name": "proj", "width": 1280, "height": 720,
                 "K": [1500, 0, 640, 0, 1490, 360, 0, 0, 1], "R": [1,0,0,0,1,0,0,0,1],
                 "t": [0, 0, 0]}]})");
-  DaemonProcess d(dir, sim("handheld"));
+  DaemonProcess d(dir, DaemonProcess::Launch{{"--sim", "handheld"}, {}, -1, true});
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
   json k;
@@ -254,7 +262,7 @@ TEST(SimKeystone, IntrinsicsOfRigJsonWinOverTheScene) {
     return k.contains("projector");
   }));
   EXPECT_EQ(k["projector"]["intrinsics"], json({1500.0, 1490.0, 640.0, 360.0}));
-  EXPECT_EQ(k["projector"]["source"], dir.file("state/rig.json"));
+  EXPECT_EQ(k["projector"]["source"], "rig model (rig.json)");
 }
 
 json outputStats(Connection& c) {
@@ -265,7 +273,7 @@ json outputStats(Connection& c) {
 
 TEST(SimKeystone, KeystoneSetGetAndWhatTheOutputShows) {
   TempDir dir;
-  DaemonProcess d(dir, sim("handheld"));
+  DaemonProcess d(dir, sim(dir, "handheld"));
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
   ASSERT_EQ((*c.call({{"cmd", "keystone"}, {"action", "auto"}, {"enable", false}}))["class"],

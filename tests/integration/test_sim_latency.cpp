@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "daemon_harness.hpp"
+#include "truth_rig_file.hpp"
 #include "unit/calibration/rig_capture.hpp"
 
 namespace procam::itest {
@@ -161,7 +162,9 @@ TEST(SimLatency, CalibrateSettlesByTheMeasuredLatency) {
   dir.write("procamd.toml", "[calibration]\nlatency_repeats = 1\nlatency_timeout_s = " +
                                 std::to_string(1.0 * kSlowdown) + "\n");
   DaemonProcess d(
-      dir, DaemonProcess::Launch{{"--config", dir.file("procamd.toml"), "--sim", scene}, {}});
+      dir, DaemonProcess::Launch{{"--config", dir.file("procamd.toml"), "--sim", scene, "--rig",
+                                  truthRigFile(dir, scene, TruthParts::kCamerasOnly)},
+                                 {}});
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
   const json request = {

@@ -7,19 +7,17 @@
 // they stand still (noise below [content] viewer_threshold_m).
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <thread>
 
 #include "content/mesh_placement.hpp"
 #include "daemon_harness.hpp"
 #include "sim/scene_library.hpp"
+#include "truth_rig_file.hpp"
 
 namespace procam::itest {
 namespace {
-
-DaemonProcess::Launch sim(const std::string& scene) {
-  return DaemonProcess::Launch{{"--sim", scene}, {}, -1, true};
-}
 
 const char* kCubeObj = R"(# unit cube
 v -1 -1 -1
@@ -178,14 +176,19 @@ void expectCubeShown(Connection& c, const TempDir& dir, const Vec3& eye,
 TEST(SimMeshContent, ObjCubeOnTheObliqueWallIsDrawnForTheSceneViewer) {
   TempDir dir;
   dir.write("cube.obj", kCubeObj);
-  DaemonProcess d(dir, sim("wall_oblique"));
+  DaemonProcess d(dir, simWithTruth(dir, "wall_oblique"));
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
   auto scene = sim::resolveScene("wall_oblique");
   ASSERT_TRUE(scene);
-  expectCubeShown(c, dir, scene->viewerPosition(0), "scene");
+  expectCubeShown(c, dir, scene->viewerPosition(0), "rig");
   ASSERT_TRUE(c.call({{"cmd", "content"}, {"action", "clear"}}));
   ASSERT_TRUE(eventually([&] { return shownStats(c)["source"] == "none"; }));
+  // A missing file is an I/O error, not `unavailable`.
+  auto missing =
+      c.call({{"cmd", "content"}, {"action", "load"}, {"path", dir.file("none.obj")}}, 30s);
+  ASSERT_TRUE(missing);
+  EXPECT_EQ((*missing)["code"], "io-error") << missing->dump();
 }
 
 TEST(SimMeshContent, ConfiguredViewerWinsOverTheScenes) {
@@ -193,29 +196,45 @@ TEST(SimMeshContent, ConfiguredViewerWinsOverTheScenes) {
   dir.write("cube.obj", kCubeObj);
   dir.write("procamd.toml",
             "[sim]\nscene = \"wall_oblique\"\n[content]\nviewer = [0.6, 0.9, 1.3]\n");
-  DaemonProcess d(dir, DaemonProcess::Launch{{"--config", dir.file("procamd.toml")}, {}, -1, true});
+  DaemonProcess d(dir, DaemonProcess::Launch{{"--config", dir.file("procamd.toml"), "--rig",
+                                              truthRigFile(dir, "wall_oblique")},
+                                             {},
+                                             -1,
+                                             true});
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
   expectCubeShown(c, dir, Vec3(0.6, 0.9, 1.3), "config");
 }
 
-TEST(SimMeshContent, NonPlanarSurfaceIsUnavailable) {
+// The dome's truth has no plane: a rig without a planar surface cannot take the
+// planar 3D path (the calibrated, non-planar case is in daemon_calibrate_tests).
+// Without a rig model the daemon has no geometry: the virtual rig's devices alone
+// give no projector pose and no surface.
+TEST(SimMeshContent, UncalibratedRigIsUnavailable) {
   TempDir dir;
   dir.write("cube.obj", kCubeObj);
-  DaemonProcess d(dir, sim("dome3"));
+  DaemonProcess d(dir, DaemonProcess::Launch{{"--sim", "corner_stereo"}, {}, -1, true});
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
   auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", dir.file("cube.obj")}}, 30s);
   ASSERT_TRUE(load);
   EXPECT_EQ((*load)["class"], "ERROR") << load->dump();
   EXPECT_EQ((*load)["code"], "unavailable") << load->dump();
-  EXPECT_NE((*load)["message"].get<std::string>().find("not planar"), std::string::npos)
+  EXPECT_FALSE(std::filesystem::exists(dir.path() + "/state/rig.json"));
+}
+
+TEST(SimMeshContent, NonPlanarSurfaceIsUnavailable) {
+  TempDir dir;
+  dir.write("cube.obj", kCubeObj);
+  DaemonProcess d(dir, simWithTruth(dir, "dome3"));
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", dir.file("cube.obj")}}, 30s);
+  ASSERT_TRUE(load);
+  EXPECT_EQ((*load)["class"], "ERROR") << load->dump();
+  EXPECT_EQ((*load)["code"], "unavailable") << load->dump();
+  EXPECT_NE((*load)["message"].get<std::string>().find("display surface"), std::string::npos)
       << load->dump();
-  // A missing file is an I/O error, not `unavailable`.
-  auto missing =
-      c.call({{"cmd", "content"}, {"action", "load"}, {"path", dir.file("none.obj")}}, 30s);
-  ASSERT_TRUE(missing);
-  EXPECT_EQ((*missing)["code"], "io-error") << missing->dump();
 }
 
 // wall_oblique's wall and projector (at half resolution) with a tracked viewer who stands
@@ -271,7 +290,11 @@ TEST(SimMeshContent, DrawingFollowsTheTrackedViewerAndNotItsNoise) {
   dir.write("follow.toml", kFollowScene);
   dir.write("procamd.toml", "[sim]\nscene = \"" + dir.file("follow.toml") +
                                 "\"\n[content]\nviewer_threshold_m = 0.005\n");
-  DaemonProcess d(dir, DaemonProcess::Launch{{"--config", dir.file("procamd.toml")}, {}, -1, true});
+  DaemonProcess d(dir, DaemonProcess::Launch{{"--config", dir.file("procamd.toml"), "--rig",
+                                              truthRigFile(dir, dir.file("follow.toml"))},
+                                             {},
+                                             -1,
+                                             true});
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
   ASSERT_EQ((*c.call({{"cmd", "pattern"}, {"name", "off"}}))["pattern"], "off");

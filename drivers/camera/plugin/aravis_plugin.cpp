@@ -65,8 +65,11 @@ int create(const procam_device_desc* d, const procam_config* config, procam_devi
 
 }  // namespace
 
-const procam_driver_factory kAravisFactory = {PROCAM_FAMILY_CAMERA, "aravis",
+const procam_driver_factory kAravisFactory = {PROCAM_FAMILY_CAMERA,
+                                              "aravis",
                                               "GigE Vision / USB3 Vision camera (libaravis)",
-                                              &probe, &create};
+                                              &probe,
+                                              &create,
+                                              nullptr};
 
 }  // namespace procam::camera::plugin

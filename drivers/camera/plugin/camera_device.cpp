@@ -147,7 +147,7 @@ void destroy(void* self) {
   delete c;
 }
 
-const procam_camera_ops kOps = {&getFormat, &setExposure, &capture};
+const procam_camera_ops kOps = {PROCAM_CAMERA_OPS_VERSION, &getFormat, &setExposure, &capture};
 
 }  // namespace
 

@@ -55,7 +55,11 @@ int create(const procam_device_desc* d, const procam_config* config, procam_devi
 
 }  // namespace
 
-const procam_driver_factory kLibcameraFactory = {
-    PROCAM_FAMILY_CAMERA, "libcamera", "camera through libcamera's CameraManager", &probe, &create};
+const procam_driver_factory kLibcameraFactory = {PROCAM_FAMILY_CAMERA,
+                                                 "libcamera",
+                                                 "camera through libcamera's CameraManager",
+                                                 &probe,
+                                                 &create,
+                                                 nullptr};
 
 }  // namespace procam::camera::plugin

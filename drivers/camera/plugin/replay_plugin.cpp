@@ -53,8 +53,11 @@ int create(const procam_device_desc* d, const procam_config* config, procam_devi
 
 }  // namespace
 
-const procam_driver_factory kReplayFactory = {PROCAM_FAMILY_CAMERA, "replay",
+const procam_driver_factory kReplayFactory = {PROCAM_FAMILY_CAMERA,
+                                              "replay",
                                               "recorded frames: a folder of images and index.csv",
-                                              &probe, &create};
+                                              &probe,
+                                              &create,
+                                              nullptr};
 
 }  // namespace procam::camera::plugin

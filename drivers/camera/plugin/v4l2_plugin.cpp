@@ -73,7 +73,11 @@ int create(const procam_device_desc* d, const procam_config* config, procam_devi
 
 }  // namespace
 
-const procam_driver_factory kV4l2Factory = {
-    PROCAM_FAMILY_CAMERA, "v4l2", "Video4Linux2 capture device (mmap streaming)", &probe, &create};
+const procam_driver_factory kV4l2Factory = {PROCAM_FAMILY_CAMERA,
+                                            "v4l2",
+                                            "Video4Linux2 capture device (mmap streaming)",
+                                            &probe,
+                                            &create,
+                                            nullptr};
 
 }  // namespace procam::camera::plugin

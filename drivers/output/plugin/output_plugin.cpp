@@ -65,7 +65,7 @@ void destroy(void* self) {
   delete static_cast<Device*>(self);
 }
 
-const procam_output_ops kOps = {&getMode, &show};
+const procam_output_ops kOps = {PROCAM_OUTPUT_OPS_VERSION, &getMode, &show};
 
 int finish(std::unique_ptr<Device> d, procam_device* out, char* err, size_t err_len) {
   render::RenderSetup setup;
@@ -141,9 +141,10 @@ int createKms(const procam_device_desc* desc, const procam_config* config, proca
 
 const procam_driver_factory kFactories[] = {
     {PROCAM_FAMILY_OUTPUT, "headless", "EGL surfaceless output, frames kept in memory",
-     &probeHeadless, &createHeadless},
+     &probeHeadless, &createHeadless, nullptr},
 #if PROCAM_OUTPUT_PLUGIN_KMS
-    {PROCAM_FAMILY_OUTPUT, "kms", "DRM/KMS scan-out with GBM and EGL", &probeKms, &createKms},
+    {PROCAM_FAMILY_OUTPUT, "kms", "DRM/KMS scan-out with GBM and EGL", &probeKms, &createKms,
+     nullptr},
 #endif
 };
 

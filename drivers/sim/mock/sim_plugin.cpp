@@ -1,8 +1,10 @@
 #include "sim_plugin.hpp"
 
+#include <array>
 #include <cstring>
 #include <exception>
 #include <memory>
+#include <mutex>
 #include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
@@ -62,7 +64,7 @@ int tiltRead(void* self, procam_tilt_sample* out, char* err, size_t len) {
   out->timestamp_ns = static_cast<uint64_t>(t * 1e9);
   return PROCAM_OK;
 }
-const procam_tilt_ops kTiltOps = {tiltRead};
+const procam_tilt_ops kTiltOps = {PROCAM_TILT_OPS_VERSION, tiltRead};
 
 // --- tracker ---
 int trackerRead(void* self, procam_pose_sample* out, char* err, size_t len) {
@@ -77,7 +79,17 @@ int trackerRead(void* self, procam_pose_sample* out, char* err, size_t len) {
   out->timestamp_ns = static_cast<uint64_t>(t * 1e9);
   return PROCAM_OK;
 }
-const procam_tracker_ops kTrackerOps = {trackerRead};
+int trackerRate(void* self, double* hz) {
+  auto* dev = static_cast<Device*>(self);
+  for (const auto& t : dev->world->scene().trackers()) {
+    if (t.name == dev->name && t.rate_hz > 0) {
+      *hz = t.rate_hz;
+      return PROCAM_OK;
+    }
+  }
+  return PROCAM_ENOTSUP;
+}
+const procam_tracker_ops kTrackerOps = {PROCAM_TRACKER_OPS_VERSION, trackerRead, trackerRate};
 
 // --- output ---
 const ProjectorSpec* projectorSpec(const Device* dev) {
@@ -124,7 +136,7 @@ int outputShow(void* self, const procam_image* frame, char* err, size_t len) {
   }
   return PROCAM_OK;
 }
-const procam_output_ops kOutputOps = {outputMode, outputShow};
+const procam_output_ops kOutputOps = {PROCAM_OUTPUT_OPS_VERSION, outputMode, outputShow};
 
 // --- camera ---
 const CameraSpec* cameraSpec(const Device* dev) {
@@ -181,7 +193,8 @@ int cameraCapture(void* self, int, procam_image* out, char* err, size_t len) {
   }
   return PROCAM_OK;
 }
-const procam_camera_ops kCameraOps = {cameraFormat, cameraExposure, cameraCapture};
+const procam_camera_ops kCameraOps = {PROCAM_CAMERA_OPS_VERSION, cameraFormat, cameraExposure,
+                                      cameraCapture};
 
 template <procam_family Family>
 int create(const procam_device_desc* d, const procam_config*, procam_device* out, char* err,
@@ -225,15 +238,84 @@ int create(const procam_device_desc* d, const procam_config*, procam_device* out
   }
 }
 
+// --- enumerate ---
+// The devices of the scene named by the option "scene" (procamd --sim SCENE), one
+// list per family, kept until the next call for that family.
+struct Listed {
+  std::vector<std::string> strings;  // stable storage: reserved before pointers are taken
+  std::vector<std::array<procam_kv, 3>> kv;
+  std::vector<procam_device_desc> descs;
+};
+
+template <procam_family Family>
+int enumerate(const procam_config* config, const procam_device_desc** out, size_t* n, char* err,
+              size_t len) {
+  static std::mutex mutex;
+  static Listed listed;
+  try {
+    *out = nullptr;
+    *n = 0;
+    std::string scene_name;
+    for (size_t i = 0; config && i < config->n_options; ++i) {
+      const procam_kv& o = config->options[i];
+      if (o.key && o.value && std::strcmp(o.key, "scene") == 0) scene_name = o.value;
+    }
+    if (scene_name.empty()) return PROCAM_OK;  // not asked for a virtual rig
+    auto world = SimWorld::open(scene_name);
+    if (!world) return report(err, len, world.error().message, PROCAM_EINVAL);
+    const Scene& scene = (*world)->scene();
+    std::vector<std::string> names;
+    if constexpr (Family == PROCAM_FAMILY_CAMERA) {
+      for (const auto& c : scene.cameras()) names.push_back(c.name);
+    } else if constexpr (Family == PROCAM_FAMILY_TILT) {
+      for (const auto& t : scene.tiltSensors()) names.push_back(t.name);
+    } else if constexpr (Family == PROCAM_FAMILY_TRACKER) {
+      for (const auto& t : scene.trackers()) names.push_back(t.name);
+    } else {
+      for (const auto& p : scene.projectors()) names.push_back(p.name);
+    }
+    std::lock_guard lock(mutex);
+    listed = Listed{};
+    listed.strings.reserve(names.size() * 4 + 2);
+    listed.kv.reserve(names.size());
+    listed.descs.reserve(names.size());
+    const char* subsystem = listed.strings.emplace_back("sim").c_str();
+    const char* scene_value = listed.strings.emplace_back(scene_name).c_str();
+    const char* role = listed.strings
+                           .emplace_back(Family == PROCAM_FAMILY_CAMERA    ? "camera"
+                                         : Family == PROCAM_FAMILY_TILT    ? "tilt"
+                                         : Family == PROCAM_FAMILY_TRACKER ? "tracker"
+                                                                           : "output")
+                           .c_str();
+    for (const auto& name : names) {
+      const char* n_ptr = listed.strings.emplace_back(name).c_str();
+      listed.kv.push_back({procam_kv{"PROCAM_ROLE", role}, procam_kv{"SIM_SCENE", scene_value},
+                           procam_kv{"SIM_DEVICE", n_ptr}});
+      procam_device_desc d{};
+      d.family = Family;
+      d.subsystem = subsystem;
+      d.name = n_ptr;
+      d.properties = listed.kv.back().data();
+      d.n_properties = listed.kv.back().size();
+      listed.descs.push_back(d);
+    }
+    *out = listed.descs.data();
+    *n = listed.descs.size();
+    return PROCAM_OK;
+  } catch (const std::exception& e) {
+    return report(err, len, e.what(), PROCAM_EINTERNAL);
+  }
+}
+
 const procam_driver_factory kFactories[] = {
     {PROCAM_FAMILY_CAMERA, "sim-camera", "virtual rig camera (ray-cast rendering)", probe,
-     create<PROCAM_FAMILY_CAMERA>},
-    {PROCAM_FAMILY_TILT, "sim-tilt", "virtual rig accelerometer", probe,
-     create<PROCAM_FAMILY_TILT>},
+     create<PROCAM_FAMILY_CAMERA>, enumerate<PROCAM_FAMILY_CAMERA>},
+    {PROCAM_FAMILY_TILT, "sim-tilt", "virtual rig accelerometer", probe, create<PROCAM_FAMILY_TILT>,
+     enumerate<PROCAM_FAMILY_TILT>},
     {PROCAM_FAMILY_TRACKER, "sim-tracker", "virtual rig head tracker", probe,
-     create<PROCAM_FAMILY_TRACKER>},
+     create<PROCAM_FAMILY_TRACKER>, enumerate<PROCAM_FAMILY_TRACKER>},
     {PROCAM_FAMILY_OUTPUT, "sim-output", "virtual rig projector", probe,
-     create<PROCAM_FAMILY_OUTPUT>},
+     create<PROCAM_FAMILY_OUTPUT>, enumerate<PROCAM_FAMILY_OUTPUT>},
 };
 
 const procam_plugin_table kTable = {PROCAM_PLUGIN_ABI_VERSION, "sim", "1", 4, kFactories};

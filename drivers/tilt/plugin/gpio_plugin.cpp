@@ -140,9 +140,12 @@ int createGpioOn(std::unique_ptr<GpioLines> lines, const procam_config* config, 
 }
 
 #if PROCAM_TILT_GPIOD
-const procam_driver_factory kGpioFactory = {PROCAM_FAMILY_TILT, "gpio",
+const procam_driver_factory kGpioFactory = {PROCAM_FAMILY_TILT,
+                                            "gpio",
                                             "two ball tilt switches on a GPIO chip (libgpiod)",
-                                            &probe, &create};
+                                            &probe,
+                                            &create,
+                                            nullptr};
 #endif
 
 }  // namespace procam::tilt::plugin

@@ -65,7 +65,11 @@ int createHidOn(std::unique_ptr<HidTransport> transport, const procam_config* co
 }
 
 const procam_driver_factory kHidFactory = {
-    PROCAM_FAMILY_TILT, "hid", "HID sensor accelerometer (usage 0x20/0x73) on /dev/hidrawN", &probe,
-    &create};
+    PROCAM_FAMILY_TILT,
+    "hid",
+    "HID sensor accelerometer (usage 0x20/0x73) on /dev/hidrawN",
+    &probe,
+    &create,
+    nullptr};
 
 }  // namespace procam::tilt::plugin

@@ -110,7 +110,11 @@ int createI2cOn(std::shared_ptr<I2cBus> bus, const procam_device_desc* d,
 }
 
 const procam_driver_factory kI2cFactory = {
-    PROCAM_FAMILY_TILT, "i2c", "ADXL345, MPU-6050 or LIS3DH on /dev/i2c-N (register level)", &probe,
-    &create};
+    PROCAM_FAMILY_TILT,
+    "i2c",
+    "ADXL345, MPU-6050 or LIS3DH on /dev/i2c-N (register level)",
+    &probe,
+    &create,
+    nullptr};
 
 }  // namespace procam::tilt::plugin

@@ -88,7 +88,11 @@ int create(const procam_device_desc* d, const procam_config* config, procam_devi
 }  // namespace
 
 const procam_driver_factory kIioFactory = {
-    PROCAM_FAMILY_TILT, "iio", "Linux IIO accelerometer (sysfs, or the buffer of /dev/iio:deviceN)",
-    &probe, &create};
+    PROCAM_FAMILY_TILT,
+    "iio",
+    "Linux IIO accelerometer (sysfs, or the buffer of /dev/iio:deviceN)",
+    &probe,
+    &create,
+    nullptr};
 
 }  // namespace procam::tilt::plugin

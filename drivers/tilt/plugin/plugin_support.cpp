@@ -69,7 +69,7 @@ void destroy(void* self) {
   delete static_cast<TiltDevice*>(self);  // the sensor's destructor closes it
 }
 
-const procam_tilt_ops kOps = {&readSample};
+const procam_tilt_ops kOps = {PROCAM_TILT_OPS_VERSION, &readSample};
 
 }  // namespace
 

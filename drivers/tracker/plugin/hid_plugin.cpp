@@ -78,7 +78,7 @@ int readPose(void* self, procam_pose_sample* out, char* err, std::size_t len) {
   }
 }
 
-const procam_tracker_ops kOps = {&readPose};
+const procam_tracker_ops kOps = {PROCAM_TRACKER_OPS_VERSION, &readPose, nullptr};
 
 int pollFd(void* self) {
   return static_cast<wm::WiimoteTracker*>(self)->pollFd();
@@ -220,9 +220,12 @@ const tracking::TrackedPose* wiimoteLastPose(const procam_device& device) {
 }
 
 const procam_driver_factory kHidFactory = {
-    PROCAM_FAMILY_TRACKER, "hid",
+    PROCAM_FAMILY_TRACKER,
+    "hid",
     "Wii Remote IR camera on /dev/hidrawN (057e:0306/0330): up to 4 IR LEDs, constellation "
     "pose, filter",
-    &probe, &create};
+    &probe,
+    &create,
+    nullptr};
 
 }  // namespace procam::tracker::plugin

@@ -44,7 +44,7 @@ int readPose(void* self, procam_pose_sample* out, char* err, std::size_t len) {
   }
 }
 
-const procam_tracker_ops kOps = {&readPose};
+const procam_tracker_ops kOps = {PROCAM_TRACKER_OPS_VERSION, &readPose, nullptr};
 
 int pollFd(void* self) {
   return static_cast<IrCameraTracker*>(self)->pollFd();
@@ -199,9 +199,12 @@ const tracking::TrackedPose* irCameraLastPose(const procam_device& device) {
 }
 
 const procam_driver_factory kIrCameraFactory = {
-    PROCAM_FAMILY_TRACKER, "ir_camera",
+    PROCAM_FAMILY_TRACKER,
+    "ir_camera",
     "IR LEDs on the viewer seen by a camera (any camera driver): blobs, constellation pose, "
     "filter",
-    &probe, &create};
+    &probe,
+    &create,
+    nullptr};
 
 }  // namespace procam::tracker::plugin

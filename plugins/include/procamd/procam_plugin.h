@@ -28,22 +28,33 @@
 extern "C" {
 #endif
 
-/* Bumped on every incompatible change of any type or signature below. */
-#define PROCAM_PLUGIN_ABI_VERSION 1u
+/* Bumped on every incompatible change of the types shared by every family
+ * (descriptions, images, the device and factory structs, the plugin table).
+ * Each family's operations table carries its own `version` as its first
+ * member: a new operation appended to one table bumps only that family's
+ * version, and the daemon reads an operation only from a table whose version
+ * has it (PipeWire's SPA interfaces follow the same rule). */
+#define PROCAM_PLUGIN_ABI_VERSION 2u
+
+/* The operations table versions this header describes. */
+#define PROCAM_CAMERA_OPS_VERSION 1u
+#define PROCAM_TILT_OPS_VERSION 1u
+#define PROCAM_TRACKER_OPS_VERSION 1u
+#define PROCAM_OUTPUT_OPS_VERSION 1u
 
 #define PROCAM_PLUGIN_ABI_SYMBOL "procam_plugin_abi_version"
 #define PROCAM_PLUGIN_ENTRY_SYMBOL "procam_plugin_entry"
 
 /* Status codes. */
 #define PROCAM_OK 0
-#define PROCAM_EINVAL (-1)   /* bad argument or configuration */
-#define PROCAM_ENODEV (-2)   /* device gone or not present */
-#define PROCAM_EIO (-3)      /* device reported an error */
+#define PROCAM_EINVAL (-1) /* bad argument or configuration */
+#define PROCAM_ENODEV (-2) /* device gone or not present */
+#define PROCAM_EIO (-3)    /* device reported an error */
 #define PROCAM_ETIMEDOUT (-4)
-#define PROCAM_EAGAIN (-5)   /* no data yet; poll the device fd */
-#define PROCAM_ENOTSUP (-6)  /* operation not supported by this driver */
+#define PROCAM_EAGAIN (-5)  /* no data yet; poll the device fd */
+#define PROCAM_ENOTSUP (-6) /* operation not supported by this driver */
 #define PROCAM_EINTERNAL (-7)
-#define PROCAM_EEND (-8)     /* the stream ended for good (a finished recording) */
+#define PROCAM_EEND (-8) /* the stream ended for good (a finished recording) */
 
 typedef enum procam_family {
   PROCAM_FAMILY_CAMERA = 1,
@@ -62,10 +73,10 @@ typedef struct procam_kv {
  * Any pointer may be NULL when unknown. */
 typedef struct procam_device_desc {
   procam_family family;
-  const char* subsystem; /* "video4linux", "iio", "hidraw", "i2c-dev", "gpio", "drm", "sim" */
-  const char* devnode;   /* "/dev/video0" */
-  const char* syspath;   /* "/sys/devices/..." */
-  const char* name;      /* human readable, or the configured name */
+  const char* subsystem;       /* "video4linux", "iio", "hidraw", "i2c-dev", "gpio", "drm", "sim" */
+  const char* devnode;         /* "/dev/video0" */
+  const char* syspath;         /* "/sys/devices/..." */
+  const char* name;            /* human readable, or the configured name */
   const procam_kv* properties; /* udev properties (PROCAM_ROLE, ID_VENDOR_ID, ...) */
   size_t n_properties;
 } procam_device_desc;
@@ -95,6 +106,7 @@ typedef struct procam_image {
 /* Camera. `capture` fills `out` with a buffer owned by the driver that stays
  * valid until the next capture or destroy. */
 typedef struct procam_camera_ops {
+  uint32_t version; /* PROCAM_CAMERA_OPS_VERSION the driver was built with */
   int (*get_format)(void* self, uint32_t* out_width, uint32_t* out_height,
                     procam_pixel_format* out_format);
   int (*set_exposure)(void* self, double seconds, char* err, size_t err_len);
@@ -109,6 +121,7 @@ typedef struct procam_tilt_sample {
 } procam_tilt_sample;
 
 typedef struct procam_tilt_ops {
+  uint32_t version; /* PROCAM_TILT_OPS_VERSION */
   int (*read)(void* self, procam_tilt_sample* out, char* err, size_t err_len);
 } procam_tilt_ops;
 
@@ -126,11 +139,16 @@ typedef struct procam_pose_sample {
 } procam_pose_sample;
 
 typedef struct procam_tracker_ops {
+  uint32_t version; /* PROCAM_TRACKER_OPS_VERSION */
   int (*read)(void* self, procam_pose_sample* out, char* err, size_t err_len);
+  /* Optional (may be NULL): the tracker's own sample rate in Hz, so that the
+   * daemon polls it no faster than it reports; PROCAM_ENOTSUP when unknown. */
+  int (*get_rate)(void* self, double* out_hz);
 } procam_tracker_ops;
 
 /* Projector output: shows one full frame of the mode's size. */
 typedef struct procam_output_ops {
+  uint32_t version; /* PROCAM_OUTPUT_OPS_VERSION */
   int (*get_mode)(void* self, uint32_t* out_width, uint32_t* out_height, double* out_refresh_hz);
   int (*show)(void* self, const procam_image* frame, char* err, size_t err_len);
 } procam_output_ops;
@@ -153,14 +171,24 @@ typedef struct procam_device {
 
 /* One driver. `probe` scores how well the driver handles a device: 0 means
  * "not mine", higher wins (hardware drivers use 1..99, simulated drivers 100+
- * so that they outrank hardware when enabled). `create` fills `out`. */
+ * so that they outrank hardware when enabled). `create` fills `out`.
+ *
+ * `enumerate` (may be NULL) lists devices the driver provides by itself,
+ * without udev or configuration: the virtual rig's mock devices, a replayed
+ * recording. The daemon calls it at start with the driver's options (for the
+ * virtual rig: "scene"), then opens each listed device with probe/create like
+ * any other. On PROCAM_OK `*out_devices` points to `*out_n` descriptions owned
+ * by the plugin and valid until the next enumerate call or unload; a driver
+ * with nothing to offer for these options returns PROCAM_OK and 0 devices. */
 typedef struct procam_driver_factory {
   procam_family family;
   const char* name;
   const char* description;
   int (*probe)(const procam_device_desc* device);
-  int (*create)(const procam_device_desc* device, const procam_config* config,
-                procam_device* out, char* err, size_t err_len);
+  int (*create)(const procam_device_desc* device, const procam_config* config, procam_device* out,
+                char* err, size_t err_len);
+  int (*enumerate)(const procam_config* config, const procam_device_desc** out_devices,
+                   size_t* out_n, char* err, size_t err_len);
 } procam_driver_factory;
 
 typedef struct procam_plugin_table {
@@ -180,12 +208,12 @@ typedef const procam_plugin_table* (*procam_plugin_entry_fn)(void);
 #endif
 
 /* Defines the two exported symbols of a shared-object plugin. */
-#define PROCAM_PLUGIN_DEFINE(entry_function)                                          \
-  PROCAM_PLUGIN_EXTERN_C __attribute__((visibility("default")))                       \
-  const uint32_t procam_plugin_abi_version = PROCAM_PLUGIN_ABI_VERSION;               \
+#define PROCAM_PLUGIN_DEFINE(entry_function)                                               \
+  PROCAM_PLUGIN_EXTERN_C __attribute__((visibility("default")))                            \
+  const uint32_t procam_plugin_abi_version = PROCAM_PLUGIN_ABI_VERSION;                    \
   PROCAM_PLUGIN_EXTERN_C __attribute__((visibility("default"))) const procam_plugin_table* \
-  procam_plugin_entry(void) {                                                          \
-    return entry_function();                                                           \
+  procam_plugin_entry(void) {                                                              \
+    return entry_function();                                                               \
   }
 
 #ifdef __cplusplus

@@ -61,7 +61,7 @@ inline int tiltRead(void* self, procam_tilt_sample* out, char* err, size_t len) 
   out->specific_force[2] = 9.81;
   return PROCAM_OK;
 }
-inline const procam_tilt_ops kTiltOps = {tiltRead};
+inline const procam_tilt_ops kTiltOps = {PROCAM_TILT_OPS_VERSION, tiltRead};
 
 inline int tiltFd(void* self) {
   return static_cast<Tilt*>(self)->pipe[0];
@@ -138,7 +138,7 @@ inline int trackerRead(void* self, procam_pose_sample* out, char* err, size_t le
   out->timestamp_ns = static_cast<uint64_t>(n);
   return PROCAM_OK;
 }
-inline const procam_tracker_ops kTrackerOps = {trackerRead};
+inline const procam_tracker_ops kTrackerOps = {PROCAM_TRACKER_OPS_VERSION, trackerRead, nullptr};
 
 inline int trackerFd(void* self) {
   return static_cast<Tracker*>(self)->pipe[0];
@@ -177,9 +177,9 @@ inline int createTracker(const procam_device_desc*, const procam_config* config,
 }
 
 inline const procam_driver_factory kFactories[] = {
-    {PROCAM_FAMILY_TILT, "generic-tilt", "weak match", probeGeneric, createTilt},
-    {PROCAM_FAMILY_TILT, "fake-tilt", "test tilt sensor", probeTilt, createTilt},
-    {PROCAM_FAMILY_TRACKER, "slow-tracker", "test tracker", probeTracker, createTracker},
+    {PROCAM_FAMILY_TILT, "generic-tilt", "weak match", probeGeneric, createTilt, nullptr},
+    {PROCAM_FAMILY_TILT, "fake-tilt", "test tilt sensor", probeTilt, createTilt, nullptr},
+    {PROCAM_FAMILY_TRACKER, "slow-tracker", "test tracker", probeTracker, createTracker, nullptr},
 };
 
 inline plugins::DriverRegistry registry() {

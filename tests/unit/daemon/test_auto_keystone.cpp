@@ -13,6 +13,7 @@
 #include "config.hpp"
 #include "keystone/keystone_solver.hpp"
 #include "output_frames.hpp"
+#include "rig_store.hpp"
 
 namespace procam::daemon {
 namespace {
@@ -191,21 +192,31 @@ struct TempDir {
   ~TempDir() { std::filesystem::remove_all(path); }
 };
 
-TEST(ProjectorFromRigFile, ReadsTheNamedProjectorsIntrinsics) {
+TEST(RigStore, ReadsAVersion1RigAndItsProjectorsIntrinsics) {
   TempDir dir;
-  EXPECT_EQ(projectorFromRigFile(dir.path, "proj").error().code, ErrorCode::kNotFound);
+  auto none = loadRig(dir.path);
+  ASSERT_TRUE(none) << none.error().message;
+  EXPECT_TRUE(none->rig.empty());
   std::ofstream(dir.path / "rig.json")
       << R"({"cameras": [], "projectors": [{"name": "proj", "width": 1920, "height": 1080,
             "K": [2000, 0, 959.5, 0, 2010, 539.5, 0, 0, 1], "R": [1,0,0,0,1,0,0,0,1],
             "t": [0, 0, 0]}]})";
-  auto p = projectorFromRigFile(dir.path, "proj");
-  ASSERT_TRUE(p) << p.error().message;
+  auto loaded = loadRig(dir.path);
+  ASSERT_TRUE(loaded) << loaded.error().message;
+  const rig::RigProjector* p = loaded->rig.projectorForOutput("proj");
+  ASSERT_NE(p, nullptr);
   EXPECT_EQ(p->K.fx, 2000);
   EXPECT_EQ(p->K.fy, 2010);
   EXPECT_EQ(p->K.cx, 959.5);
   EXPECT_EQ(p->width, 1920);
+  EXPECT_EQ(p->output, "");                                // version 1: not bound to an output
+  EXPECT_EQ(loaded->rig.projectorForOutput("beamer"), p);  // the only one serves any output
+  std::filesystem::remove(dir.path / "rig.json.bak");
   std::ofstream(dir.path / "rig.json") << R"({"projectors": [{"name": "proj", "K": [1, 2]}]})";
-  EXPECT_EQ(projectorFromRigFile(dir.path, "proj").error().code, ErrorCode::kParse);
+  std::filesystem::remove(dir.path / "rig.json.bak");
+  auto bad = loadRig(dir.path);
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().code, ErrorCode::kParse);
 }
 
 TEST(OutputFrames, PatternsContentAndTheWarp) {

@@ -114,7 +114,7 @@ int noCreate(const procam_device_desc*, const procam_config*, procam_device*, ch
 }
 
 TEST(PluginTable, ValidationNamesTheProblem) {
-  procam_driver_factory bad_family{PROCAM_FAMILY_TILT, "x", "", scoreFive, noCreate};
+  procam_driver_factory bad_family{PROCAM_FAMILY_TILT, "x", "", scoreFive, noCreate, nullptr};
   const uint32_t nine = 9;  // what a broken plugin might store; not a valid enumerator
   std::memcpy(&bad_family.family, &nine, sizeof nine);
   procam_plugin_table table{PROCAM_PLUGIN_ABI_VERSION, "t", "1", 1, &bad_family};
@@ -122,7 +122,7 @@ TEST(PluginTable, ValidationNamesTheProblem) {
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("unknown family 9"), std::string::npos);
 
-  procam_driver_factory no_probe{PROCAM_FAMILY_CAMERA, "cam", "", nullptr, noCreate};
+  procam_driver_factory no_probe{PROCAM_FAMILY_CAMERA, "cam", "", nullptr, noCreate, nullptr};
   table.factories = &no_probe;
   r = validateTable(&table, "test");
   ASSERT_FALSE(r);
@@ -138,10 +138,10 @@ TEST(PluginTable, ValidationNamesTheProblem) {
 
 TEST(DriverRegistry, HighestScoreOfTheRightFamilyWins) {
   static const procam_driver_factory factories[] = {
-      {PROCAM_FAMILY_TILT, "low", "", scoreFive, noCreate},
-      {PROCAM_FAMILY_TILT, "high", "", scoreFifty, noCreate},
-      {PROCAM_FAMILY_CAMERA, "camera-highest", "", scoreFifty, noCreate},
-      {PROCAM_FAMILY_TILT, "never", "", neverProbe, noCreate},
+      {PROCAM_FAMILY_TILT, "low", "", scoreFive, noCreate, nullptr},
+      {PROCAM_FAMILY_TILT, "high", "", scoreFifty, noCreate, nullptr},
+      {PROCAM_FAMILY_CAMERA, "camera-highest", "", scoreFifty, noCreate, nullptr},
+      {PROCAM_FAMILY_TILT, "never", "", neverProbe, noCreate, nullptr},
   };
   DriverRegistry registry;
   for (const auto& f : factories) ASSERT_TRUE(registry.add(Driver{&f, "test", nullptr}));

@@ -1,4 +1,4 @@
-#include "rig_file.hpp"
+#include "rig/rig_json.hpp"
 
 namespace procam::rig {
 namespace {

@@ -1,0 +1,169 @@
+// The rig model (rig.json): version 2 round trip at full precision, version 1
+// read, merging that keeps what a calibration did not touch, and refusal of
+// malformed or hostile documents with a typed error.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "rig/rig_model.hpp"
+
+namespace procam::rig {
+namespace {
+
+using nlohmann::json;
+
+RigProjector projector(const std::string& name, double fx) {
+  RigProjector p;
+  p.name = p.output = name;
+  p.width = 1280;
+  p.height = 800;
+  p.K = {fx, fx * 1.001, 639.5, 399.5, 0};
+  p.dist = {0.01, -0.002, 0, 0, 0};
+  p.pose.R = Eigen::AngleAxisd(0.3, Vec3(0.2, 1, 0.1).normalized()).toRotationMatrix();
+  p.pose.t = Vec3(0.1, -0.2, 3.0 + 1.0 / 3.0);
+  p.rms_px = 0.07;
+  p.points = 4321;
+  p.calibrated = {"structured light, route (a): cameras a b", "2026-11-26T12:00:00Z"};
+  return p;
+}
+
+RigCamera camera(const std::string& name) {
+  RigCamera c;
+  c.name = name;
+  c.model.width = 1024;
+  c.model.height = 768;
+  c.model.K = {900, 900, 511.5, 383.5, 0};
+  c.model.dist = {-0.04, 0.01, 0, 0, 0};
+  c.model.pose.t = Vec3(1, 2, 3);
+  c.rms_px = 0.1;
+  return c;
+}
+
+TEST(RigModel, Version2RoundTripKeepsEveryDigit) {
+  RigModel rig;
+  rig.cameras = {camera("cam_left"), camera("cam_right")};
+  rig.projectors = {projector("proj_a", 1500), projector("proj_b", 1600)};
+  TiltMountModel tilt;
+  tilt.sensor = "accel";
+  tilt.sensor_from_projector << 0, 1, 0, 0, 0, 1, 1, 0, 0;
+  tilt.calibration.offset = Vec3(0.01, -0.02, 0.05);
+  tilt.calibration.scale = Vec3(1.01, 0.99, 1.0);
+  tilt.fit_rms_g = 1e-4;
+  rig.projectors[0].tilt = tilt;
+  rig.projectors[1].photometric = {{"gamma", 2.2}};
+  rig.surface.plane = geom::Plane{Vec3(0, -1, 0), 3.0};
+  rig.surface.plane_rms_m = 1e-4;
+  rig.surface.meshes["proj_b"] = "surface-proj_b.ply";
+  rig.viewer.position = Vec3(-1.6, 0.4, 1.6);
+  rig.viewer.tracker = "ir_head";
+
+  const json j = rigToJson(rig);
+  EXPECT_EQ(j["version"], 2);
+  auto back = rigFromText(j.dump(2), "rig.json");
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_EQ(rigToJson(*back), j);  // a fixed point: nothing lost or rounded
+  ASSERT_EQ(back->projectors.size(), 2u);
+  const RigProjector& p = back->projectors[0];
+  EXPECT_EQ(p.pose.t.z(), 3.0 + 1.0 / 3.0);
+  EXPECT_EQ(p.pose.R, rig.projectors[0].pose.R);
+  ASSERT_TRUE(p.tilt);
+  EXPECT_EQ(p.tilt->sensor_from_projector, tilt.sensor_from_projector);
+  EXPECT_EQ(p.tilt->calibration.offset, tilt.calibration.offset);
+  EXPECT_EQ(back->projectors[1].photometric["gamma"], 2.2);
+  EXPECT_EQ(back->viewer.position, rig.viewer.position);
+  EXPECT_EQ(back->surface.meshes.at("proj_b"), "surface-proj_b.ply");
+  EXPECT_EQ(back->projectorForOutput("proj_b"), &back->projectors[1]);
+  EXPECT_EQ(back->projectorForOutput("elsewhere"), nullptr);  // bound projectors only
+}
+
+TEST(RigModel, Version1IsReadWithItsOneProjectorUnbound) {
+  const char* v1 = R"({"cameras": [{"name": "cam", "width": 640, "height": 480,
+      "K": [500, 0, 319.5, 0, 500, 239.5, 0, 0, 1], "R": [1,0,0,0,1,0,0,0,1], "t": [0,0,0]}],
+    "projectors": [{"name": "proj", "width": 1280, "height": 800,
+      "K": [1500, 0, 639.5, 0, 1500, 399.5, 0, 0, 1], "R": [1,0,0,0,1,0,0,0,1],
+      "t": [0, 0, 0], "reprojection_rms_px": 0.1, "points": 10}],
+    "surface": {"mesh": "surface.ply"}})";
+  auto rig = rigFromText(v1, "v1");
+  ASSERT_TRUE(rig) << rig.error().message;
+  ASSERT_EQ(rig->projectors.size(), 1u);
+  EXPECT_EQ(rig->projectors[0].output, "");
+  EXPECT_EQ(rig->projectorForOutput("beamer"), &rig->projectors[0]);
+  EXPECT_EQ(rig->surface.meshes.at("proj"), "surface.ply");
+  EXPECT_EQ(rig->camera("cam")->model.K.fx, 500);
+}
+
+TEST(RigModel, MergeReplacesWhatWasCalibratedAndKeepsTheRest) {
+  RigModel base;
+  base.cameras = {camera("cam_left"), camera("cam_right")};
+  base.projectors = {projector("proj_a", 1500), projector("proj_b", 1600)};
+  TiltMountModel tilt;
+  tilt.sensor = "accel";
+  base.projectors[0].tilt = tilt;
+  base.surface.meshes["proj_b"] = "surface-proj_b.ply";
+  base.viewer.position = Vec3(1, 2, 3);
+
+  RigModel update;
+  update.projectors = {projector("proj_a", 1510), projector("proj_c", 1700)};
+  update.surface.meshes["proj_a"] = "surface-proj_a.ply";
+  const RigModel merged = mergeRig(base, update);
+  ASSERT_EQ(merged.projectors.size(), 3u);
+  EXPECT_EQ(merged.projector("proj_a")->K.fx, 1510);
+  EXPECT_TRUE(merged.projector("proj_a")->tilt);  // a calibration without the sensor keeps it
+  EXPECT_EQ(merged.projector("proj_b")->K.fx, 1600);
+  EXPECT_EQ(merged.projector("proj_c")->K.fx, 1700);
+  EXPECT_EQ(merged.cameras.size(), 2u);
+  EXPECT_EQ(merged.surface.meshes.size(), 2u);
+  EXPECT_EQ(merged.viewer.position, Vec3(1, 2, 3));
+  EXPECT_EQ(rigToJson(mergeRig(base, RigModel{})), rigToJson(base));  // nothing new: unchanged
+}
+
+TEST(RigModel, MalformedDocumentsAreTypedErrors) {
+  const std::pair<const char*, ErrorCode> cases[] = {
+      {"[]", ErrorCode::kParse},
+      {"not json", ErrorCode::kParse},
+      {R"({"version": 3})", ErrorCode::kInvalidInput},
+      {R"({"version": "2"})", ErrorCode::kParse},
+      {R"({"projectors": {}})", ErrorCode::kParse},
+      {R"({"projectors": [{"name": "p", "width": 10, "height": 10, "K": [1, 2]}]})",
+       ErrorCode::kParse},
+      // Not a rotation.
+      {R"({"cameras": [{"width": 10, "height": 10, "K": [5,0,5,0,5,5,0,0,1],
+          "R": [2,0,0,0,1,0,0,0,1], "t": [0,0,0]}]})",
+       ErrorCode::kParse},
+      // A focal length of zero.
+      {R"({"cameras": [{"width": 10, "height": 10, "K": [0,0,5,0,5,5,0,0,1],
+          "R": [1,0,0,0,1,0,0,0,1], "t": [0,0,0]}]})",
+       ErrorCode::kParse},
+      // Absurd size.
+      {R"({"cameras": [{"width": 1000000, "height": 10, "K": [5,0,5,0,5,5,0,0,1],
+          "R": [1,0,0,0,1,0,0,0,1], "t": [0,0,0]}]})",
+       ErrorCode::kParse},
+      {R"({"surface": {"plane": [0, 0, 0, 1]}})", ErrorCode::kParse},
+      {R"({"viewer": {"position": [1, 2]}})", ErrorCode::kParse},
+      {R"({"projectors": [{"name": "p", "width": 10, "height": 10, "K": [5,0,5,0,5,5,0,0,1],
+          "tilt": {"mount": [1,0,0,0,1,0,0,0,1], "scale": [0, 1, 1]}}]})",
+       ErrorCode::kParse},
+  };
+  for (const auto& [text, code] : cases) {
+    auto r = rigFromText(text, "test");
+    ASSERT_FALSE(r) << text;
+    EXPECT_EQ(r.error().code, code) << text << ": " << r.error().message;
+  }
+  // 65 devices: over the bound.
+  json many = {{"cameras", json::array()}};
+  for (int i = 0; i < 65; ++i) many["cameras"].push_back(json::object());
+  EXPECT_FALSE(rigFromJson(many, "many"));
+}
+
+TEST(RigModel, ProjectorWithoutPoseKeepsOnlyItsIntrinsics) {
+  auto rig = rigFromText(R"({"version": 2, "projectors": [{"name": "p", "output": "hdmi",
+      "width": 1920, "height": 1080, "K": [2000,0,959.5,0,2000,539.5,0,0,1]}]})",
+                         "k-only");
+  ASSERT_TRUE(rig) << rig.error().message;
+  EXPECT_FALSE(rig->projectors[0].pose_known);
+  EXPECT_EQ(rig->projectorForOutput("hdmi")->K.fx, 2000);
+  EXPECT_FALSE(rigToJson(*rig)["projectors"][0].contains("R"));
+}
+
+}  // namespace
+}  // namespace procam::rig
