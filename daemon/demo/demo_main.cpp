@@ -183,7 +183,7 @@ int main(int argc, char** argv) {
       "Error columns: the shown image judged with the true orientation at the tilt sample's\n"
       "time (corner px in the framebuffer, aspect and area against the largest upright\n"
       "rectangle). 'tilt' uses the true pitch and roll; 'full' adds the true yaw, which a\n"
-      "tilt sensor cannot see (seed §6.2.2: the camera gives the azimuth).\n\n");
+      "tilt sensor cannot see ([Raskar02] §6.2.2: the camera gives the azimuth).\n\n");
   std::printf("%7s %6s | %7s %7s %6s | %7s %7s | %9s %8s %7s | %9s\n", "t [s]", "still", "pitch",
               "roll", "yaw", "est p", "est r", "tilt px", "aspect%", "area%", "full px");
   auto watch = demo::Child::start({opt.procamctl, "--socket", socket, "--json", "watch"});

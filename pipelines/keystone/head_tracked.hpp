@@ -1,6 +1,6 @@
 #pragma once
 // Head-tracked rendering on a planar display with an oblique projector, in one pass
-// (seed §4.2.1-4.2.3, Appendix B):
+// ([Raskar02] §4.2.1-4.2.3, Appendix B):
 //  1. P_T: off-axis frustum from the viewer T through the axis-aligned rectangle S on
 //     the display plane that bounds the projector's keystoned image (§4.2.1);
 //  2. A: the collineation from P_T's normalised image to the projector's, induced by the

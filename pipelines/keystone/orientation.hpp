@@ -1,5 +1,5 @@
 #pragma once
-// Projector orientation relative to a vertical wall (seed §3.2.5: P_P = F[R 0], only the
+// Projector orientation relative to a vertical wall ([Raskar02] §3.2.5: P_P = F[R 0], only the
 // rotation matters; §6.2.2: tilt sensors give elevation and roll, the rigid camera gives
 // the azimuth).
 //

@@ -1,5 +1,5 @@
 #pragma once
-// The CPU back-end of the planar 3D path (seed §4.2.2-4.2.3): vertex-coloured triangles
+// The CPU back-end of the planar 3D path ([Raskar02] §4.2.2-4.2.3): vertex-coloured triangles
 // through A'4x4 P_T, drawn as the GL back-end's colour program draws them. Triangles are
 // clipped in homogeneous coordinates to the depth range -w <= z <= w (which also keeps
 // only w > 0: nothing behind the projector) and to a band one pixel outside the image,

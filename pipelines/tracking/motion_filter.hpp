@@ -1,5 +1,5 @@
 #pragma once
-// Position filters for tracker readings (seed §4.1.4: readings are low-pass filtered
+// Position filters for tracker readings ([Raskar02] §4.1.4: readings are low-pass filtered
 // before use), with prediction ahead by the display latency (issue 7):
 //  - One Euro: adaptive first-order low-pass whose cut-off rises with speed
 //    (min_cutoff + beta |v|), so jitter is removed at rest and lag stays small in motion;

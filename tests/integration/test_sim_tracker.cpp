@@ -1,7 +1,7 @@
 // Trackers and cameras in the running daemon on the virtual rig (dome3: the
 // tracker `ir_head` follows the viewer's walk with 2 mm noise per axis), over
 // the control socket: positions against the scene's truth, the tracker ->
-// world registration (seed eq. 4.2) persisted across a restart, and a camera
+// world registration ([Raskar02] eq. 4.2) persisted across a restart, and a camera
 // and a tracker unplugged and back (PROCAM_SIM_UNPLUG).
 #include <gtest/gtest.h>
 
