@@ -244,7 +244,7 @@ int main(int argc, char** argv) {
     std::printf(
         "Held still at the end: the update at t = %.2f s, which stays on the wall, is off by "
         "corner %.3f px, aspect %.4f %%, area %.4f %%\n"
-        "  (issue 4 tolerances: corner <= 0.5 px, aspect 0.1 %%, area 0.5 %%).\n",
+        "  (procamd's keystone accuracy bounds: corner <= 0.5 px, aspect 0.1 %%, area 0.5 %%).\n",
         final_time, final_hold->corner_px, final_hold->aspect_pct, final_hold->area_pct);
   }
 

@@ -146,7 +146,7 @@ void expectRegistered(const json& reg, const RegistrationCase& c) {
   ASSERT_TRUE(reg.is_object()) << reg.dump();
   EXPECT_EQ(reg["source"], "points");
   EXPECT_EQ(reg["points"], 6);
-  EXPECT_LE(reg["rms_m"].get<double>(), 1e-3);  // issue 7: registration from 6 points <= 1 mm
+  EXPECT_LE(reg["rms_m"].get<double>(), 1e-3);  // registration from 6 points: <= 1 mm RMS
   Mat3 R;
   for (int i = 0; i < 9; ++i) R(i / 3, i % 3) = reg["R"][i].get<double>();
   // 0.3 mm on points about a metre apart: well under a milliradian and a millimetre.

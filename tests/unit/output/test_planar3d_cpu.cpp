@@ -5,7 +5,7 @@
 // Comparisons skip a 1 px band around every place where the visible triangle changes
 // (triangle edges, clipping boundaries, intersections) and the image border: two correct
 // rasterizers may disagree by one pixel on edges (GL snaps vertices to a sub-pixel grid,
-// the CPU keeps doubles), and both the GL-vs-CPU figures and the coverage check
+// the CPU keeps doubles), and both the GL-vs-CPU bounds and the coverage check
 // are about the interiors.
 #include <gtest/gtest.h>
 
