@@ -9,7 +9,7 @@
 //     depth in [-1, 1] for points inside S's frustum (eq. 4.9).
 // Normalised coordinates here are OpenGL's clip/NDC space (x right, y up, z in [-1, 1]
 // from near to far), since that is where the depth buffer lives. Framebuffer pixels
-// follow DESIGN.md (pixel centres at integers, y down).
+// follow ARCHITECTURE.md (pixel centres at integers, y down).
 #include "core/error.hpp"
 #include "core/types.hpp"
 

@@ -1,5 +1,5 @@
 #pragma once
-// Choice of the cheapest rendering path a scene allows (DESIGN.md's table).
+// Choice of the cheapest rendering path a scene allows (ARCHITECTURE.md's table).
 #include "core/error.hpp"
 
 namespace procam::render {

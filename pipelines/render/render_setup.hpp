@@ -55,7 +55,7 @@ struct Content {
 };
 
 // Skips frames that would come out identical: nothing re-renders unless the geometry
-// was reconfigured or the content version changed (DESIGN.md: no work when nothing moved).
+// was reconfigured or the content version changed (ARCHITECTURE.md: no work when nothing moved).
 class FrameGate {
  public:
   void geometryChanged() { dirty_ = true; }

@@ -1,6 +1,6 @@
 #pragma once
 // Backward warp maps: for every output pixel, the source-image coordinate to sample
-// (DESIGN.md's pixel convention). Built once when the geometry changes and applied to
+// (ARCHITECTURE.md's pixel convention). Built once when the geometry changes and applied to
 // every frame (precomputed maps). Entries outside the source footprint sample as black;
 // kOutside marks pixels that no source pixel reaches. Maps hold float32 coordinates:
 // per-pixel render data, with the error against double bounded in tests.
