@@ -1,8 +1,8 @@
 #pragma once
 // Automatic keystone: tilt samples -> sample gate -> low-pass, stillness and
 // hysteresis (keystone::TiltFilter) -> a new gravity direction -> the keystone
-// solve (seed §3.2.5, run on a worker) -> the pre-warp homography. Tilt only:
-// gravity fixes pitch and roll; yaw needs the camera (seed §6.2.2) and is 0 here.
+// solve ([Raskar02] §3.2.5, run on a worker) -> the pre-warp homography. Tilt only:
+// gravity fixes pitch and roll; yaw needs the camera ([Raskar02] §6.2.2) and is 0 here.
 #include <array>
 #include <cstdint>
 #include <optional>

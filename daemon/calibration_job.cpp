@@ -165,7 +165,7 @@ tl::expected<CalibrationOutcome, CalibrationFailure> runCalibration(const Calibr
         rc != PROCAM_OK) {
       return tl::unexpected(deviceFailure("output", plan.output.name, rc, "show a pattern", err));
     }
-    // The frame reaches the screen within a few refreshes (seed §4.1.1 assumes a
+    // The frame reaches the screen within a few refreshes ([Raskar02] §4.1.1 assumes a
     // static projected image per capture).
     if (!waitCancellable(outcome.settle_frames / plan.refresh_hz, hooks))
       return tl::unexpected(cancelled);

@@ -2,7 +2,7 @@
 // The calibrate operation's work, apart from the daemon: its arguments, and the
 // run on a worker thread that shows every structured-light frame on the output,
 // waits for it to settle, captures it with both cameras, decodes and solves route
-// (a) (seed §4.1.1) through calib::solveStereoRoute, the pipeline procam-calibrate
+// (a) ([Raskar02] §4.1.1) through calib::solveStereoRoute, the pipeline procam-calibrate
 // uses on files.
 #include <functional>
 #include <memory>

@@ -1,7 +1,7 @@
 // 3D content follows a tracked viewer (PROTOCOL.md `content`): while a mesh is shown and
 // its viewer came from a tracker, a sample that moved the viewer more than
 // [content] viewer_threshold_m from the eye of the last drawing recomputes only the
-// view-dependent matrix A'4x4 P_T for the new eye (S and A stay, seed §4.2.2-4.2.3; the
+// view-dependent matrix A'4x4 P_T for the new eye (S and A stay, [Raskar02] §4.2.2-4.2.3; the
 // mesh stays where it was placed in the world) and draws the outputs again. One such
 // frame is in flight at a time and they start at most once per output frame period; a
 // viewer who does not move causes no work.

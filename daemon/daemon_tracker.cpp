@@ -1,6 +1,6 @@
 // Trackers and camera readings in the running daemon (PROTOCOL.md "Trackers"):
 // every usable tracker is read at its rate, its latest pose kept raw and in the
-// world frame (seed §4.1.2 "Tracked Viewer Registration", §4.1.4), cameras with
+// world frame ([Raskar02] §4.1.2 "Tracked Viewer Registration", §4.1.4), cameras with
 // a poll fd are counted as their frames arrive, and `tracker register` fits the
 // tracker -> world registration (eq. 4.2, §4.2.5) kept in tracker.json.
 #include <algorithm>

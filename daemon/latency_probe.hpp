@@ -1,6 +1,6 @@
 #pragma once
 // The display-to-capture latency of an output seen by cameras (projector–camera
-// synchronisation, seed §4.1.1): on a worker, shows black and white in turn on
+// synchronisation, [Raskar02] §4.1.1): on a worker, shows black and white in turn on
 // the output, captures each camera across every switch and finds when the
 // change appears (sl::findTransition); the median over the repeats gives the
 // settle frames `calibrate` waits after showing a pattern.

@@ -1,4 +1,4 @@
-// procamd: the projector-camera daemon (see daemon/PROTOCOL.md, DESIGN.md).
+// procamd: the projector-camera daemon (see daemon/PROTOCOL.md, ARCHITECTURE.md).
 #include <unistd.h>
 
 #include <cstdio>

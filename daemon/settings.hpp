@@ -11,7 +11,7 @@
 namespace procam::daemon {
 
 // Output-pixel corners of the corrected image, in the order top-left,
-// top-right, bottom-right, bottom-left (x right, y down; DESIGN.md).
+// top-right, bottom-right, bottom-left (x right, y down; ARCHITECTURE.md).
 using Quad = std::array<std::array<double, 2>, 4>;
 
 struct Settings {

@@ -1,7 +1,7 @@
 #pragma once
 // Trackers in the daemon (PROTOCOL.md "Trackers"): the latest reading of every
 // tracker, raw and in the world frame, and the tracker -> world registrations
-// (seed §4.1.2 "Tracked Viewer Registration", eq. 4.2, §4.2.5) that the
+// ([Raskar02] §4.1.2 "Tracked Viewer Registration", eq. 4.2, §4.2.5) that the
 // `tracker register` command fits and <state-dir>/tracker.json keeps beside
 // rig.json. Pure data and JSON here; daemon_tracker.cpp does the reading.
 #include <chrono>

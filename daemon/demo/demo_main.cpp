@@ -212,7 +212,7 @@ int main(int argc, char** argv) {
       "Error columns: the shown image judged with the true orientation at the tilt sample's\n"
       "time (corner px in the framebuffer, aspect and area against the largest upright\n"
       "rectangle). 'tilt' uses the true pitch and roll; 'full' adds the true yaw, which a\n"
-      "tilt sensor cannot see (seed §6.2.2: the camera gives the azimuth).\n\n");
+      "tilt sensor cannot see ([Raskar02] §6.2.2: the camera gives the azimuth).\n\n");
   std::printf("%7s %6s | %7s %7s %6s | %7s %7s | %9s %8s %7s | %9s\n", "t [s]", "still", "pitch",
               "roll", "yaw", "est p", "est r", "tilt px", "aspect%", "area%", "full px");
   auto watch = demo::Child::start({opt.procamctl, "--socket", socket, "--json", "watch"});
@@ -273,7 +273,7 @@ int main(int argc, char** argv) {
     std::printf(
         "Held still at the end: the update at t = %.2f s, which stays on the wall, is off by "
         "corner %.3f px, aspect %.4f %%, area %.4f %%\n"
-        "  (issue 4 tolerances: corner <= 0.5 px, aspect 0.1 %%, area 0.5 %%).\n",
+        "  (procamd's keystone accuracy bounds: corner <= 0.5 px, aspect 0.1 %%, area 0.5 %%).\n",
         final_time, final_hold->corner_px, final_hold->aspect_pct, final_hold->area_pct);
   }
 

@@ -1,7 +1,7 @@
 #pragma once
 // A mesh as 3D content on a planar display for one projector and a viewer: placed in
 // front of the surface, shaded, and with the single-pass A'4x4 P_T matrix that renders
-// it (seed §4.2.1-4.2.3, eq. 4.10; RenderPath::kPlanar3d).
+// it ([Raskar02] §4.2.1-4.2.3, eq. 4.10; RenderPath::kPlanar3d).
 //
 // Placement: the plane's axes are u (horizontal, to the viewer's right) and v (world up
 // projected onto the plane; world +Y when the plane is horizontal), n = u x v faces the
@@ -45,7 +45,7 @@ struct PlacedMesh {
 Result<PlacedMesh> placeMeshContent(const MeshContent& content, const PlanarView& view);
 
 // The view-dependent part alone: RenderSetup::planar3d for the viewer `view.eye` with
-// S kept (A does not depend on the viewer, seed §4.2.2), so that a placed mesh is drawn
+// S kept (A does not depend on the viewer, [Raskar02] §4.2.2), so that a placed mesh is drawn
 // for a moved viewer where it stands. Depth range of P_T: 0.1 to 2 times the viewer's
 // distance to S's centre. kDegenerate when the viewer is on the plane or behind it.
 Result<Mat4> planar3dForViewer(const PlanarView& view, const keystone::DisplayRect& S);

@@ -147,7 +147,7 @@ cv::Vec3f Renderer::radianceAlong(const geom::Ray& ray) const {
     if (!lamp.image) continue;
     const PixelTruth::Light l = light(lamp, hit->hit.point, hit->hit.normal, hit->surface);
     if (!l.lit) continue;
-    // Irradiance from a point source: I * cos(theta) / d^2 (seed §5.2.4).
+    // Irradiance from a point source: I * cos(theta) / d^2 ([Raskar02] §5.2.4).
     const double scale = state_.projectors[lamp.projector].spec.brightness * l.cos_incidence /
                          (l.distance * l.distance);
     irradiance += lamp.image->sample(l.pixel.x(), l.pixel.y()) * static_cast<float>(scale);

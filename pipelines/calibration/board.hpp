@@ -1,7 +1,7 @@
 #pragma once
 // Calibration boards and their detection: checkerboard, ChArUco and an AprilTag
 // (tag36h11) grid. Each detection yields image points and the matching board
-// points (metres, board plane z = 0) for cv::calibrateCamera (seed §7.3, [Zhang99]).
+// points (metres, board plane z = 0) for cv::calibrateCamera ([Raskar02] §7.3, [Zhang99]).
 #include <opencv2/core.hpp>
 #include <string>
 

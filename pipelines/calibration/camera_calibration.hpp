@@ -1,6 +1,6 @@
 #pragma once
 // Camera intrinsics from board views (cv::calibrateCamera, Zhang's method) and the
-// extrinsics of a camera pair from simultaneous views (seed §4.1.1 step one,
+// extrinsics of a camera pair from simultaneous views ([Raskar02] §4.1.1 step one,
 // "Camera Calibration").
 #include <span>
 #include <vector>

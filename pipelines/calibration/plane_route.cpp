@@ -1,5 +1,5 @@
 // Route (b): projector intrinsics and pose from one calibrated camera and a blank
-// plane at >= 2 orientations (seed §7.3, [Raskar01b]).
+// plane at >= 2 orientations ([Raskar02] §7.3, [Raskar01b]).
 //
 // With the camera frame as reference, a point on plane i (m_i . X = 1) seen along
 // the normalised camera ray x lies at X = x / (m_i . x), and the projector sees it at

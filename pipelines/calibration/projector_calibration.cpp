@@ -128,7 +128,7 @@ Result<ProjectorCalibration> calibrateProjectorFromSurface(const surface::Surfac
   if (!c && c.error().code == ErrorCode::kCoplanar)
     return fail(ErrorCode::kCoplanar,
                 "the decoded surface is planar, so the projector's depth scale is ambiguous "
-                "(seed 4.1.1): add a non-planar object to the scene for this calibration, "
+                "([Raskar02] §4.1.1): add a non-planar object to the scene for this calibration, "
                 "or calibrate from the plane at two or more orientations (route b)");
   return c;
 }

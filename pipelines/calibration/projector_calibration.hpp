@@ -1,12 +1,12 @@
 #pragma once
-// Projector calibration: a projector is the dual of a camera (seed §3.1.2), P = K[R|t].
+// Projector calibration: a projector is the dual of a camera ([Raskar02] §3.1.2), P = K[R|t].
 // Three routes, all returning K, R, t and the reprojection RMS:
 //  (a) 3D surface points triangulated by a calibrated camera pair + the projector
-//      pixels that lit them -> 3x4 DLT + LM -> RQ decomposition (seed §4.1.1);
-//  (b) one calibrated camera and a blank plane at >= 2 orientations (seed §7.3),
+//      pixels that lit them -> 3x4 DLT + LM -> RQ decomposition ([Raskar02] §4.1.1);
+//  (b) one calibrated camera and a blank plane at >= 2 orientations ([Raskar02] §7.3),
 //      for a projector with square pixels, zero skew and a known c_x (see below);
 //  (c) >= 6 fiducials with known 3D positions + the projector pixels lighting them
-//      (seed §5.2.5).
+//      ([Raskar02] §5.2.5).
 #include <cstdint>
 #include <optional>
 #include <span>

@@ -1,5 +1,5 @@
 #pragma once
-// Route (a) from decoded structured light (seed §4.1.1): two calibrated cameras
+// Route (a) from decoded structured light ([Raskar02] §4.1.1): two calibrated cameras
 // decode the same pattern set; each decoded map is inverted on a projector grid,
 // the nodes both cameras see are triangulated, the projector's 3x4 matrix is fitted
 // to them and the display surface is modelled from the points consistent with it.

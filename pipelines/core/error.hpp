@@ -11,7 +11,8 @@ enum class ErrorCode {
   kInvalidInput,     // malformed argument: wrong sizes, NaN/Inf, negative counts
   kTooFewPoints,     // fewer correspondences than the model needs
   kDegenerate,       // configuration admits no unique solution (collinear, duplicates)
-  kCoplanar,         // 3D points (near) coplanar: projection matrix undetermined (seed §4.1.1)
+  kCoplanar,         // 3D points (near) coplanar: projection matrix undetermined
+                     // ([Raskar02] §4.1.1)
   kIllConditioned,   // system too badly conditioned to trust the result
   kNoConvergence,    // iterative solver did not reach its tolerance
   kNotFound,         // requested item absent (no intersection, unknown name)

@@ -1,5 +1,5 @@
 #pragma once
-// Eigen aliases shared by all pipelines. Doubles for estimation (DESIGN.md).
+// Eigen aliases shared by all pipelines. Doubles for estimation (ARCHITECTURE.md).
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <vector>

@@ -1,6 +1,6 @@
 #pragma once
-// Pinhole model shared by cameras and projectors (seed §3.1.2, eq. 3.1): a projector
-// is the dual of a camera, P = K[R|t]. Frames follow DESIGN.md: x right, y down,
+// Pinhole model shared by cameras and projectors ([Raskar02] §3.1.2, eq. 3.1): a projector
+// is the dual of a camera, P = K[R|t]. Frames follow ARCHITECTURE.md: x right, y down,
 // z forward; pixel centres at integer coordinates; R, t map world -> device.
 #include <optional>
 

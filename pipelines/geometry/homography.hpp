@@ -1,5 +1,5 @@
 #pragma once
-// Plane-to-plane homographies (seed §3.2.5, §4.2.1): dst ~ H * src.
+// Plane-to-plane homographies ([Raskar02] §3.2.5, §4.2.1): dst ~ H * src.
 #include <array>
 #include <optional>
 #include <span>

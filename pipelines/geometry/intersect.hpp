@@ -1,6 +1,6 @@
 #pragma once
 // Ray intersection with the surface primitives of the virtual rig and of surface
-// models (seed §3.1.1: M = TV ∧ D). All return the nearest hit with t in
+// models ([Raskar02] §3.1.1: M = TV ∧ D). All return the nearest hit with t in
 // (t_min, t_max), or nullopt.
 #include <cstdint>
 #include <memory>

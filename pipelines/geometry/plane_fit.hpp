@@ -1,5 +1,5 @@
 #pragma once
-// Planes: least-squares and RANSAC fits (seed §4.1.1 coplanarity, §7.3 planar
+// Planes: least-squares and RANSAC fits ([Raskar02] §4.1.1 coplanarity, §7.3 planar
 // display surfaces).
 #include <cstdint>
 #include <span>

@@ -64,7 +64,7 @@ Result<Normalized> prepare(std::span<const Vec3> world, std::span<const Vec2> pi
     return fail(ErrorCode::kDegenerate, "projection matrix: fewer than 6 distinct 3D points");
   }
   // Principal spreads of the 3D points (centroid is 0 after normalisation). Points on
-  // one plane leave P undetermined up to a family (seed §4.1.1): the fix is geometric.
+  // one plane leave P undetermined up to a family ([Raskar02] §4.1.1): the fix is geometric.
   Eigen::MatrixXd centred(n.X.size(), 3);
   for (std::size_t i = 0; i < n.X.size(); ++i) centred.row(Eigen::Index(i)) = n.X[i].transpose();
   const Eigen::VectorXd spreads = detail::singularValues(centred);
@@ -74,7 +74,7 @@ Result<Normalized> prepare(std::span<const Vec3> world, std::span<const Vec2> pi
                 "projection matrix: the 3D points are (nearly) coplanar (thickness/extent = " +
                     detail::shortNumber(ratio) +
                     "), so depth and focal length cannot be separated; add points on a "
-                    "non-planar surface, e.g. a second wall at an angle (seed §4.1.1)");
+                    "non-planar surface, e.g. a second wall at an angle ([Raskar02] §4.1.1)");
   }
   // Image points all on one line: the camera centre lies in the points' plane or the
   // points are collinear; either way nothing is determined.

@@ -1,6 +1,6 @@
 #pragma once
-// 3x4 projection matrix from 3D-2D correspondences and its decomposition (seed
-// §4.1.1 eq. 4.1, "Projector Calibration").
+// 3x4 projection matrix from 3D-2D correspondences and its decomposition
+// ([Raskar02] §4.1.1 eq. 4.1, "Projector Calibration").
 #include <span>
 
 #include "core/error.hpp"
@@ -20,7 +20,7 @@ struct ProjectionOptions {
   bool refine = true;
   int max_iterations = 100;
   // Points whose smallest principal spread is below this fraction of the largest
-  // are treated as coplanar (seed §4.1.1: the planar depth-scale ambiguity).
+  // are treated as coplanar ([Raskar02] §4.1.1: the planar depth-scale ambiguity).
   double coplanar_ratio = 1e-3;
   double max_condition = 1e8;  // of the normalised DLT system; larger -> kIllConditioned
 };

@@ -51,7 +51,7 @@ Result<RigidFit> fitRigidTransform(std::span<const Vec3> from, std::span<const V
   }
   const Eigen::Matrix3Xd src = toMatrix(from);
   const Eigen::Matrix3Xd dst = toMatrix(to);
-  // Umeyama needs rank(cross-covariance) >= 2 for a unique rotation (seed eq. 4.2):
+  // Umeyama needs rank(cross-covariance) >= 2 for a unique rotation ([Raskar02] eq. 4.2):
   // both sets must span at least a plane.
   if (!spansPlane(src) || !spansPlane(dst)) {
     return fail(ErrorCode::kDegenerate, "points are collinear or coincident");

@@ -1,5 +1,5 @@
 #pragma once
-// Rigid (optionally similarity) transform between point sets, seed eq. 4.2.
+// Rigid (optionally similarity) transform between point sets, [Raskar02] eq. 4.2.
 #include <span>
 
 #include "core/error.hpp"

@@ -1,5 +1,5 @@
 #pragma once
-// Triangulation from rays or from projection matrices (seed §4.1.1, display surface
+// Triangulation from rays or from projection matrices ([Raskar02] §4.1.1, display surface
 // estimation from a stereo pair).
 #include <span>
 

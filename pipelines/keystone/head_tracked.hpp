@@ -1,6 +1,6 @@
 #pragma once
 // Head-tracked rendering on a planar display with an oblique projector, in one pass
-// (seed §4.2.1-4.2.3, Appendix B):
+// ([Raskar02] §4.2.1-4.2.3, Appendix B):
 //  1. P_T: off-axis frustum from the viewer T through the axis-aligned rectangle S on
 //     the display plane that bounds the projector's keystoned image (§4.2.1);
 //  2. A: the collineation from P_T's normalised image to the projector's, induced by the
@@ -9,7 +9,7 @@
 //     depth in [-1, 1] for points inside S's frustum (eq. 4.9).
 // Normalised coordinates here are OpenGL's clip/NDC space (x right, y up, z in [-1, 1]
 // from near to far), since that is where the depth buffer lives. Framebuffer pixels
-// follow DESIGN.md (pixel centres at integers, y down).
+// follow ARCHITECTURE.md (pixel centres at integers, y down).
 #include "core/error.hpp"
 #include "core/types.hpp"
 

@@ -1,6 +1,6 @@
 #pragma once
 // The largest rectangle of a given aspect ratio, with sides parallel to the axes, inside
-// a convex polygon (the keystoned image on the wall, seed §3.2.5 Fig. 3.8).
+// a convex polygon (the keystoned image on the wall, [Raskar02] §3.2.5 Fig. 3.8).
 //
 // For a fixed aspect a the rectangle is (centre c, half height h, half width a*h). It is
 // inside the convex polygon iff every edge half-plane n·p <= b holds at its worst corner:

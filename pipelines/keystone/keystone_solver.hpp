@@ -1,5 +1,5 @@
 #pragma once
-// Keystone correction for a projector in front of a vertical wall (seed §3.2.5): the
+// Keystone correction for a projector in front of a vertical wall ([Raskar02] §3.2.5): the
 // projector's image on the wall is a keystoned quadrilateral; the content is shown in the
 // largest rectangle of its aspect ratio, aligned with gravity, inside it; the pre-warp is
 // the homography content pixels -> framebuffer pixels. Translation does not matter

@@ -1,11 +1,11 @@
 #pragma once
-// Projector orientation relative to a vertical wall (seed §3.2.5: P_P = F[R 0], only the
+// Projector orientation relative to a vertical wall ([Raskar02] §3.2.5: P_P = F[R 0], only the
 // rotation matters; §6.2.2: tilt sensors give elevation and roll, the rigid camera gives
 // the azimuth).
 //
-// Wall frame W (right-handed, +Z up as the world frame of DESIGN.md): X runs along the
+// Wall frame W (right-handed, +Z up as the world frame of ARCHITECTURE.md): X runs along the
 // wall to the right, Y is horizontal and points into the wall (away from the viewer), Z
-// points up. Projector frame: x right, y down, z forward (DESIGN.md). R maps W to the
+// points up. Projector frame: x right, y down, z forward (ARCHITECTURE.md). R maps W to the
 // projector frame: x_p = R x_w.
 //
 // Angle convention (the one the command line documents): reference pose = optical axis

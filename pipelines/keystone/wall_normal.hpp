@@ -1,6 +1,6 @@
 #pragma once
 // The wall's plane in the projector frame from projector-camera correspondences, the
-// camera rigidly attached with calibrated extrinsics (seed §6.2.2 azimuth from the
+// camera rigidly attached with calibrated extrinsics ([Raskar02] §6.2.2 azimuth from the
 // camera, §6.3 self-correcting projector).
 //
 // A wall point on the projector ray p = Kp^-1 x_p is X = p / (m·p) for the plane

@@ -1,5 +1,5 @@
 #pragma once
-// Bilinear sampling of RGBA8 images in DESIGN.md's pixel convention: pixel (i, j) has its
+// Bilinear sampling of RGBA8 images in ARCHITECTURE.md's pixel convention: pixel (i, j) has its
 // centre at (i, j). A sample at (x, y) is defined on [-0.5, W-0.5) x [-0.5, H-0.5) — the
 // image's footprint — with the outermost half pixel clamped to the edge texel (what GL's
 // CLAMP_TO_EDGE does); outside the footprint the result is transparent black.

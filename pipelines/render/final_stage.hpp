@@ -1,5 +1,5 @@
 #pragma once
-// The last stage of every projector frame (seed §4.1.2): a per-pixel intensity weight
+// The last stage of every projector frame ([Raskar02] §4.1.2): a per-pixel intensity weight
 // from the projector's alpha mask, itself passed through a lookup table that accounts for
 // the projector's non-linear response (so blended overlaps sum to one in light, not in
 // code values), then a per-channel output lookup table. Integer arithmetic defined here

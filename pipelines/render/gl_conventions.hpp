@@ -1,5 +1,5 @@
 #pragma once
-// The one place where this project's pixel conventions (DESIGN.md: x right, y down,
+// The one place where this project's pixel conventions (ARCHITECTURE.md: x right, y down,
 // pixel centres at integer coordinates) meet OpenGL's (normalised device coordinates
 // in [-1, 1], texture coordinates in [0, 1] with texel centres at half-integers).
 #include "core/types.hpp"

@@ -1,5 +1,5 @@
 #pragma once
-// Two-pass projective texture over a surface mesh (seed §3.2.3, §4.1.1): the desired
+// Two-pass projective texture over a surface mesh ([Raskar02] §3.2.3, §4.1.1): the desired
 // image for a viewer is projected from the viewer's centre onto the display-surface mesh,
 // and the mesh is seen from the projector. For a fixed mesh, projector and viewer this is
 // a fixed map from projector pixels to desired-image pixels, built here in double.

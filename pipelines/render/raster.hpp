@@ -1,5 +1,5 @@
 #pragma once
-// Scan conversion of one triangle over pixel centres (DESIGN.md convention), with a
+// Scan conversion of one triangle over pixel centres (ARCHITECTURE.md convention), with a
 // top-left rule so that pixels on an edge shared by two triangles are drawn once.
 #include <algorithm>
 #include <cmath>

@@ -1,9 +1,9 @@
 #pragma once
-// The CPU back-end of the planar 3D path (seed §4.2.2-4.2.3): vertex-coloured triangles
+// The CPU back-end of the planar 3D path ([Raskar02] §4.2.2-4.2.3): vertex-coloured triangles
 // through A'4x4 P_T, drawn as the GL back-end's colour program draws them. Triangles are
 // clipped in homogeneous coordinates to the depth range -w <= z <= w (which also keeps
 // only w > 0: nothing behind the projector) and to a band one pixel outside the image,
-// so no visible geometry is lost; pixel centres sit at integers (DESIGN.md), edges follow
+// so no visible geometry is lost; pixel centres sit at integers (ARCHITECTURE.md), edges follow
 // the top-left rule (raster.hpp), a float depth buffer keeps the nearest fragment
 // (GL_LESS, cleared to the far plane) and colours are interpolated perspective-correctly,
 // as GL's default smooth shading does.

@@ -1,5 +1,5 @@
 #pragma once
-// Choice of the cheapest rendering path a scene allows (DESIGN.md's table).
+// Choice of the cheapest rendering path a scene allows (ARCHITECTURE.md's table).
 #include "core/error.hpp"
 
 namespace procam::render {
@@ -16,7 +16,7 @@ struct SceneTraits {
 };
 
 enum class RenderPath {
-  kHomography,   // planar surface: one 3x3 pre-warp (seed §3.2.5, §4.2.1, §4.2.4 chains)
+  kHomography,   // planar surface: one 3x3 pre-warp ([Raskar02] §3.2.5, §4.2.1, §4.2.4 chains)
   kPlanar3d,     // planar surface, tracked viewer, 3D content: A'4x4 P_T (§4.2.2-4.2.3)
   kTwoPassMesh,  // non-planar surface, tracked viewer: projective texture (§3.2.3, §4.1.1)
   kLookupWarp,   // non-planar surface, static viewer: measured lookup warp (§4.1.5)

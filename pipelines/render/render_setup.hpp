@@ -37,7 +37,7 @@ struct RenderSetup {
   WarpGrid lookup;  // kLookupWarp: projector pixel -> content pixel
 
   // kPlanar3d: world -> homogeneous projector pixels with depth, (x w, y w, z w, w) and
-  // z in [-1, 1] for visible depths: A'4x4 P_T of seed eq. 4.10 in this project's pixel
+  // z in [-1, 1] for visible depths: A'4x4 P_T of [Raskar02] eq. 4.10 in this project's pixel
   // convention (its clip-space form comes from glConventions()).
   Mat4 planar3d = Mat4::Identity();
 
@@ -55,7 +55,7 @@ struct Content {
 };
 
 // Skips frames that would come out identical: nothing re-renders unless the geometry
-// was reconfigured or the content version changed (DESIGN.md: no work when nothing moved).
+// was reconfigured or the content version changed (ARCHITECTURE.md: no work when nothing moved).
 class FrameGate {
  public:
   void geometryChanged() { dirty_ = true; }

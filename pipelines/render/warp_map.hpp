@@ -1,6 +1,6 @@
 #pragma once
 // Backward warp maps: for every output pixel, the source-image coordinate to sample
-// (DESIGN.md's pixel convention). Built once when the geometry changes and applied to
+// (ARCHITECTURE.md's pixel convention). Built once when the geometry changes and applied to
 // every frame (precomputed maps). Entries outside the source footprint sample as black;
 // kOutside marks pixels that no source pixel reaches. Maps hold float32 coordinates:
 // per-pixel render data, with the error against double bounded in tests.
@@ -18,10 +18,10 @@ struct WarpMap {
   cv::Size size() const { return xy.size(); }
 };
 
-// The post-rendering warp grid of seed §4.1.3: nodes on a regular lattice of output
+// The post-rendering warp grid of [Raskar02] §4.1.3: nodes on a regular lattice of output
 // pixels, each holding the source coordinate it must show. Between nodes the map is
 // piecewise linear over two triangles per cell, split along the diagonal from node
-// (i, j) to (i+1, j+1) — the "multiple textured triangles" of the seed, identical on
+// (i, j) to (i+1, j+1) — the "multiple textured triangles" of [Raskar02], identical on
 // the CPU and in GL.
 struct WarpGrid {
   int cols = 0, rows = 0;      // node counts, >= 2 each
@@ -32,7 +32,7 @@ struct WarpGrid {
   const Vec2& at(int i, int j) const { return source[static_cast<size_t>(j) * cols + i]; }
 };
 
-// Map of an output image related to the source by dst ~ H * src (seed §4.2.1 eq. 4.6).
+// Map of an output image related to the source by dst ~ H * src ([Raskar02] §4.2.1 eq. 4.6).
 // kInvalidInput for non-finite H or empty size, kDegenerate when H is singular.
 Result<WarpMap> homographyMap(const Mat3& H, cv::Size output_size);
 

@@ -1,7 +1,7 @@
 #pragma once
-// Adaptive pattern count — skip what the scene does not need (seed §4.1.4: a coarse
+// Adaptive pattern count — skip what the scene does not need ([Raskar02] §4.1.4: a coarse
 // 16x12 binary-coded pass). A coarse Gray pass decides whether the surface is planar
-// (one camera sees a plane through the projector as a homography, seed §3.2.5); a
+// (one camera sees a plane through the projector as a homography, [Raskar02] §3.2.5); a
 // planar surface stops there with enough correspondences for that homography, and
 // only a non-planar one gets the full-resolution set.
 #include <functional>

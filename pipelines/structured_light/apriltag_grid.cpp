@@ -110,7 +110,7 @@ Result<std::vector<TagCorrespondence>> detectTagGrid(const TagGrid& grid, const 
     if (d->decision_margin < o.min_margin || d->hamming > 0) continue;
     const TagPlacement& t = grid.tags[static_cast<std::size_t>(d->id)];
     for (int c = 0; c < 4; ++c) {
-      // libapriltag puts pixel centres at +0.5 (DESIGN.md: integer centres).
+      // libapriltag puts pixel centres at +0.5 (ARCHITECTURE.md: integer centres).
       out.push_back({d->id, c, Vec2(d->p[c][0] - 0.5, d->p[c][1] - 0.5), t.corners[c]});
     }
   }

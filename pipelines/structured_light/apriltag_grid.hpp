@@ -2,7 +2,7 @@
 // Single-frame sparse correspondences: a grid of tag36h11 AprilTags shown by the
 // projector (or printed on a board) and detected in one capture. Used by the planar
 // fast path, the handheld keystone's camera and drift checks during display.
-// Corners are in DESIGN.md's pixel-centre convention on both sides.
+// Corners are in ARCHITECTURE.md's pixel-centre convention on both sides.
 #include <array>
 #include <opencv2/core.hpp>
 #include <vector>

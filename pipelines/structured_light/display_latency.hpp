@@ -1,5 +1,5 @@
 #pragma once
-// Display-to-capture latency (projector–camera synchronisation, seed §4.1.1:
+// Display-to-capture latency (projector–camera synchronisation, [Raskar02] §4.1.1:
 // every structured-light capture must see the pattern shown before it). An
 // output switches a test region between two levels at a known time; a camera
 // keeps capturing it; the latency is when the new level first appears in the

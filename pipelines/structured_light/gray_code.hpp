@@ -1,7 +1,7 @@
 #pragma once
 // Reflected binary (Gray) code: neighbouring cells differ in exactly one bit, so a
-// camera pixel on a stripe edge decodes to one of the two adjacent cells (seed
-// §4.1.1, "binary-coding the projector illuminated pixels ... log2(n) frames").
+// camera pixel on a stripe edge decodes to one of the two adjacent cells
+// ([Raskar02] §4.1.1, "binary-coding the projector illuminated pixels ... log2(n) frames").
 #include <bit>
 #include <cstdint>
 

@@ -1,5 +1,5 @@
 #pragma once
-// Structured-light pattern sets (seed §4.1.1 display-surface estimation, §4.1.4
+// Structured-light pattern sets ([Raskar02] §4.1.1 display-surface estimation, §4.1.4
 // sampling density): Gray code for projector columns and rows, each bit followed by
 // its inverse so the decoder thresholds every camera pixel against its own pair,
 // all-white and all-black reference frames, and optionally N-step phase shifting
@@ -61,7 +61,7 @@ Result<Mode> parseMode(const std::string& text);  // "gray" | "gray+phase"
 
 // kInvalidInput for sizes < 1 or > 65536, steps < 1, N < 3, period < 4 or gamma <= 0.
 // In kGrayPhase the Gray cell is period/4 (period = max(phase_period, 4*step)), which
-// keeps unwrapping unambiguous with a one-cell Gray error (seed §4.1.4 trade-off).
+// keeps unwrapping unambiguous with a one-cell Gray error ([Raskar02] §4.1.4 trade-off).
 Result<PatternSet> makePatternSet(const PatternOptions& options);
 
 // The frame's image at projector resolution, CV_8UC1.

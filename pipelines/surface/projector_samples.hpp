@@ -2,7 +2,7 @@
 // Inverts a decoded camera -> projector map on a projector grid: for every projector
 // node (i*step, j*step) the sub-pixel camera point that sees it. A local affine fit
 // of camera position against decoded projector position over the node's
-// neighbourhood averages the decoder's quantisation and noise (seed §4.1.1 "for
+// neighbourhood averages the decoder's quantisation and noise ([Raskar02] §4.1.1 "for
 // each projector pixel (u, v) ... a corresponding illuminated 3D surface point").
 #include <cstdint>
 #include <vector>

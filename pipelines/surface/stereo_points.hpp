@@ -1,5 +1,5 @@
 #pragma once
-// Display-surface points from a calibrated camera pair (seed §4.1.1 "Display Surface
+// Display-surface points from a calibrated camera pair ([Raskar02] §4.1.1 "Display Surface
 // Estimation"): the projector node seen by both cameras is triangulated from their
 // two rays. Each point keeps the projector pixel that lit it, which is what
 // projector calibration (route a) and the projector-space mesh need.

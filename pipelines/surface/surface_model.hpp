@@ -1,5 +1,5 @@
 #pragma once
-// Display-surface model from triangulated points (seed §4.1.1: a mesh in projector
+// Display-surface model from triangulated points ([Raskar02] §4.1.1: a mesh in projector
 // image space; §4.2: planar surfaces need only a plane). A RANSAC plane test picks
 // the cheaper model: planar -> plane; otherwise a mesh over the projector grid with
 // holes where nothing was decoded, simplified where the surface is flat.

@@ -1,7 +1,7 @@
 #pragma once
-// IR LED blobs in an IR-filtered camera image (issue 7): background subtraction,
+// IR LED blobs in an IR-filtered camera image: background subtraction,
 // threshold, 8-connected components, intensity-weighted sub-pixel centroids.
-// Pixel centres are at integer coordinates (DESIGN.md).
+// Pixel centres are at integer coordinates (ARCHITECTURE.md).
 #include <opencv2/core/mat.hpp>
 #include <vector>
 

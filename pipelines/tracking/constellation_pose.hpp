@@ -44,7 +44,8 @@ Result<ConstellationPose> estimateConstellationPose(
 // First-order covariance of the constellation origin in the camera frame for a pose
 // seen with isotropic pixel noise `sigma` on every LED in `used` (all when empty):
 // sigma^2 (J^T J)^-1 over the 6 pose parameters, position block. Also the theoretical
-// bound for a camera and a layout (issue 7: f and distance decide the 2 mm budget).
+// bound for a camera and a layout (f and distance decide whether the 2 mm RMS
+// head-position bound can be met).
 Mat3 positionCovariance(const geom::Intrinsics& K, const geom::Pose& pose,
                         std::span<const Vec3> leds, double sigma, std::span<const int> used = {});
 

@@ -1,8 +1,8 @@
 #pragma once
-// Per-frame pose pipeline shared by every IR LED tracker (issue 7): blob centres of one
+// Per-frame pose pipeline shared by every IR LED tracker: blob centres of one
 // frame -> constellation pose (keeping the last pose for estimateConstellationPose's
-// shortcut) -> optional tracker -> world registration (eq. 4.2, §4.2.5) -> motion filter
-// with prediction by the display latency (§4.1.4). Pure: no I/O.
+// shortcut) -> optional tracker -> world registration ([Raskar02] eq. 4.2, §4.2.5) -> motion filter
+// with prediction by the display latency ([Raskar02] §4.1.4). Pure: no I/O.
 #include <optional>
 #include <span>
 #include <vector>

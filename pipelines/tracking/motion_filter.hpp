@@ -1,6 +1,7 @@
 #pragma once
-// Position filters for tracker readings (seed §4.1.4: readings are low-pass filtered
-// before use), with prediction ahead by the display latency (issue 7):
+// Position filters for tracker readings ([Raskar02] §4.1.4: readings are low-pass filtered
+// before use), with prediction ahead by the display latency (the rendered frame is
+// seen that much later than the reading):
 //  - One Euro: adaptive first-order low-pass whose cut-off rises with speed
 //    (min_cutoff + beta |v|), so jitter is removed at rest and lag stays small in motion;
 //  - Kalman: constant-velocity model per axis, white-acceleration process noise.

@@ -1,6 +1,6 @@
 #pragma once
 // LED positions from two (or more) calibrated cameras by triangulation, and the
-// constellation's world pose from them through the rigid fit of seed eq. 4.2.
+// constellation's world pose from them through the rigid fit of [Raskar02] eq. 4.2.
 #include <span>
 #include <vector>
 

@@ -32,7 +32,7 @@ Result<TrackerRegistration> registerTrackerToScreen(std::span<const Vec3> tracke
   const Vec3& O = tracker[origin];
   Vec3 r3 = plane->plane.n;
   if (r3.dot(viewer_side - O) < 0) r3 = -r3;
-  // The seed normalises M_x - O directly; projecting it into the plane first keeps R
+  // [Raskar02] §4.2.5 normalises M_x - O directly; projecting it into the plane first keeps R
   // orthonormal when the readings are noisy.
   Vec3 r1 = tracker[x_axis] - O;
   r1 -= r1.dot(r3) * r3;

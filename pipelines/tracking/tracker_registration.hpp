@@ -1,5 +1,5 @@
 #pragma once
-// Tracker -> world registration (issue 7; seed eq. 4.2 and §4.2.5): from >= 4 points
+// Tracker -> world registration ([Raskar02] eq. 4.2 and §4.2.5): from >= 4 points
 // measured by the tracker whose world coordinates are known, or from tracker readings
 // of points on a screen that itself defines the world frame (plane z = 0).
 #include <span>

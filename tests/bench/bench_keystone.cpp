@@ -168,7 +168,7 @@ void plot(const std::filesystem::path& out) {
          << "' using ($4==" << cal << " && strcol(1) eq '" << c.name << "' ? $5 : 1/0):7 "
          << "with linespoints title '" << c.name << (cal ? " calibrated" : " raw") << "'";
     }
-  gp << ", 0.5 with lines dt 2 title 'issue tolerance 0.5 px'\n";
+  gp << ", 0.5 with lines dt 2 title 'corner bound 0.5 px'\n";
   gp.close();
   const std::string cmd = "gnuplot '" + (out / "bench_keystone_noise.gp").string() + "'";
   if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "gnuplot failed\n");

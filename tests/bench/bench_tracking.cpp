@@ -1,4 +1,4 @@
-// IR tracking bench (issue 7): blob detection (pipelines/tracking/blob_detector) at
+// IR tracking bench: blob detection (pipelines/tracking/blob_detector) at
 // 640x480 and 1280x1024 against an OpenCV baseline in the same run (threshold +
 // cv::connectedComponentsWithStats + intensity moments per component), and the ir_camera
 // tracker end to end on a replay recording of the synthetic head trajectory

@@ -1,6 +1,7 @@
 // procam-calibrate end to end: the built programs on files in a temporary directory,
 // captures rendered by `procam-sim render` (one process per frame and camera), the
-// results checked against the rig's ground truth with the issue's tolerances.
+// results checked against the rig's ground truth with procamd's calibration accuracy
+// bounds.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -63,8 +64,8 @@ Vec3 vector3(const nlohmann::json& a) {
   return Vec3(a.at(0).get<double>(), a.at(1).get<double>(), a.at(2).get<double>());
 }
 
-// Projector of rig.json against procam-sim's truth: the issue's intrinsics
-// tolerances (focal 0.5%, principal point 2 px), and pose ones when `pose`.
+// Projector of rig.json against procam-sim's truth: the intrinsics accuracy bounds
+// (focal 0.5%, principal point 2 px), and pose ones when `pose`.
 void expectProjector(const nlohmann::json& rig, const nlohmann::json& truth, bool pose) {
   ASSERT_EQ(rig.at("projectors").size(), 1u);
   const auto& p = rig["projectors"][0];
@@ -160,8 +161,8 @@ TEST(CalibrateCli, PatternsWritesOnePngPerFrameAndTheSequence) {
   EXPECT_NE(r.err.find("--projector"), std::string::npos) << r.err;
 }
 
-// corner_stereo (half resolution, the issue's camera): decode the left camera into a
-// PFM, then route (a) with both cameras; the issue's tolerances.
+// corner_stereo (half resolution, under the reference capture conditions): decode the
+// left camera into a PFM, then route (a) with both cameras; route (a)'s accuracy bounds.
 TEST(CalibrateCli, DecodeAndSolveRouteAOnCornerStereo) {
   TempDir dir;
   const std::string text = issueCornerStereo();
@@ -210,7 +211,7 @@ TEST(CalibrateCli, DecodeAndSolveRouteAOnCornerStereo) {
   EXPECT_EQ(bad_undecoded, 0);
   const double rms = std::sqrt(sum / (2.0 * std::max(decoded, 1)));
   EXPECT_GT(decoded, 0.9 * lit);
-  EXPECT_LE(rms, 0.1);  // the issue: Gray + phase <= 0.1 projector px RMS
+  EXPECT_LE(rms, 0.1);  // Gray + phase decoding bound: <= 0.1 projector px RMS
   std::printf("[ figures  ] decode: %.4f projector px RMS over %d of %d lit pixels\n", rms, decoded,
               lit);
 
@@ -254,7 +255,7 @@ TEST(CalibrateCli, DecodeAndSolveRouteAOnCornerStereo) {
 
 // wall_oblique: `solve` (route a) on the plane fails with the coplanar error naming
 // solve-planes; `solve-planes` (route b) with the wall at two orientations meets the
-// issue's intrinsics tolerances.
+// intrinsics accuracy bounds.
 TEST(CalibrateCli, WallObliqueCoplanarErrorAndSolvePlanes) {
   TempDir dir;
   const std::string straight = issueWallOblique(0.0), turned = issueWallOblique(25.0);
@@ -401,7 +402,7 @@ exposure = 0.8
 
 }  // namespace
 
-// The issue: camera calibration from 15 rendered checkerboard views, focal within 0.3%.
+// Camera calibration from 15 rendered checkerboard views: focal within 0.3%.
 TEST(CalibrateCli, CameraFromFifteenCheckerboardViews) {
   TempDir dir;
   const int views = 15;

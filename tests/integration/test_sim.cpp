@@ -58,7 +58,7 @@ TEST(Sim, KeystoneHomographyMapsTheFrameCornersOntoTheSetCorners) {
   ASSERT_EQ((*k)["output_size"], json({1280, 720}));
   const json& H = (*k)["homography"];
   ASSERT_EQ(H.size(), 3u);
-  // dst ~ H * src for the frame's corner pixel centres (seed §3.2.5); exact up
+  // dst ~ H * src for the frame's corner pixel centres ([Raskar02] §3.2.5); exact up
   // to rounding of a 4-point solve, so 1e-6 px.
   const double src[4][2] = {{0, 0}, {1279, 0}, {1279, 719}, {0, 719}};
   for (int i = 0; i < 4; ++i) {

@@ -92,7 +92,7 @@ std::string writePreviousRig(const TempDir& dir, const std::string& scene) {
 }
 
 // rig.json in the state directory, against the scene's truth, with the
-// structured-light issue's route (a) tolerances on corner_stereo: focal 0.5%,
+// route (a) accuracy bounds on corner_stereo: focal 0.5%,
 // principal point 2 px, position 2 mm, rotation 0.05 degrees, reprojection RMS
 // <= 0.15 px.
 void expectRigMatchesTruth(const TempDir& dir, const json& reply, const std::string& scene,

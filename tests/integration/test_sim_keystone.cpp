@@ -1,7 +1,7 @@
 // Automatic keystone and the output frames of procamd --sim, over the socket
 // only. Ground truth comes from the scene: the projector's true rotation at the
 // time of the tilt sample a solution was made from, solved with
-// keystone::solveKeystone (issue 4's tolerances: corner <= 0.5 px, aspect within
+// keystone::solveKeystone (procamd's keystone accuracy bounds: corner <= 0.5 px, aspect within
 // 0.1 %, area within 0.5 % of the largest).
 #include <gtest/gtest.h>
 #include <sys/stat.h>

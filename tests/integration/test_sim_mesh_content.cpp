@@ -1,7 +1,7 @@
 // 3D content on the virtual rig: `content load` of an OBJ cube on `wall_oblique` (a
 // planar wall; the scene's viewer, or [content] viewer from the configuration) is drawn through the
 // planar 3D path, and the output's statistics (status.outputs.shown) match a double-precision ray
-// cast of the placed cube seen by the viewer (seed §4.2.1: a projector pixel shows what the
+// cast of the placed cube seen by the viewer ([Raskar02] §4.2.1: a projector pixel shows what the
 // viewer's ray through that pixel's wall point meets). A non-planar surface makes the load
 // `unavailable`. With a tracker the drawing follows the viewer as they move, and not while
 // they stand still (noise below [content] viewer_threshold_m).

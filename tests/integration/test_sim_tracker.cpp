@@ -1,7 +1,7 @@
 // Trackers and cameras in the running daemon on the virtual rig (dome3: the
 // tracker `ir_head` follows the viewer's walk with 2 mm noise per axis), over
 // the control socket: positions against the scene's truth, the tracker ->
-// world registration (seed eq. 4.2) persisted across a restart, and a camera
+// world registration ([Raskar02] eq. 4.2) persisted across a restart, and a camera
 // and a tracker unplugged and back (PROCAM_SIM_UNPLUG).
 #include <gtest/gtest.h>
 
@@ -146,7 +146,7 @@ void expectRegistered(const json& reg, const RegistrationCase& c) {
   ASSERT_TRUE(reg.is_object()) << reg.dump();
   EXPECT_EQ(reg["source"], "points");
   EXPECT_EQ(reg["points"], 6);
-  EXPECT_LE(reg["rms_m"].get<double>(), 1e-3);  // issue 7: registration from 6 points <= 1 mm
+  EXPECT_LE(reg["rms_m"].get<double>(), 1e-3);  // registration from 6 points: <= 1 mm RMS
   Mat3 R;
   for (int i = 0; i < 9; ++i) R(i / 3, i % 3) = reg["R"][i].get<double>();
   // 0.3 mm on points about a metre apart: well under a milliradian and a millimetre.

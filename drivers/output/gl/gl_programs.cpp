@@ -17,7 +17,7 @@ void main() {
 }
 )";
 
-// Projective texture from the viewer onto the surface (seed §3.2.3): (s, t, q) is linear
+// Projective texture from the viewer onto the surface ([Raskar02] §3.2.3): (s, t, q) is linear
 // in the world point, so GL's perspective-correct interpolation reproduces it exactly.
 constexpr const char* kSampleMeshVs = R"(#version 300 es
 layout(location = 0) in vec3 aWorld;

@@ -1,6 +1,6 @@
 #pragma once
 // The GLES 3 back-end of render::Renderer: the same paths as the CPU reference, drawn by
-// the GPU (seed §3.2.3, §4.1.2-4.1.3, §4.2.1-4.2.3):
+// the GPU ([Raskar02] §3.2.3, §4.1.2-4.1.3, §4.2.1-4.2.3):
 //  - homography pre-warp: one quad with projective texture coordinates;
 //  - planar 3D: vertex-coloured triangles through A'4x4 P_T with the depth test;
 //  - two-pass mesh: the surface mesh from the projector, the desired image projected on

@@ -48,7 +48,7 @@ class HidrawWiimote final : public WiimoteTransport {
 // "Wiimote": IR camera), square pixels: f = 512 / tan(16.5 deg) = 1728.5 px (the vertical
 // field is then 25 deg against the quoted 23: the published figures are rounded and
 // disagree; calibrate and override fx fy cx cy for accuracy). Principal point at the
-// grid's centre (pixel centres at integers, DESIGN.md). At the origin, pose identity.
+// grid's centre (pixel centres at integers, ARCHITECTURE.md). At the origin, pose identity.
 geom::CameraModel wiimoteCamera();
 
 struct WiimoteIrOptions {

@@ -1,8 +1,8 @@
 #pragma once
-// The hid head tracker (issue 7): a Wii Remote's IR camera watching the 4 IR LEDs on the
+// The hid head tracker: a Wii Remote's IR camera watching the 4 IR LEDs on the
 // viewer's glasses or cap, its blob frames fed to tracking::LedTracker (constellation
 // pose, tracker -> world registration, motion filter, prediction by the display
-// latency, seed §4.1.4) like the ir_camera tracker's.
+// latency, [Raskar02] §4.1.4) like the ir_camera tracker's.
 #include <procamd/procam_plugin.h>
 
 #include <optional>

@@ -1,9 +1,9 @@
 #pragma once
-// The ir_camera head tracker (issue 7): an IR-filtered camera, opened through any camera
+// The ir_camera head tracker: an IR-filtered camera, opened through any camera
 // driver of the plugin ABI, seeing the LEDs on the viewer's glasses or cap. Per frame:
 // blobs (threshold, connected components, sub-pixel centroids) -> tracking::LedTracker
 // (constellation pose, tracker -> world registration, motion filter, prediction by the
-// display latency, seed §4.1.4). Errors carry the ABI's status (camera::CameraError).
+// display latency, [Raskar02] §4.1.4). Errors carry the ABI's status (camera::CameraError).
 #include <procamd/procam_plugin.h>
 
 #include <optional>

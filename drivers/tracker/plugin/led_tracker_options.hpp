@@ -27,7 +27,7 @@ Result<Points3> pointsOption(const plugins::DriverOptions& o, const char* key,
 // The camera's intrinsics (fx, fy, cx, cy required; k1 k2 p1 p2 k3 optional) and its pose
 // in the tracker frame: camera_position (its centre, default the origin) and either
 // camera_rvec (OpenCV rotation vector, tracker frame -> camera, as a calibration reports
-// it) or camera_look_at with camera_up (default 0,0,1: the world's up, DESIGN.md).
+// it) or camera_look_at with camera_up (default 0,0,1: the world's up, ARCHITECTURE.md).
 // Width and height are left 0 (the camera's frames decide).
 Result<geom::CameraModel> trackerCamera(const plugins::DriverOptions& o);
 

@@ -1,7 +1,7 @@
 #pragma once
-// The shipped scenes with the camera for the accuracy tests: 8-bit captures,
-// read noise 1 DN, no shot noise, linear response, projector gamma 2.2, exposure and
-// ambient set for white ~75% of full scale and ambient 10% of white. Reduced
+// The shipped scenes under the reference capture conditions of the accuracy tests:
+// 8-bit captures, read noise 1 DN, no shot noise, linear response, projector gamma 2.2,
+// exposure and ambient set for white ~75% of full scale and ambient 10% of white. Reduced
 // resolutions (intrinsics scaled) keep the rendering to seconds. Empty text when
 // the shipped scene no longer has the lines edited here.
 #include <cmath>

@@ -1,7 +1,7 @@
 #pragma once
 // Shows a pattern set on the virtual rig (drivers/sim) and captures it with the
 // scene's cameras; scenes are the shipped ones with test-specific edits (smaller
-// resolutions, the noise, gamma and ambient light).
+// resolutions, the reference capture conditions' noise, gamma and ambient light).
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -88,7 +88,7 @@ inline Levels radianceLevels(const sim::Scene& scene, const std::string& camera)
   return l;
 }
 
-// The lighting: ambient 10% of the white level and white at 75% of full
+// The reference lighting: ambient 10% of the white level and white at 75% of full
 // scale, on the median lit pixel of `camera`. The scene's ambient line must read
 // "ambient = <ambient_text>"; "exposure = E" is added after `exposure_marker`, a
 // line of every camera block.

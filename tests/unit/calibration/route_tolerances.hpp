@@ -1,5 +1,5 @@
 #pragma once
-// The route (a) tolerances for a calibrated projector against the truth:
+// Route (a) accuracy bounds for a calibrated projector against the truth:
 // focal 0.5%, principal point 2 px, position 2 mm, rotation 0.05 degrees.
 #include <gtest/gtest.h>
 

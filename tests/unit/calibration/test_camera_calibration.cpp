@@ -38,7 +38,7 @@ TEST(Board, ParsesTheCommandLineForms) {
     EXPECT_EQ(parseBoard(bad).error().code, ErrorCode::kParse) << bad;
 }
 
-// The issue: camera calibration from 15 rendered checkerboard views, focal within 0.3%.
+// Camera calibration from 15 rendered checkerboard views: focal within 0.3%.
 TEST(CameraCalibration, FifteenCheckerboardViews) {
   const auto spec = *parseBoard("checker:9x6:0.03");
   const auto board = checkerImage(spec);

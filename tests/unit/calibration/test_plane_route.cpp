@@ -45,7 +45,7 @@ std::vector<PlaneView> twoOrientations(double sigma) {
 
 }  // namespace
 
-// The intrinsics tolerances for route (b): focal 0.5%, principal point 2 px
+// The intrinsics accuracy bounds for route (b): focal 0.5%, principal point 2 px
 // (c_x is the assumed image centre, exact for this projector).
 TEST(RouteB, TwoPlaneOrientationsGiveTheIntrinsics) {
   const auto projector = procam::testing::squarePixelProjector();

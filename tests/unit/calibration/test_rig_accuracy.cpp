@@ -1,7 +1,8 @@
-// The issue's accuracy requirements on the virtual rig: camera read noise 1 DN on
-// 8-bit captures, projector gamma 2.2, ambient light 10% of the white level. The
+// Calibration accuracy on the virtual rig under the reference capture conditions:
+// camera read noise 1 DN on 8-bit captures, projector gamma 2.2, ambient light 10% of
+// the white level. The
 // shipped scenes are used at half resolution (intrinsics scaled) to keep the
-// rendering to seconds; tolerances are the issue's.
+// rendering to seconds; tolerances are procamd's calibration accuracy bounds.
 #include <gtest/gtest.h>
 
 #include "calibration/projector_calibration.hpp"
@@ -244,7 +245,7 @@ TEST(RigAccuracy, WallObliqueCoplanarAndRouteB) {
 // The projector at its full 1280x800 and the cameras at 1/2 and 1/4 of 1024x768: one
 // camera pixel spans ~3.3 and ~6.6 projector pixels, so neighbouring camera pixels
 // decode several projector pixels apart. Route (a) as shipped (Gray + 3-phase, nodes
-// every 8 projector pixels) with the issue's tolerances: focal 0.5%, principal point
+// every 8 projector pixels) with route (a)'s accuracy bounds: focal 0.5%, principal point
 // 2 px, position 2 mm, rotation 0.05 degrees, reprojection RMS <= 0.15 px. Most lit
 // pixels must decode (a neighbour test in projector pixels would drop them all).
 TEST(RigAccuracy, CornerStereoRouteACoarseCameras) {
@@ -262,7 +263,7 @@ TEST(RigAccuracy, CornerStereoRouteACoarseCameras) {
       ASSERT_TRUE(d);
       const AxisError e = correspondenceError(scene, names[i], *d);
       EXPECT_GT(e.pixels, 0.9 * e.lit) << names[i] << " at " << camera_scale;
-      // Gray + phase <= 0.1 projector px (the issue's) where a camera pixel spans
+      // Gray + phase <= 0.1 projector px (the decoding bound) where a camera pixel spans
       // ~3 projector pixels; at 1/4 the camera's own noise spans twice the
       // projector pixels, so 0.2.
       EXPECT_LE(e.rms, camera_scale == 0.5 ? 0.1 : 0.2) << names[i] << " at " << camera_scale;
@@ -290,7 +291,7 @@ TEST(RigAccuracy, CornerStereoRouteACoarseCameras) {
 // projector pixels, so the finest one or two Gray bits (stripes of 1 and 2 cells)
 // blur out and the oblique left camera decodes to blocks of 2 or 4 cells. Most lit
 // pixels still decode; the error is bounded by the uniform error over a block of 4,
-// 4 / sqrt(12) = 1.15 projector px RMS, not the issue's 0.5 (which needs a camera
+// 4 / sqrt(12) = 1.15 projector px RMS, not the Gray-code bound of 0.5 (which needs a camera
 // pixel no wider than a cell).
 TEST(RigAccuracy, GrayAloneCoarseCameraDecodesToBlocks) {
   const sim::Scene scene = parse(procam::testing::issueCornerStereo(1.0, 0.5));

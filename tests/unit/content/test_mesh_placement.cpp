@@ -77,7 +77,7 @@ TEST(MeshPlacement, BoxStandsOnTheWallCentredOnSAndShaded) {
     }
   }
   EXPECT_EQ(front, 2);
-  // Points on the wall appear where the projector lights them (seed §4.2.1: the
+  // Points on the wall appear where the projector lights them ([Raskar02] §4.2.1: the
   // viewer's ray meets the wall at the point itself).
   for (const Vec3& p : placed->mesh.vertices) {
     if (std::abs(p.y() - 3) > 1e-12) continue;
@@ -92,7 +92,7 @@ TEST(MeshPlacement, BoxStandsOnTheWallCentredOnSAndShaded) {
 
 // The view-dependent part for a moved viewer: a point of the placed mesh (off the wall)
 // lands on the projector pixel that lights the wall where the new viewer's ray through
-// it meets the wall (seed §4.2.1), inside the depth range; a viewer behind the wall is
+// it meets the wall ([Raskar02] §4.2.1), inside the depth range; a viewer behind the wall is
 // refused.
 TEST(MeshPlacement, Planar3dForAMovedViewerFollowsTheirRays) {
   PlanarView view = wallView();

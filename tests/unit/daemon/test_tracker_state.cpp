@@ -1,5 +1,5 @@
 // Tracker registrations in the daemon: the `tracker register` request fitted
-// (seed eq. 4.2, §4.2.5), its typed errors, and tracker.json round trips.
+// ([Raskar02] eq. 4.2, §4.2.5), its typed errors, and tracker.json round trips.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>

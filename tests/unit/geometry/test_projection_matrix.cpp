@@ -90,7 +90,7 @@ TEST(ProjectionMatrix, DecomposeRejectsCameraAtInfinity) {
 TEST(ProjectionMatrix, CoplanarPointsAreATypedErrorWithAdvice) {
   const CameraModel cam = testing::makeCamera({1, -5, 1.5}, {0, 0, 1});
   std::mt19937_64 rng(4);
-  // Seed §4.1.1: one wall alone cannot calibrate. Exactly planar, and planar within
+  // [Raskar02] §4.1.1: one wall alone cannot calibrate. Exactly planar, and planar within
   // 1e-4 of the extent (below ProjectionOptions::coplanar_ratio = 1e-3).
   for (double thickness : {0.0, 2e-4}) {
     const Points3 X = boxPoints(40, {0, 0, 1}, {1.5, thickness, 1.0}, rng);

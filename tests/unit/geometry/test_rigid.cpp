@@ -1,5 +1,5 @@
 // Tests for pipelines/geometry/rigid: transforms recovered from exact and noisy
-// correspondences (seed eq. 4.2), and typed errors for degenerate sets.
+// correspondences ([Raskar02] eq. 4.2), and typed errors for degenerate sets.
 #include <gtest/gtest.h>
 
 #include <cmath>

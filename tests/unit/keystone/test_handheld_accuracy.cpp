@@ -1,9 +1,10 @@
-// Accuracy on the virtual rig's `handheld` scene (issue: self-correcting handheld
-// projector). The projector is rescaled to 1920x1080 (same field of view) because the
-// tolerances are stated in pixels at that resolution. The hand trajectory is played
-// as 10 s holds at each keyframe pose, since the tolerances apply "once settled"
-// (the filter's still mean then spans 8 s: white noise of 400 ug/sqrt(Hz) averages to
-// ~0.1 mg, i.e. ~0.1 mrad, ~0.3 px at the corners of this 2100 px lens). The
+// Accuracy on the virtual rig's `handheld` scene (a self-correcting handheld projector,
+// [Raskar02] §3.2.5, §6.2.2). The projector is rescaled to 1920x1080 (same field of
+// view) because the keystone accuracy bounds are stated in pixels at that resolution.
+// The hand trajectory is played as 10 s holds at each keyframe pose, since the bounds
+// apply once the projector has settled (the filter's still mean then spans 8 s: white
+// noise of 400 ug/sqrt(Hz) averages to ~0.1 mg, i.e. ~0.1 mrad, ~0.3 px at the corners
+// of this 2100 px lens). The
 // accelerometer is the scene's MPU-6050-like model (400 ug/sqrt(Hz), 50 mg bias),
 // calibrated by six still positions; the filter is the 10 Hz TiltFilter.
 //

@@ -1,5 +1,5 @@
 #pragma once
-// Random scenes for the planar 3D path (seed §4.2.2-4.2.3, eq. 4.10): an oblique projector
+// Random scenes for the planar 3D path ([Raskar02] §4.2.2-4.2.3, eq. 4.10): an oblique projector
 // lighting a wall, a tracked viewer in front of it, S bounding the projector's image and
 // A'4x4 P_T in this project's pixel convention.
 #include <optional>

@@ -1,5 +1,5 @@
 // The GLES 3 back-end on Mesa's surfaceless EGL against the CPU reference on the same
-// inputs (issue: mean abs difference <= 1/255 and PSNR >= 45 dB away from borders).
+// inputs (bound: mean abs difference <= 1/255 and PSNR >= 45 dB away from borders).
 #include <gtest/gtest.h>
 
 #include <opencv2/imgcodecs.hpp>

@@ -1,11 +1,11 @@
-// The CPU back-end of the planar 3D path (A'4x4 P_T, seed §4.2.2-4.2.3) against a
+// The CPU back-end of the planar 3D path (A'4x4 P_T, [Raskar02] §4.2.2-4.2.3) against a
 // double-precision ray-cast reference on random planar scenes, and against the GLES
 // back-end on a cube.
 //
 // Comparisons skip a 1 px band around every place where the visible triangle changes
 // (triangle edges, clipping boundaries, intersections) and the image border: two correct
 // rasterizers may disagree by one pixel on edges (GL snaps vertices to a sub-pixel grid,
-// the CPU keeps doubles), and both the GL-vs-CPU figures and the coverage check
+// the CPU keeps doubles), and both the GL-vs-CPU bounds and the coverage check
 // are about the interiors.
 #include <gtest/gtest.h>
 
@@ -30,7 +30,7 @@ struct Reference {
 };
 
 // The pixel's ray meets the wall at Wp; the viewer sees there whatever its ray eye -> Wp
-// meets first (seed §4.2.1). A hit counts only inside A'P_T's clip volume, evaluated in
+// meets first ([Raskar02] §4.2.1). A hit counts only inside A'P_T's clip volume, evaluated in
 // double; colours are the world-space barycentric blend at the hit (perspective-correct).
 Reference referenceRender(const test::Planar3dScene& s, const ColoredMesh& mesh, cv::Size size) {
   Reference r{cv::Mat(size, CV_32S, cv::Scalar(-1)), cv::Mat(size, CV_8UC4, cv::Scalar::all(0))};

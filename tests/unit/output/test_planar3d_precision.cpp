@@ -1,6 +1,6 @@
-// The planar 3D path (seed §4.2.2-4.2.3, eq. 4.10): A'4x4 P_T evaluated by GL in float32
+// The planar 3D path ([Raskar02] §4.2.2-4.2.3, eq. 4.10): A'4x4 P_T evaluated by GL in float32
 // against double-precision geometry, for random oblique projectors and tracked viewers.
-// Issue: no clipped geometry, visibility order preserved, pixel error <= 0.05 px.
+// Bounds: no clipped geometry, visibility order preserved, pixel error <= 0.05 px.
 #include <gtest/gtest.h>
 
 #include <random>

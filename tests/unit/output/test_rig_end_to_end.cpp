@@ -1,7 +1,8 @@
 // End to end on the virtual rig with the mock output (CPU renderer):
 //  - wall_oblique: the keystone pre-warp (homography path) makes the content appear on
 //    the wall as an upright rectangle of the content's aspect, seen by the rig's camera
-//    (keystone issue: corner error <= 0.5 projector px at 1920x1080, aspect within 0.1%);
+//    (keystone accuracy bounds: corner error <= 0.5 projector px at 1920x1080, aspect
+//    within 0.1%);
 //  - dome3, one projector, static viewer: the two-pass projective texture over a surface
 //    mesh; the viewer perceives the content with <= 0.5 px geometric error.
 // Features are Gaussian blobs whose centroids are measured in the rendered images.

@@ -1,6 +1,6 @@
 #pragma once
 // Pinhole matrices and surfaces for render tests, built independently of the code under
-// test (frames per DESIGN.md: x right, y down, z forward; P = K [R | t]).
+// test (frames per ARCHITECTURE.md: x right, y down, z forward; P = K [R | t]).
 #include <cmath>
 #include <optional>
 

@@ -1,4 +1,4 @@
-// Alpha mask with the weight LUT (seed §4.1.2) and the output LUT.
+// Alpha mask with the weight LUT ([Raskar02] §4.1.2) and the output LUT.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -18,7 +18,7 @@ inline std::filesystem::path scenePath(const std::string& name) {
   return sourceDir() / "tests" / "scenes" / (name + ".toml");
 }
 
-// The shipped scenes the issue asks for.
+// The shipped scenes (tests/scenes), each a case of [Raskar02]'s rendering-path table.
 inline const char* const kShippedScenes[] = {"wall_oblique", "corner_stereo", "handheld", "dome3",
                                              "object_box"};
 

@@ -1,6 +1,6 @@
 // A checkerboard shown by the wall_oblique projector, seen by its camera with noise
 // off: the detected inner corners must land where analytic projection puts them
-// (issue 2: within 0.05 px).
+// (the simulator's geometric fidelity bound: within 0.05 px).
 #include <gtest/gtest.h>
 
 #include <cmath>

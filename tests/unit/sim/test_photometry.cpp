@@ -115,7 +115,8 @@ INSTANTIATE_TEST_SUITE_P(BitsAndGamma, SimResponse,
                                             ::testing::Values(1.0, 2.2)));
 
 // Noise on (linear camera): per flat patch the mean code and the standard deviation
-// about the exact per-pixel mean match the model within 5% (issue 2):
+// about the exact per-pixel mean match the model within 5% (the simulator's noise
+// fidelity bound):
 // sigma^2 = gain * mu / (electrons per DN) + read^2 + 1/12 (quantisation).
 TEST(SimPhotometry, NoiseMeanAndSigmaMatchTheScene) {
   const double gain = 1.5, full_well = 20000, read = 3.0;

@@ -90,7 +90,8 @@ TEST(SimTilt, AccelerometerReportsGravityReactionInItsMountedFrame) {
   EXPECT_TRUE(roll->truth.isApprox(Vec3(-g * std::sin(r), 0, g * std::cos(r)), 1e-12));
 }
 
-// White noise sigma = density * sqrt(rate / 2) per axis, within 5% (issue 2),
+// White noise sigma = density * sqrt(rate / 2) per axis, within 5% (the simulator's
+// noise fidelity bound),
 // zero mean after the bias; samples repeat exactly for the same seed.
 TEST(SimTilt, NoiseMatchesTheNoiseDensity) {
   auto scene = resolveScene("handheld");

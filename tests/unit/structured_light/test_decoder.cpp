@@ -46,7 +46,7 @@ ErrorStats compare(const Decoded& d, const ViewModel& m) {
       s.max = std::max({s.max, std::abs(eu), std::abs(ev)});
       ++n;
     }
-  // Per-axis RMS (the "projector px RMS" of one coordinate).
+  // Per-axis RMS (the "projector px RMS" of the decoding bounds, one coordinate).
   s.rms = n ? std::sqrt(sum / (2.0 * n)) : 1e9;
   s.decoded_fraction = static_cast<double>(n) / d.u.total();
   EXPECT_EQ(n, d.decoded);
@@ -88,7 +88,7 @@ TEST(Decoder, GrayNoiselessDecodesEveryPixelWithinOneCell) {
   EXPECT_LE(s.rms, 0.5);
 }
 
-// The conditions: read noise 1 DN on 8 bits, gamma 2.2, ambient 10%, plus a
+// The reference capture conditions: read noise 1 DN on 8 bits, gamma 2.2, ambient 10%, plus a
 // mild defocus. Gray alone: <= 0.5 px RMS.
 TEST(Decoder, GrayMeetsHalfPixelUnderGammaAmbientNoiseDefocus) {
   for (double camera_gamma : {1.0, 2.2}) {

@@ -1,5 +1,6 @@
 // The adaptive scan and the AprilTag grid on views rendered by the virtual rig
-// (drivers/sim), the camera (8 bits, read noise 1 DN, ambient 10%).
+// (drivers/sim), under the reference capture conditions (8 bits, read noise 1 DN,
+// ambient 10%).
 #include <gtest/gtest.h>
 
 #include <set>

@@ -2,7 +2,8 @@
 // synthesized here: gray8 PNGs of Gaussian LED blobs rendered from a known head
 // trajectory (LEDs 6 cm apart at 2 m, blob centres jittered by 0.1 px; f = 4000 px, the
 // lens positionCovariance's bound asks for, see unit/tracking/led_trajectory.hpp).
-// Issue 7: position <= 2 mm RMS, filtered latency within one frame of the raw signal.
+// Head-tracking bounds: position <= 2 mm RMS, filtered latency within one frame of the raw
+// signal.
 #include <gtest/gtest.h>
 #include <unistd.h>
 

@@ -3,7 +3,7 @@
 // the setup handshake with a fake Wii Remote, then every report through the plugin's
 // read(). The reports' 10-bit grid is the only error: uniform quantisation,
 // sigma = 1/sqrt(12) px per coordinate, so the raw position's error is bounded by
-// positionCovariance at that sigma (first order, issue 7).
+// positionCovariance at that sigma (first order).
 #include <gtest/gtest.h>
 
 #include <cmath>

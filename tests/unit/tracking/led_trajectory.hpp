@@ -1,5 +1,5 @@
 #pragma once
-// Synthetic head trajectory for the LED tracker's tests and bench (issue 7): a cap
+// Synthetic head trajectory for the LED tracker's tests and bench: a cap
 // constellation with LEDs ~6 cm apart, 2 m in front of one camera, swaying and turning.
 // Camera f = 4000 px on a 1280x1024 sensor: positionCovariance's bound for this layout
 // at 2 m with 0.1 px blob noise is below 1.5 mm there, and above 2 mm at f = 1000 px

@@ -1,5 +1,5 @@
 // Tests for pipelines/tracking/constellation_pose and stereo_position on synthetic
-// views: LEDs about 6 cm apart at 2 m, blob noise 0.1 px (issue 7: <= 2 mm RMS).
+// views: LEDs about 6 cm apart at 2 m, blob noise 0.1 px (bound: <= 2 mm RMS).
 //
 // Theoretical bound (first order, positionCovariance): depth from one camera comes
 // from the constellation's apparent size, sigma_z ~ z^2 sigma_px / (f r sqrt(n)),
@@ -69,7 +69,7 @@ double singleCameraBound(double f) {
   return std::sqrt(positionCovariance(cam.K, head_in_cam, kLeds, 0.1).trace());
 }
 
-// Issue 7's budget (<= 2 mm RMS) and agreement of the reported covariance with the
+// The head-position bound (<= 2 mm RMS) and agreement of the reported covariance with the
 // observed scatter (>= 60 trials: the RMS is known to ~10 %, so +-30 %).
 void expectWithinBudget(double sum_sq, double sum_trace, int trials) {
   const double rms = std::sqrt(sum_sq / trials), predicted = std::sqrt(sum_trace / trials);

@@ -1,6 +1,6 @@
 // Tests for pipelines/tracking/led_tracker against a ground-truth head trajectory:
 // LEDs 6 cm apart at 2 m, blob noise 0.1 px -> position <= 2 mm RMS, filtered lag
-// within one frame of the raw signal (issue 7).
+// within one frame of the raw signal.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -1,5 +1,5 @@
 // Tests for pipelines/tracking/motion_filter: noise reduction, lag within one frame of
-// the raw signal (issue 7) and prediction by the display latency.
+// the raw signal and prediction by the display latency.
 #include <gtest/gtest.h>
 
 #include <cmath>

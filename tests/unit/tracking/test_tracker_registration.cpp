@@ -1,5 +1,5 @@
 // Tests for pipelines/tracking/tracker_registration: tracker -> world from 6 measured
-// points (issue 7: <= 1 mm), the screen-defined frame of seed §4.2.5, typed errors.
+// points (<= 1 mm RMS), the screen-defined frame of [Raskar02] §4.2.5, typed errors.
 #include <gtest/gtest.h>
 
 #include <cmath>
