@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 
+#include "core/units.hpp"
 #include "keystone/keystone_solver.hpp"
 #include "state_file.hpp"
 
@@ -38,7 +39,7 @@ Result<TiltMount> mountFromConfig(const KeystoneConfig& config) {
 Result<TiltTracker> TiltTracker::create(const KeystoneConfig& config, TiltMount mount) {
   keystone::TiltFilterOptions o;
   o.cutoff_hz = config.cutoff_hz;
-  o.hysteresis = config.hysteresis_deg * std::numbers::pi / 180.0;
+  o.hysteresis = degToRad(config.hysteresis_deg);
   auto filter = keystone::TiltFilter::create(o);
   if (!filter) return tl::unexpected(filter.error());
   return TiltTracker(std::move(*filter), std::move(mount));

@@ -17,7 +17,7 @@
 
 #include "event_loop.hpp"
 #include "protocol.hpp"
-#include "unique_fd.hpp"
+#include "core/unique_fd.hpp"
 
 namespace procam::daemon {
 

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "core/error.hpp"
-#include "unique_fd.hpp"
+#include "core/unique_fd.hpp"
 
 namespace procam::daemon {
 

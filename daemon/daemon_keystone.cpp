@@ -6,6 +6,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "core/units.hpp"
 #include "daemon.hpp"
 #include "geometry/homography.hpp"
 #include "log.hpp"
@@ -17,8 +18,6 @@ using nlohmann::json;
 namespace code = proto::code;
 
 namespace {
-
-constexpr double kDeg = 180.0 / std::numbers::pi;
 
 json quadJson(const std::array<Vec2, 4>& q) {
   json a = json::array();
@@ -276,8 +275,8 @@ json Daemon::keystoneJson() const {
   }
   if (k.estimate) {
     const auto& e = *k.estimate;
-    j["estimate"] = {{"pitch_deg", e.angles.pitch * kDeg},
-                     {"roll_deg", e.angles.roll * kDeg},
+    j["estimate"] = {{"pitch_deg", radToDeg(e.angles.pitch)},
+                     {"roll_deg", radToDeg(e.angles.roll)},
                      {"down", {e.down.x(), e.down.y(), e.down.z()}},
                      {"scale", e.scale},
                      {"sample_time", e.sample_time},

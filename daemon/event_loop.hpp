@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "core/error.hpp"
-#include "unique_fd.hpp"
+#include "core/unique_fd.hpp"
 
 namespace procam::daemon {
 

@@ -18,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "core/units.hpp"
 #include "demo/child_process.hpp"
 #include "keystone/display_error.hpp"
 #include "keystone/keystone_solver.hpp"
@@ -29,11 +30,11 @@ namespace {
 
 using nlohmann::json;
 using procam::Mat3;
+using procam::radToDeg;
 using procam::Vec2;
 namespace demo = procam::demo;
 namespace keystone = procam::keystone;
 namespace sim = procam::sim;
-constexpr double kDeg = 180.0 / 3.14159265358979323846;
 
 struct Options {
   std::string scene = "handheld";
@@ -254,9 +255,10 @@ int main(int argc, char** argv) {
     }
     last_printed = t;
     std::printf("%7.2f %6s | %7.2f %7.2f %6.1f | %7.2f %7.2f | %9.3f %8.4f %7.4f | %9.2f\n", t,
-                still ? "yes" : "no", truth.pitch * kDeg, truth.roll * kDeg, truth.yaw * kDeg,
-                e["estimate"]["pitch_deg"].get<double>(), e["estimate"]["roll_deg"].get<double>(),
-                tilt.corner_px, tilt.aspect_pct, tilt.area_pct, full.corner_px);
+                still ? "yes" : "no", radToDeg(truth.pitch), radToDeg(truth.roll),
+                radToDeg(truth.yaw), e["estimate"]["pitch_deg"].get<double>(),
+                e["estimate"]["roll_deg"].get<double>(), tilt.corner_px, tilt.aspect_pct,
+                tilt.area_pct, full.corner_px);
     std::fflush(stdout);
   }
   watch->stop();

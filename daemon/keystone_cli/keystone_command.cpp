@@ -7,6 +7,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "core/units.hpp"
 #include "keystone/orientation.hpp"
 
 namespace procam::keystone_cli {
@@ -166,11 +167,11 @@ Result<SolveArgs> parseSolveArgs(const std::vector<std::string>& args) {
       p.content_width = std::max(1, int(std::lround(p.height * a)));
     }
   }
-  constexpr double kDeg = std::numbers::pi / 180;
   auto vec = [](const std::vector<double>& v) { return Vec3(v[0], v[1], v[2]); };
   Result<Mat3> R;
   if (angles) {
-    R = keystone::rotationFromAngles({*pitch * kDeg, *roll * kDeg, yaw.value_or(0) * kDeg});
+    R = keystone::rotationFromAngles(
+        {degToRad(*pitch), degToRad(*roll), degToRad(yaw.value_or(0))});
   } else if (down && normal) {
     auto fused = keystone::fuseOrientation(vec(*down), vec(*normal));
     if (fused)

@@ -8,7 +8,7 @@
 
 #include "protocol.hpp"
 #include "tl/expected.hpp"
-#include "unique_fd.hpp"
+#include "core/unique_fd.hpp"
 
 namespace procam::ctl {
 

@@ -8,11 +8,11 @@
 #include <cerrno>
 #include <cstring>
 
-#include "unique_fd.hpp"  // daemon/, header only
+#include "core/unique_fd.hpp"
 
 namespace procam::content {
 
-using daemon::UniqueFd;
+using procam::UniqueFd;
 
 namespace {
 

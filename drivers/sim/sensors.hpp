@@ -12,11 +12,12 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/units.hpp"
 #include "sim/scene.hpp"
 
 namespace procam::sim {
 
-inline constexpr double kStandardGravity = 9.80665;  // m/s^2
+using procam::kStandardGravity;  // core/units.hpp
 
 struct TiltSample {
   double time = 0;

@@ -8,10 +8,11 @@
 
 #include "core/error.hpp"
 #include "core/types.hpp"
+#include "core/units.hpp"
 
 namespace procam::tilt {
 
-constexpr double kStandardGravity = 9.80665;  // m/s^2 per g
+using procam::kStandardGravity;  // core/units.hpp
 
 struct TiltSample {
   Vec3 specific_force = Vec3::Zero();  // m/s^2, sensor frame

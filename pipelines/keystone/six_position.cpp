@@ -1,7 +1,8 @@
 #include "keystone/six_position.hpp"
 
 #include <cmath>
-#include <numbers>
+
+#include "core/units.hpp"
 
 namespace procam::keystone {
 
@@ -16,7 +17,7 @@ Result<std::string> SixPositionCollector::add(const Vec3& mean_g) {
   Eigen::Index axis = 0;
   mean_g.cwiseAbs().maxCoeff(&axis);
   const Vec3 u = mean_g.normalized();
-  if (std::abs(u[axis]) < std::cos(10.0 * std::numbers::pi / 180.0)) {
+  if (std::abs(u[axis]) < std::cos(degToRad(10.0))) {
     return fail(ErrorCode::kInvalidInput,
                 "no sensor axis is within 10 degrees of vertical: hold one straight up or down");
   }

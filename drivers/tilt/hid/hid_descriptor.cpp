@@ -3,13 +3,14 @@
 #include <cmath>
 #include <map>
 
+#include "core/units.hpp"
+
 namespace procam::tilt {
 namespace {
 
 constexpr std::uint16_t kSensorPage = 0x20;
 constexpr std::uint16_t kAccelerometer3D = 0x73;
 constexpr std::uint16_t kAxisUsage[3] = {0x453, 0x454, 0x455};
-constexpr double kStandardGravity = 9.80665;
 
 struct Globals {
   std::uint16_t usage_page = 0;

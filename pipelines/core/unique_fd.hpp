@@ -1,10 +1,11 @@
 #pragma once
-// Owning file descriptor.
+// Owning file descriptor: closed exactly once, by its last owner (RAII for every
+// device and socket handle, CODING-STYLE.md).
 #include <unistd.h>
 
 #include <utility>
 
-namespace procam::daemon {
+namespace procam {
 
 class UniqueFd {
  public:
@@ -31,4 +32,8 @@ class UniqueFd {
   int fd_ = -1;
 };
 
+}  // namespace procam
+
+namespace procam::daemon {
+using procam::UniqueFd;
 }  // namespace procam::daemon
