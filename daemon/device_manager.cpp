@@ -58,11 +58,13 @@ DeviceManager::DeviceManager(EventLoop& loop, const plugins::DriverRegistry& reg
       emit_(std::move(emit)),
       warn_(std::move(warn)),
       opener_(std::make_unique<WorkerPool>(loop, 1)),
-      reader_(std::make_unique<WorkerPool>(loop, 1)) {}
+      reader_(std::make_unique<WorkerPool>(loop, 1)),
+      closer_(std::make_unique<WorkerPool>(loop, 1)) {}
 
 DeviceManager::~DeviceManager() {
   opener_.reset();
   reader_.reset();  // a read still running ends first; its result is dropped
+  closer_.reset();  // a release still running ends first
   *alive_ = false;
   for (const auto& [name, fd] : watched_) loop_.remove(fd);
   for (const auto& [id, name] : polls_) loop_.removeTimer(id);
@@ -103,6 +105,7 @@ void DeviceManager::setReadGate(std::function<bool(const std::string&)> may_read
 // --- start-up and hotplug ---
 
 void DeviceManager::start(const DeviceManagerOptions& options) {
+  presence_interval_ = options.presence_interval;
   for (const auto& e : devices_.entries()) watchFd(e);
   if (options.udev) {
     auto udev = Udev::create();
@@ -188,7 +191,11 @@ void DeviceManager::openDiscovered(plugins::DeviceDescription desc, bool async) 
     auto entry =
         std::make_shared<DeviceEntry>(DeviceSet::prepare(registry_, std::move(desc), "", {}));
     return guarded([this, entry, syspath] {
-      if (pending_.erase(syspath) == 0) return;  // unplugged while opening
+      if (pending_.erase(syspath) == 0) {  // unplugged while opening
+        retire(entry->device.share());
+        entry->device.reset();
+        return;
+      }
       addDiscovered(std::move(*entry));
     });
   });
@@ -218,7 +225,9 @@ void DeviceManager::removeUnplugged(const std::string& name) {
   if (!e) return;
   json body = e->toJson();
   body["state"] = "removed";
+  retire(e->device.share());
   e->device.reset();  // the set's reference; a worker's share ends with its job
+  last_frame_.erase(name);
   e->error = "unplugged";
   logInfo("unplugged: " + describeFamily(*e));
   removed(name);
@@ -245,6 +254,7 @@ void DeviceManager::markLost(const std::string& name, const std::string& reason)
   unwatchFd(name);
   DeviceEntry* e = devices_.find(name);
   if (!e) return;
+  retire(e->device.share());
   e->device.reset();
   e->lost = true;
   e->retries = 0;
@@ -262,6 +272,7 @@ void DeviceManager::markEnded(const std::string& name, const std::string& reason
   unwatchFd(name);
   DeviceEntry* e = devices_.find(name);
   if (!e) return;
+  retire(e->device.share());
   e->device.reset();
   e->ended = true;
   e->error = "ended: " + reason;
@@ -309,7 +320,11 @@ void DeviceManager::retry(const std::string& name, uint64_t token) {
 void DeviceManager::finishRetry(const std::string& name, uint64_t token, DeviceEntry fresh) {
   DeviceEntry* e = devices_.find(name);
   auto it = retries_.find(name);
-  if (!e || !e->lost || it == retries_.end() || it->second.token != token) return;
+  if (!e || !e->lost || it == retries_.end() || it->second.token != token) {
+    retire(fresh.device.share());  // a stale attempt that opened after all
+    fresh.device.reset();
+    return;
+  }
   if (!fresh.usable()) {
     ++e->retries;
     e->error = "lost: " + fresh.error;
@@ -410,23 +425,57 @@ bool DeviceManager::readEntry(const std::string& name) {
   return false;
 }
 
-void DeviceManager::startRead(DeviceEntry& e) {
+DeviceManager::ReadResult DeviceManager::checkOnce(const procam_device& raw) {
+  ReadResult r;
+  std::array<char, 512> err{};
+  r.rc = raw.ops.camera->check(raw.self, err.data(), err.size() - 1);
+  if (r.rc != PROCAM_OK) {
+    r.reason = err[0] ? err.data() : "liveness check failed (code " + std::to_string(r.rc) + ")";
+  }
+  return r;
+}
+
+void DeviceManager::checkCamera(const std::string& name) {
+  DeviceEntry* e = devices_.find(name);
+  if (!e || !e->usable() || reading_.count(name) || !gateOpen(name)) return;
+  const procam_device& raw = e->device.raw();
+  if (raw.ops.camera && raw.ops.camera->check) {
+    startRead(*e, true);
+  } else {
+    readEntry(name);
+  }
+}
+
+void DeviceManager::startRead(DeviceEntry& e, bool check_only) {
   const std::string name = e.name;
   auto ticket = std::make_shared<ReadTicket>();
   reading_[name] = ticket;
   unwatchFd(name);
   // The worker's share keeps the device alive if the loop closes it meanwhile.
-  reader_->submit([this, name, ticket, device = e.device.share(),
-                   family = e.description.family]() -> WorkerPool::Completion {
+  reader_->submit([this, name, ticket, device = e.device.share(), family = e.description.family,
+                   check_only]() -> WorkerPool::Completion {
     auto result = std::make_shared<ReadResult>();
     if (ticket->begin()) {
-      *result = readOnce(device->raw(), family);
+      *result = check_only ? checkOnce(device->raw()) : readOnce(device->raw(), family);
       ticket->end();
     } else {
       result->withdrawn = true;
     }
-    return guarded(
-        [this, name, ticket, device, result] { finishRead(name, ticket, device, *result); });
+    return guarded([this, name, ticket, device, result, check_only]() mutable {
+      // A passed check carries no reading: nothing to deliver.
+      if (check_only && result->rc == PROCAM_OK) result->withdrawn = true;
+      finishRead(name, ticket, device, *result);
+      // Closed meanwhile (lost, unplugged), this may be the last reference.
+      retire(std::move(device));
+    });
+  });
+}
+
+void DeviceManager::retire(std::shared_ptr<plugins::Device> device) {
+  if (!device) return;
+  closer_->submit([device = std::move(device)]() mutable -> WorkerPool::Completion {
+    device.reset();
+    return {};
   });
 }
 
@@ -457,6 +506,9 @@ bool DeviceManager::deliver(const std::string& name, const ReadResult& result) {
   }
   const DeviceEntry* e = devices_.find(name);
   if (!e) return false;
+  if (std::holds_alternative<CameraFrame>(result.reading)) {
+    last_frame_[name] = std::chrono::steady_clock::now();
+  }
   // Hooks may change the set: hand them a copy of the list and look nothing up after.
   const auto hooks = on_reading_;
   for (const auto& h : hooks) h(*e, result.reading);
@@ -495,15 +547,11 @@ void DeviceManager::presenceCheck() {
     if (e) watchFd(*e);
     it = gated_.erase(it);
   }
-  std::vector<std::string> names, cameras;
+  std::vector<std::string> names;
   for (const auto& e : devices_.entries()) {
     const auto family = e.description.family;
-    if (!e.usable() || family == PROCAM_FAMILY_OUTPUT || watched_.count(e.name) ||
-        gated_.count(e.name) || reading_.count(e.name)) {
-      continue;
-    }
-    if (family == PROCAM_FAMILY_CAMERA) {
-      cameras.push_back(e.name);
+    if (!e.usable() || family == PROCAM_FAMILY_OUTPUT || family == PROCAM_FAMILY_CAMERA ||
+        watched_.count(e.name) || gated_.count(e.name) || reading_.count(e.name)) {
       continue;
     }
     bool polled = false;
@@ -511,19 +559,29 @@ void DeviceManager::presenceCheck() {
     if (!polled) names.push_back(e.name);
   }
   for (const auto& n : names) readEntry(n);
-  for (const auto& n : cameras) checkCameraPresence(n);
+  // A capture is the only call every camera driver answers with PROCAM_ENODEV
+  // once the camera is gone (a format is answered from memory). A camera that
+  // delivers frames anyway needs no extra one.
+  for (const auto& n : silentCameras()) checkCamera(n);
 }
 
-void DeviceManager::checkCameraPresence(const std::string& name) {
-  DeviceEntry* e = devices_.find(name);
-  // A capture on the reader worker is a presence check of its own.
-  if (!e || !e->usable() || !gateOpen(name) || reading_.count(name)) return;
-  const procam_device& raw = e->device.raw();
-  uint32_t w = 0, h = 0;
-  procam_pixel_format format{};
-  if (int rc = raw.ops.camera->get_format(raw.self, &w, &h, &format); rc == PROCAM_ENODEV) {
-    report(name, rc, "the camera is gone (no format)");
+std::vector<std::string> DeviceManager::silentCameras() const {
+  const auto now = std::chrono::steady_clock::now();
+  // Half the interval: a camera captured by the previous check delivered its
+  // frame just under one interval ago and is due again now.
+  const auto recent = presence_interval_ / 2;
+  std::vector<std::string> due;
+  for (const auto& e : devices_.entries()) {
+    if (e.description.family != PROCAM_FAMILY_CAMERA || !e.usable() || gated_.count(e.name) ||
+        reading_.count(e.name) || !gateOpen(e.name)) {
+      continue;
+    }
+    if (auto it = last_frame_.find(e.name); it != last_frame_.end() && now - it->second < recent) {
+      continue;
+    }
+    due.push_back(e.name);
   }
+  return due;
 }
 
 void DeviceManager::added(const std::string& name) {

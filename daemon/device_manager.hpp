@@ -3,11 +3,12 @@
 // hotplug through a udev monitor watched by the event loop, watches device
 // fds, and closes devices that fail with PROCAM_ENODEV ("lost") and reopens
 // them with back-off. Every method runs on the loop thread; driver create()
-// calls for hotplugged and lost devices run on the manager's opener worker and
+// calls for hotplugged and lost devices run on the manager's opener worker,
 // tracker reads and camera captures on its reader worker (a tracker read may
-// detect blobs and search poses for a hundred milliseconds), so neither a slow
-// open nor a slow read blocks the loop. Tilt reads are cheap and stay on the
-// loop.
+// detect blobs and search poses for a hundred milliseconds) and the destroy()
+// of devices it closes on its closer worker (releasing a gone camera can wait
+// out the library's timeouts), so neither a slow open, a slow read nor a slow
+// close blocks the loop. Tilt reads are cheap and stay on the loop.
 #include <chrono>
 #include <functional>
 #include <map>
@@ -48,9 +49,10 @@ struct DeviceManagerOptions {
   // devices are the whole rig).
   bool udev = true;
   // Tilt sensors and trackers without a poll fd that nobody polls are read
-  // this often, so that a device gone without a udev event is noticed;
-  // cameras without one are asked for their format (rendering or grabbing a
-  // frame each second would cost too much).
+  // this often, and every camera that delivered no frame in the last half
+  // interval is captured (on the reader worker), so that a device gone
+  // without a udev event is noticed: a camera's fd may never become readable
+  // again once it is gone, and many cameras have none.
   std::chrono::milliseconds presence_interval{1000};
 };
 
@@ -142,13 +144,23 @@ class DeviceManager {
   };
   // One driver call; on the loop for tilt sensors, on the reader worker otherwise.
   static ReadResult readOnce(const procam_device& raw, procam_family family);
-  void startRead(DeviceEntry& entry);
+  // A camera's liveness check (procam_camera_ops::check) on the reader worker.
+  static ReadResult checkOnce(const procam_device& raw);
+  void startRead(DeviceEntry& entry, bool check_only = false);
+  // The presence check of a camera without recent frames: its driver's check
+  // when it has one, else a capture.
+  void checkCamera(const std::string& name);
   void finishRead(const std::string& name, const std::shared_ptr<ReadTicket>& ticket,
                   const std::shared_ptr<plugins::Device>& device, const ReadResult& result);
   bool deliver(const std::string& name, const ReadResult& result);
   bool gateOpen(const std::string& name) const { return !may_read_ || may_read_(name); }
-  void checkCameraPresence(const std::string& name);
+  // Cameras due for a liveness capture: usable, not being read, gate open, no
+  // frame delivered within the last half presence interval.
+  std::vector<std::string> silentCameras() const;
   void presenceCheck();
+  // Hands a reference to a closed device to the closer worker, so that the
+  // driver's destroy() runs there when it is the last one, not on the loop.
+  void retire(std::shared_ptr<plugins::Device> device);
   void added(const std::string& name);
   void removed(const std::string& name);
   // Posts `fn` to the loop unless the manager was destroyed meanwhile.
@@ -180,12 +192,18 @@ class DeviceManager {
   std::map<std::string, Retry> retries_;
   uint64_t next_token_ = 1;
   int presence_timer_ = -1;
+  std::chrono::milliseconds presence_interval_{1000};
+  // When each camera last delivered a frame (on the loop's clock).
+  std::map<std::string, std::chrono::steady_clock::time_point> last_frame_;
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
   std::unique_ptr<WorkerPool> opener_;  // joined first on destruction
   // One thread: reads of different devices queue behind each other, which
   // costs at most one slow read of latency on two cores and keeps every
   // driver single-threaded.
   std::unique_ptr<WorkerPool> reader_;
+  // One thread for destroy(): a camera released after it died may block for
+  // seconds, which must hold up neither the loop nor the reads of the others.
+  std::unique_ptr<WorkerPool> closer_;
 };
 
 }  // namespace procam::daemon

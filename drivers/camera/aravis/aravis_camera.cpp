@@ -1,7 +1,10 @@
 #include "camera/aravis/aravis_camera.hpp"
 
 #include <arv.h>
+#include <sys/eventfd.h>
+#include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <ctime>
 #include <mutex>
@@ -84,10 +87,6 @@ uint32_t bytesPerPixel(SourceFormat f) {
                                                                  : 3;
 }
 
-void onControlLost(ArvDevice*, gpointer flag) {
-  static_cast<std::atomic<bool>*>(flag)->store(true);  // from Aravis' heartbeat thread
-}
-
 // Aravis stamps buffers with the host's real-time clock on arrival; the pipeline's
 // timestamps are CLOCK_MONOTONIC, so shift by the clocks' current offset.
 uint64_t toMonotonic(uint64_t realtime_ns) {
@@ -101,7 +100,82 @@ uint64_t toMonotonic(uint64_t realtime_ns) {
 
 }  // namespace
 
+EventFd::EventFd() : fd_(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)) {}
+
+EventFd::~EventFd() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void EventFd::signal() const {
+  const uint64_t one = 1;
+  // Can fail only with EAGAIN (the counter is full): readable already.
+  if (fd_ >= 0) (void)!::write(fd_, &one, sizeof one);
+}
+
+void EventFd::drain() const {
+  uint64_t n = 0;
+  while (fd_ >= 0 && ::read(fd_, &n, sizeof n) > 0) {
+  }
+}
+
 AravisCamera::AravisCamera(AravisOptions options) : options_(std::move(options)) {}
+
+void AravisCamera::onControlLost(void*, void* self) {
+  auto* cam = static_cast<AravisCamera*>(self);  // from Aravis' heartbeat thread
+  {
+    std::lock_guard lock(cam->watchdog_mutex_);
+    if (cam->gone_reason_.empty()) cam->gone_reason_ = "control lost (the camera is gone)";
+  }
+  cam->markGone();
+}
+
+void AravisCamera::markGone() const {
+  lost_ = true;
+  gone_fd_.signal();
+}
+
+void AravisCamera::startWatchdog() {
+  {
+    std::lock_guard lock(watchdog_mutex_);
+    watchdog_stop_ = false;
+  }
+  if (options_.probe_ms > 0) watchdog_ = std::thread([this] { watch(); });
+}
+
+void AravisCamera::stopWatchdog() {
+  {
+    std::lock_guard lock(watchdog_mutex_);
+    watchdog_stop_ = true;
+  }
+  watchdog_wake_.notify_all();
+  // At most one register read (Aravis' retries, ~2.5 s on a gone camera) to wait for.
+  if (watchdog_.joinable()) watchdog_.join();
+}
+
+void AravisCamera::watch() {
+  ArvDevice* device = arv_camera_get_device(camera_);
+  std::unique_lock lock(watchdog_mutex_);
+  for (;;) {
+    const auto period = std::chrono::milliseconds(options_.probe_ms);
+    if (watchdog_wake_.wait_for(lock, period, [this] { return watchdog_stop_; })) return;
+    if (lost_) return;
+    lock.unlock();
+    // Address 0 is a bootstrap register of both GigE Vision (Version) and
+    // USB3 Vision (the ABRM's GenCP version); the device serialises register
+    // access, so this runs beside captures and controls on other threads.
+    guint32 value = 0;
+    GError* error = nullptr;
+    const bool answered = arv_device_read_register(device, 0, &value, &error);
+    const std::string reason = answered ? std::string() : take(error);
+    lock.lock();
+    if (!answered && !watchdog_stop_) {
+      if (gone_reason_.empty()) gone_reason_ = "the camera no longer answers: " + reason;
+      lock.unlock();
+      markGone();
+      return;
+    }
+  }
+}
 
 AravisCamera::~AravisCamera() {
   stop();
@@ -115,10 +189,19 @@ CamResult<void> AravisCamera::start() {
   camera_ = arv_camera_new(options_.id.empty() ? nullptr : options_.id.c_str(), &error);
   if (!camera_) return camFail(Status::kNoDevice, name() + ": cannot open: " + take(error));
   lost_ = false;
-  g_signal_connect(arv_camera_get_device(camera_), "control-lost", G_CALLBACK(onControlLost),
-                   &lost_);
+  gone_fd_.drain();
+  {
+    std::lock_guard lock(watchdog_mutex_);
+    gone_reason_.clear();
+  }
+  control_lost_handler_ = g_signal_connect(arv_camera_get_device(camera_), "control-lost",
+                                           G_CALLBACK(onControlLost), this);
   auto ok = configure();
-  if (!ok) stop();
+  if (!ok) {
+    stop();
+    return ok;
+  }
+  startWatchdog();
   return ok;
 }
 
@@ -195,6 +278,12 @@ void AravisCamera::releaseHeld() {
 }
 
 void AravisCamera::stop() {
+  stopWatchdog();
+  if (camera_ && control_lost_handler_ != 0) {
+    // The camera may outlive this object (released on a thread of its own below).
+    g_signal_handler_disconnect(arv_camera_get_device(camera_), control_lost_handler_);
+  }
+  control_lost_handler_ = 0;
   releaseHeld();
   if (camera_ && stream_ && !lost_) {
     GError* error = nullptr;
@@ -213,12 +302,22 @@ void AravisCamera::stop() {
 }
 
 CamResult<void> AravisCamera::checkAlive() const {
-  if (lost_) return camFail(Status::kNoDevice, name() + ": control lost (the camera is gone)");
+  if (lost_) {
+    std::lock_guard lock(watchdog_mutex_);
+    return camFail(Status::kNoDevice,
+                   name() + ": " +
+                       (gone_reason_.empty() ? "control lost (the camera is gone)" : gone_reason_));
+  }
   GError* error = nullptr;
   arv_camera_get_payload(camera_, &error);
   if (error) {
-    lost_ = true;  // stop() then skips the commands a gone camera would time out on
-    return camFail(Status::kNoDevice, name() + ": the camera no longer answers: " + take(error));
+    const std::string reason = "the camera no longer answers: " + take(error);
+    {
+      std::lock_guard lock(watchdog_mutex_);
+      if (gone_reason_.empty()) gone_reason_ = reason;
+    }
+    markGone();  // stop() then skips the commands a gone camera would time out on
+    return camFail(Status::kNoDevice, name() + ": " + reason);
   }
   return {};
 }

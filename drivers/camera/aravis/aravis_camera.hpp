@@ -5,8 +5,11 @@
 // GenICam units. The frame of a Mono8/Mono16 stream points into the Aravis buffer, which
 // goes back to the stream at the next capture.
 #include <atomic>
+#include <condition_variable>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 
 #include "camera/camera.hpp"
 #include "camera/convert.hpp"
@@ -17,6 +20,21 @@ typedef struct _ArvBuffer ArvBuffer;
 
 namespace procam::camera {
 
+// An eventfd, closed with its owner.
+class EventFd {
+ public:
+  EventFd();
+  ~EventFd();
+  EventFd(const EventFd&) = delete;
+  EventFd& operator=(const EventFd&) = delete;
+  int fd() const { return fd_; }
+  void signal() const;  // async-signal- and thread-safe: a write(2)
+  void drain() const;
+
+ private:
+  int fd_ = -1;
+};
+
 struct AravisOptions {
   std::string id;                  // as arv_camera_new() takes it
   uint32_t width = 0, height = 0;  // 0: the camera's current region
@@ -25,6 +43,9 @@ struct AravisOptions {
   double fps = 0;                  // 0: the camera's current rate
   unsigned buffers = 8;            // stream buffer pool, at least 2
   std::optional<procam_pixel_format> pixel;
+  // How often a register of the camera is read to tell whether it still
+  // answers (see watch()).
+  unsigned probe_ms = 100;
 };
 
 class AravisCamera final : public Camera {
@@ -43,6 +64,10 @@ class AravisCamera final : public Camera {
   CamResult<const Frame*> capture(int timeout_ms) override;
   CamResult<void> setControl(Control control, double value) override;
   std::string name() const override { return "aravis " + options_.id; }
+  // Readable once the camera is gone (control lost or a register read not
+  // answered): the next capture() then returns kNoDevice. No frame makes it
+  // readable, so a reader that only waits on it is woken for the loss alone.
+  int pollFd() const override { return gone_fd_.fd(); }
 
   // The camera's exposure time in seconds (read back), for checks.
   CamResult<double> exposure() const;
@@ -53,6 +78,15 @@ class AravisCamera final : public Camera {
   CamResult<void> configure();
   CamResult<void> checkAlive() const;
   void releaseHeld();
+  void markGone() const;
+  // The watchdog thread: reads a bootstrap register every probe_ms until one
+  // goes unanswered (Aravis gives up after its retries, ~2.5 s on loopback),
+  // then marks the camera gone. Aravis' own heartbeat reports control-lost
+  // only after ~6-8 s; this keeps the loss of an idle camera within ~3 s.
+  void watch();
+  void startWatchdog();
+  void stopWatchdog();
+  static void onControlLost(void* device, void* self);
 
   AravisOptions options_;
   ArvCamera* camera_ = nullptr;
@@ -61,6 +95,13 @@ class AravisCamera final : public Camera {
   SourceFormat source_ = SourceFormat::kGrey;
   FrameFormat format_;
   mutable std::atomic<bool> lost_{false};
+  EventFd gone_fd_;
+  unsigned long control_lost_handler_ = 0;
+  std::thread watchdog_;
+  mutable std::mutex watchdog_mutex_;
+  std::condition_variable watchdog_wake_;
+  bool watchdog_stop_ = false;
+  mutable std::string gone_reason_;  // guarded by watchdog_mutex_
   uint64_t failed_ = 0;
   cv::Mat storage_;
   Frame frame_;

@@ -147,7 +147,8 @@ void destroy(void* self) {
   delete c;
 }
 
-const procam_camera_ops kOps = {PROCAM_CAMERA_OPS_VERSION, &getFormat, &setExposure, &capture};
+const procam_camera_ops kOps = {PROCAM_CAMERA_OPS_VERSION, &getFormat, &setExposure, &capture,
+                                nullptr};
 
 }  // namespace
 

@@ -193,8 +193,12 @@ int cameraCapture(void* self, int, procam_image* out, char* err, size_t len) {
   }
   return PROCAM_OK;
 }
+// Liveness without a ray cast: the device is there unless unplugged.
+int cameraCheck(void* self, char* err, size_t len) {
+  return presence(static_cast<Device*>(self)->name, err, len);
+}
 const procam_camera_ops kCameraOps = {PROCAM_CAMERA_OPS_VERSION, cameraFormat, cameraExposure,
-                                      cameraCapture};
+                                      cameraCapture, cameraCheck};
 
 template <procam_family Family>
 int create(const procam_device_desc* d, const procam_config*, procam_device* out, char* err,

@@ -111,6 +111,11 @@ typedef struct procam_camera_ops {
                     procam_pixel_format* out_format);
   int (*set_exposure)(void* self, double seconds, char* err, size_t err_len);
   int (*capture)(void* self, int timeout_ms, procam_image* out, char* err, size_t err_len);
+  /* Optional (may be NULL): a cheap liveness check, PROCAM_OK while the camera
+   * answers and PROCAM_ENODEV once it is gone. The daemon checks every camera
+   * that delivered no frame for a second; without `check` it captures a frame,
+   * which a camera that renders or transfers large frames pays for. */
+  int (*check)(void* self, char* err, size_t err_len);
 } procam_camera_ops;
 
 /* Tilt sensor: specific force in the sensor frame (m/s^2). At rest it reads

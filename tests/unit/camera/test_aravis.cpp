@@ -1,68 +1,24 @@
 // The aravis camera live against Aravis' fake GigE Vision camera on loopback, started by
 // the test (arv-fake-gv-camera-0.8 -i 127.0.0.1; HARDWARE-TESTING.md). Its Mono8 pixel
 // (x, y) of frame id n is (x + y + n) % 255, so every frame's content is checkable.
-#include <fcntl.h>
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
-#include <filesystem>
-#include <sstream>
+#include <memory>
 #include <thread>
 
 #include "camera/aravis/aravis_camera.hpp"
 #include "camera/plugin/camera_plugin.hpp"
-
-extern char** environ;
+#include "unit/camera/fake_gige.hpp"
 
 namespace procam::camera {
 namespace {
 
-constexpr const char* kFakeBinary = "arv-fake-gv-camera-0.8";
-constexpr const char* kLoopback = "127.0.0.1";
-
-std::string findOnPath(const std::string& name) {
-  const char* path = std::getenv("PATH");
-  std::stringstream dirs(path ? path : "/usr/bin:/bin");
-  for (std::string dir; std::getline(dirs, dir, ':');) {
-    const auto p = std::filesystem::path(dir) / name;
-    if (::access(p.c_str(), X_OK) == 0) return p.string();
-  }
-  return {};
-}
-
-// One fake camera server; the GigE server's frame counter persists across clients, so
-// each test starts its own.
-class FakeGigE {
- public:
-  explicit FakeGigE(const std::string& binary) {
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
-    const char* argv[] = {binary.c_str(), "-i", kLoopback, nullptr};
-    if (posix_spawn(&pid_, binary.c_str(), &actions, nullptr, const_cast<char**>(argv), environ) !=
-        0)
-      pid_ = -1;
-    posix_spawn_file_actions_destroy(&actions);
-  }
-  ~FakeGigE() { kill(); }
-  bool running() const { return pid_ > 0; }
-  void kill() {
-    if (pid_ <= 0) return;
-    ::kill(pid_, SIGKILL);
-    ::waitpid(pid_, nullptr, 0);
-    pid_ = -1;
-  }
-
- private:
-  pid_t pid_ = -1;
-};
+using test::FakeGigE;
+using test::findOnPath;
+using test::kFakeBinary;
+using test::kLoopback;
 
 AravisOptions loopback640() {
   AravisOptions o;

@@ -1,9 +1,11 @@
 #pragma once
 // Drivers for device-manager tests: tilt sensors that can be "unplugged"
 // (every call returns PROCAM_ENODEV while fake::gone is set) and that expose
-// a pipe as poll fd when created with the option fd=pipe; and slow trackers
+// a pipe as poll fd when created with the option fd=pipe; slow trackers
 // whose read blocks while fake::hold is set (as a blob search would), with
-// counters of the reads running at once.
+// counters of the reads running at once; and cameras without a poll fd whose
+// capture fails with PROCAM_ENODEV while fake::camera_gone is set (a GigE
+// camera that died: nothing else tells).
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -176,10 +178,100 @@ inline int createTracker(const procam_device_desc*, const procam_config* config,
   return PROCAM_OK;
 }
 
+// Cameras. Only capture() notices that the camera is gone: the format is
+// answered from memory, as real drivers do.
+inline std::atomic<bool> camera_gone{false};
+inline std::atomic<int> captures{0};  // over every camera
+inline std::atomic<int> cameras_destroyed{0};
+inline std::atomic<std::thread::id> camera_destroyed_on{};
+
+struct Camera {
+  uint64_t frames = 0;
+  uint8_t pixels[8] = {};
+};
+
+inline int cameraFormat(void*, uint32_t* w, uint32_t* h, procam_pixel_format* f) {
+  *w = 4;
+  *h = 2;
+  *f = PROCAM_PIXEL_GRAY8;
+  return PROCAM_OK;
+}
+inline int cameraExposure(void*, double, char*, size_t) {
+  return PROCAM_ENOTSUP;
+}
+inline int cameraCapture(void* self, int, procam_image* out, char* err, size_t len) {
+  ++captures;
+  if (camera_gone) {
+    std::snprintf(err, len, "fake camera stopped answering");
+    return PROCAM_ENODEV;
+  }
+  auto* c = static_cast<Camera*>(self);
+  out->width = 4;
+  out->height = 2;
+  out->stride = 4;
+  out->format = PROCAM_PIXEL_GRAY8;
+  out->data = c->pixels;
+  out->timestamp_ns = ++c->frames;
+  return PROCAM_OK;
+}
+inline const procam_camera_ops kCameraOps = {PROCAM_CAMERA_OPS_VERSION, cameraFormat,
+                                             cameraExposure, cameraCapture, nullptr};
+
+inline int noFd(void*) {
+  return -1;
+}
+inline void cameraDestroy(void* self) {
+  camera_destroyed_on = std::this_thread::get_id();
+  ++cameras_destroyed;
+  delete static_cast<Camera*>(self);
+}
+
+// Chosen by name only: udev's cameras stay unclaimed in the tests that expect so.
+inline int probeCamera(const procam_device_desc*) {
+  return 0;
+}
+
+inline int createCamera(const procam_device_desc*, const procam_config*, procam_device* out,
+                        char* err, size_t len) {
+  if (camera_gone) {
+    std::snprintf(err, len, "no answer from the camera");
+    return PROCAM_ENODEV;
+  }
+  out->family = PROCAM_FAMILY_CAMERA;
+  out->self = new Camera;
+  out->poll_fd = noFd;
+  out->destroy = cameraDestroy;
+  out->ops.camera = &kCameraOps;
+  return PROCAM_OK;
+}
+
+// The same camera with a liveness check: the daemon checks it instead of capturing.
+inline std::atomic<int> checks{0};
+inline int cameraCheck(void*, char* err, size_t len) {
+  ++checks;
+  if (camera_gone) {
+    std::snprintf(err, len, "fake camera stopped answering its checks");
+    return PROCAM_ENODEV;
+  }
+  return PROCAM_OK;
+}
+inline const procam_camera_ops kCheckedCameraOps = {PROCAM_CAMERA_OPS_VERSION, cameraFormat,
+                                                    cameraExposure, cameraCapture, cameraCheck};
+inline int createCheckedCamera(const procam_device_desc* d, const procam_config* c,
+                               procam_device* out, char* err, size_t len) {
+  const int rc = createCamera(d, c, out, err, len);
+  if (rc == PROCAM_OK) out->ops.camera = &kCheckedCameraOps;
+  return rc;
+}
+
 inline const procam_driver_factory kFactories[] = {
     {PROCAM_FAMILY_TILT, "generic-tilt", "weak match", probeGeneric, createTilt, nullptr},
     {PROCAM_FAMILY_TILT, "fake-tilt", "test tilt sensor", probeTilt, createTilt, nullptr},
     {PROCAM_FAMILY_TRACKER, "slow-tracker", "test tracker", probeTracker, createTracker, nullptr},
+    {PROCAM_FAMILY_CAMERA, "silent-camera", "test camera without a poll fd", probeCamera,
+     createCamera, nullptr},
+    {PROCAM_FAMILY_CAMERA, "checked-camera", "test camera with a liveness check", probeCamera,
+     createCheckedCamera, nullptr},
 };
 
 inline plugins::DriverRegistry registry() {

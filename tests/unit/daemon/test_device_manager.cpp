@@ -1,17 +1,20 @@
 // The device manager: udev records -> descriptions, matching, hotplug
 // add/remove (the handler called directly: no udev daemon here), device fds
 // in the loop, lost devices and their reopening, tracker reads on the reader
-// worker and the fence that hands a device to calibrate.
+// worker, liveness captures of cameras and the fence that hands a device to
+// calibrate.
 #include <gtest/gtest.h>
 #include <sys/epoll.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <regex>
 #include <set>
 #include <thread>
+#include <variant>
 
 #include "device_manager.hpp"
 #include "fake_drivers.hpp"
@@ -110,6 +113,10 @@ class ManagerTest : public ::testing::Test {
     fake::most_reads_running = 0;
     fake::destroyed_mid_read = 0;
     fake::trackers_destroyed = 0;
+    fake::camera_gone = false;
+    fake::captures = 0;
+    fake::checks = 0;
+    fake::cameras_destroyed = 0;
     loop_ = std::move(*EventLoop::create());
     manager_ = std::make_unique<DeviceManager>(
         *loop_, registry_, devices_,
@@ -123,6 +130,7 @@ class ManagerTest : public ::testing::Test {
     fake::hold = false;  // a read still blocked would hold up the reader's join
     manager_.reset();
     fake::gone = false;
+    fake::camera_gone = false;
   }
 
   // Runs the loop until `pred` holds (checked every 5 ms); false on timeout.
@@ -539,6 +547,99 @@ TEST_F(ManagerTest, ReadFenceWaitsForTheRunningReadAndDropsTheQueuedOne) {
   // The gate opens: the presence check puts both fds back.
   may_read = true;
   ASSERT_TRUE(runUntil([&] { return queued->reads > 0 && running->reads > 1; }));
+}
+
+plugins::DeviceDescription silentCamera(const std::string& name) {
+  plugins::DeviceDescription d;
+  d.family = PROCAM_FAMILY_CAMERA;
+  d.name = name;
+  d.subsystem = "config";
+  return d;
+}
+
+double secondsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+// A camera without a poll fd whose only sign of death is a failing capture
+// (a GigE camera that was switched off): the once-a-second liveness capture
+// finds it, it is lost, released off the loop, and reopened when it answers.
+TEST_F(ManagerTest, SilentCameraThatDiesIsLostAndReopenedWhenItAnswersAgain) {
+  devices_.open(registry_, silentCamera("gige"), "silent-camera", {});
+  ASSERT_TRUE(devices_.find("gige")->usable());
+  startWithoutUdev();  // procamd's interval: 1 s
+  int frames = 0;
+  manager_->onReading([&](const DeviceEntry& e, const Reading& r) {
+    if (e.name == "gige" && std::holds_alternative<CameraFrame>(r)) ++frames;
+  });
+  // Alive and idle: captured about once a second, nothing more.
+  ASSERT_TRUE(runUntil([&] { return frames >= 2; }, 3s));
+  EXPECT_LE(fake::captures, 3);
+  EXPECT_EQ(std::string(devices_.find("gige")->state()), "open");
+
+  fake::camera_gone = true;
+  const auto died = std::chrono::steady_clock::now();
+  ASSERT_TRUE(runUntil([&] { return std::string(devices_.find("gige")->state()) == "lost"; }, 3s));
+  const double to_lost = secondsSince(died);
+  RecordProperty("seconds_to_lost", std::to_string(to_lost));
+  std::printf("silent camera: lost %.2f s after it stopped answering\n", to_lost);
+  EXPECT_EQ(devices_.find("gige")->error, "lost: fake camera stopped answering");
+  ASSERT_EQ(eventsNamed("device-removed").size(), 1u);
+  EXPECT_EQ(eventsNamed("device-removed")[0]["state"], "lost");
+  ASSERT_FALSE(warnings_.empty());
+  EXPECT_NE(warnings_.back().find("fake camera stopped answering"), std::string::npos);
+  // Released by a worker, never by the loop thread (this one).
+  ASSERT_TRUE(runUntil([&] { return fake::cameras_destroyed == 1; }, 1s));
+  EXPECT_NE(fake::camera_destroyed_on.load(), std::this_thread::get_id());
+
+  // The first reopen (1 s later) finds it still gone; it answers again after that.
+  ASSERT_TRUE(runUntil([&] { return devices_.find("gige")->retries == 1; }, 3s));
+  fake::camera_gone = false;
+  const auto healthy = std::chrono::steady_clock::now();
+  ASSERT_TRUE(runUntil([&] { return devices_.find("gige")->usable(); }, 4s));
+  const double to_open = secondsSince(healthy);
+  RecordProperty("seconds_to_reopen", std::to_string(to_open));
+  std::printf("silent camera: open again %.2f s after it answered again\n", to_open);
+  EXPECT_EQ(std::string(devices_.find("gige")->state()), "open");
+  ASSERT_EQ(eventsNamed("device-added").size(), 1u);
+  EXPECT_EQ(eventsNamed("device-added")[0]["state"], "open");
+  // And watched again.
+  const int before = frames;
+  ASSERT_TRUE(runUntil([&] { return frames > before; }, 3s));
+}
+
+// A camera whose driver has a liveness check is checked, not captured: an idle
+// virtual camera renders nothing for it.
+TEST_F(ManagerTest, CameraWithALivenessCheckIsCheckedNotCaptured) {
+  devices_.open(registry_, silentCamera("virtual"), "checked-camera", {});
+  ASSERT_TRUE(devices_.find("virtual")->usable());
+  startWithoutUdev();
+  int frames = 0;
+  manager_->onReading([&](const DeviceEntry& e, const Reading&) { frames += e.name == "virtual"; });
+  ASSERT_TRUE(runUntil([&] { return fake::checks >= 2; }, 3s));
+  EXPECT_EQ(fake::captures, 0);
+  EXPECT_EQ(frames, 0);
+  fake::camera_gone = true;
+  const auto died = std::chrono::steady_clock::now();
+  ASSERT_TRUE(
+      runUntil([&] { return std::string(devices_.find("virtual")->state()) == "lost"; }, 3s));
+  std::printf("checked camera: lost %.2f s after its check failed\n", secondsSince(died));
+  EXPECT_EQ(devices_.find("virtual")->error, "lost: fake camera stopped answering its checks");
+  EXPECT_EQ(fake::captures, 0);
+}
+
+// While calibrate owns a camera (read gate closed) the liveness capture keeps
+// off it: a capture of the manager would take a frame calibrate waits for.
+TEST_F(ManagerTest, LivenessCaptureKeepsOffACameraBehindTheReadGate) {
+  devices_.open(registry_, silentCamera("gige"), "silent-camera", {});
+  bool may_read = false;
+  manager_->setReadGate([&](const std::string&) { return may_read; });
+  startWithoutUdev(50ms);
+  fake::camera_gone = true;  // would be found lost at the first capture
+  EXPECT_FALSE(runUntil([&] { return fake::captures > 0; }, 400ms));
+  EXPECT_EQ(std::string(devices_.find("gige")->state()), "open");
+  may_read = true;
+  ASSERT_TRUE(runUntil([&] { return std::string(devices_.find("gige")->state()) == "lost"; }, 1s));
 }
 
 TEST(DeviceManagerBackOff, OneTwoFourEightThenEveryTenSeconds) {
