@@ -8,7 +8,6 @@
 #include "daemon.hpp"
 #include "device_manager.hpp"
 #include "log.hpp"
-#include "rig/rig_json.hpp"
 #include "rig_store.hpp"
 #include "surface/surface_model.hpp"
 
@@ -237,16 +236,14 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
         update.surface.meshes[projector.name] = file;
         meshes[file] = surface::toPly(route.surface.mesh);
       }
-      const rig::NamedProjector named{plan->output.name, plan->set.options.width,
-                                      plan->set.options.height, route.projector};
-      const json surface = route.surface.planar ? rig::surfaceJson(route.surface, "")
-                                                : json{{"mesh", meshFileName(projector.name)}};
+      // The reply shows what is merged, in rig.json's own form.
+      const json learnt = rig::rigToJson(update);
       json reply = {{"operation", op_id},
                     {"state", "done"},
-                    {"projector", rig::projectorJson(named)},
+                    {"projector", learnt["projectors"][0]},
                     {"position", positionJson(route.projector.pose)},
                     {"reprojection_rms_px", route.projector.rms_px},
-                    {"surface", surface},
+                    {"surface", learnt["surface"]},
                     {"surface_type", route.surface.planar ? "plane" : "mesh"},
                     {"triangulated", route.triangulated},
                     {"decoded", result->decoded},

@@ -13,6 +13,7 @@
 #include "content/shm_frames.hpp"
 #include "content_mesh.hpp"
 #include "daemon.hpp"
+#include "geometry/intersect.hpp"
 #include "request_args.hpp"
 #if PROCAM_HAVE_GSTREAMER
 #include "content/gst_source.hpp"
@@ -262,17 +263,13 @@ tl::expected<PreparedMesh, MeshFailure> prepareMeshContent(const std::string& fi
     // The display surface is where the projector's central ray meets the plane.
     auto ray = model.backproject(Vec2((model.width - 1) / 2.0, (model.height - 1) / 2.0));
     if (!ray) return unavailable(ray.error().message);
-    const geom::Plane& plane = *o.plane;
-    const double along = plane.n.dot(ray->dir);
-    if (std::abs(along) < 1e-9) return unavailable("the projector's central ray misses the plane");
-    const double s = -plane.signedDistance(ray->origin) / along;
-    if (!(s > 0)) return unavailable("the display plane is behind the projector");
+    const auto hit = geom::intersectPlane(*ray, *o.plane);
+    if (!hit) return unavailable("the projector's central ray does not meet the display plane");
     content::PlanarView view;
     view.projector = model.projectionMatrix();
     view.size = {model.width, model.height};
-    view.plane_point = ray->origin + s * ray->dir;
-    // Facing the projector, as the lit side of a wall does.
-    view.plane_normal = along < 0 ? plane.n : Vec3(-plane.n);
+    view.plane_point = hit->point;
+    view.plane_normal = hit->normal;  // facing the projector, as the lit side of a wall does
     view.eye = *eye;
     auto placed = content::placeMeshContent(*loaded, view);
     if (!placed) return unavailable(placed.error().message);

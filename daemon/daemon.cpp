@@ -172,9 +172,10 @@ Result<void> Daemon::loadRigModel() {
   if (!options_.rig_path.empty()) {
     auto imported = importRig(options_.state_dir, options_.rig_path);
     if (!imported) return fail(imported.error().code, "--rig: " + imported.error().message);
-    logInfo("rig model from " + options_.rig_path + ": " +
-            std::to_string(imported->cameras.size()) + " camera(s), " +
-            std::to_string(imported->projectors.size()) + " projector(s)");
+    rig_ = std::move(*imported);
+    logInfo("rig model from " + options_.rig_path + ": " + std::to_string(rig_.cameras.size()) +
+            " camera(s), " + std::to_string(rig_.projectors.size()) + " projector(s)");
+    return {};
   }
   auto loaded = loadRig(options_.state_dir);
   if (!loaded) {
@@ -186,7 +187,7 @@ Result<void> Daemon::loadRigModel() {
   rig_ = std::move(loaded->rig);
   if (rig_.empty()) {
     logInfo("no rig model yet (" + loaded->path + "): calibrate writes it");
-  } else if (options_.rig_path.empty()) {
+  } else {
     logInfo("rig model " + loaded->path + ": " + std::to_string(rig_.cameras.size()) +
             " camera(s), " + std::to_string(rig_.projectors.size()) + " projector(s)");
   }

@@ -37,6 +37,17 @@ std::array<Vec2, 4> contentCorners(cv::Size s) {
           Vec2(0, s.height - 1.0)};
 }
 
+// What the keystone solve needs of the rig model's projector.
+ProjectorModel projectorModel(const rig::RigProjector& p) {
+  ProjectorModel m;
+  m.K = p.K;
+  m.width = p.width;
+  m.height = p.height;
+  m.source = "rig model (" +
+             (p.calibrated.method.empty() ? std::string("rig.json") : p.calibrated.method) + ")";
+  return m;
+}
+
 std::optional<cv::Size> outputMode(const DeviceEntry& e) {
   uint32_t w = 0, h = 0;
   double hz = 0;
@@ -81,13 +92,6 @@ void Daemon::probeKeystoneInputs() {
     settings_.auto_keystone = false;
     return;
   }
-  ProjectorModel model;
-  model.K = proj->K;
-  model.width = proj->width;
-  model.height = proj->height;
-  model.source =
-      "rig model (" +
-      (proj->calibrated.method.empty() ? std::string("rig.json") : proj->calibrated.method) + ")";
   Result<TiltMount> mount = mountFromConfig(config_.keystone);
   if (proj->tilt && (proj->tilt->sensor.empty() || proj->tilt->sensor == tilt->name)) {
     TiltMount m;
@@ -104,7 +108,7 @@ void Daemon::probeKeystoneInputs() {
     settings_.auto_keystone = false;
     return;
   }
-  useKeystoneInputs(std::move(model), *mount);
+  useKeystoneInputs(projectorModel(*proj), *mount);
 }
 
 void Daemon::useKeystoneInputs(ProjectorModel projector, TiltMount mount) {
@@ -570,10 +574,6 @@ json Daemon::outputsJson() const {
   return {{"frames", keystone_rt_.frames}, {"shown", list}};
 }
 
-}  // namespace procam::daemon
-
-namespace procam::daemon {
-
 void Daemon::onRigChanged() {
   // Auto keystone keeps its tilt state and takes the new intrinsics; when it had
   // none, `keystone auto on` reads the rig again.
@@ -582,10 +582,7 @@ void Daemon::onRigChanged() {
   const DeviceEntry* out = devices_.firstUsable(PROCAM_FAMILY_OUTPUT);
   const rig::RigProjector* p = out ? rig_.projectorForOutput(out->name) : nullptr;
   if (!p) return;
-  k.projector->K = p->K;
-  k.projector->width = p->width;
-  k.projector->height = p->height;
-  k.projector->source = "rig model (" + p->calibrated.method + ")";
+  k.projector = projectorModel(*p);
 }
 
 }  // namespace procam::daemon

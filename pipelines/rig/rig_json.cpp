@@ -1,21 +1,9 @@
 #include "rig/rig_json.hpp"
 
+#include "rig/rig_model.hpp"
+
 namespace procam::rig {
 namespace {
-
-Result<std::vector<double>> numbers(const nlohmann::json& j, const char* key, std::size_t n,
-                                    const std::string& where) {
-  if (!j.contains(key) || !j[key].is_array() || j[key].size() != n)
-    return fail(ErrorCode::kParse,
-                where + ": '" + key + "' must be an array of " + std::to_string(n) + " numbers");
-  std::vector<double> out;
-  for (const auto& v : j[key]) {
-    if (!v.is_number())
-      return fail(ErrorCode::kParse, where + ": '" + key + "' holds a non-number");
-    out.push_back(v.get<double>());
-  }
-  return out;
-}
 
 nlohmann::json matrixJson(const Mat3& m) {
   nlohmann::json a = nlohmann::json::array();
@@ -26,6 +14,8 @@ nlohmann::json matrixJson(const Mat3& m) {
 
 }  // namespace
 
+// The rig model's parsing of one camera (rig_model.hpp), so that cameras.json and
+// rig.json accept exactly the same camera entries.
 Result<std::vector<NamedCamera>> camerasFromJson(const nlohmann::json& doc,
                                                  const std::string& where_doc) {
   if (!doc.is_object() || !doc.contains("cameras") || !doc["cameras"].is_array() ||
@@ -34,34 +24,9 @@ Result<std::vector<NamedCamera>> camerasFromJson(const nlohmann::json& doc,
                 where_doc + ": expected {\"cameras\": [ ... ]} with at least one camera");
   std::vector<NamedCamera> out;
   for (const auto& c : doc["cameras"]) {
-    NamedCamera n;
-    const std::string where = where_doc + " camera " + std::to_string(out.size());
-    if (!c.is_object()) return fail(ErrorCode::kParse, where + ": not an object");
-    n.name = c.value("name", "camera" + std::to_string(out.size()));
-    if (!c.contains("width") || !c.contains("height") || !c["width"].is_number_integer() ||
-        !c["height"].is_number_integer())
-      return fail(ErrorCode::kParse, where + ": 'width' and 'height' are required integers");
-    n.model.width = c["width"].get<int>();
-    n.model.height = c["height"].get<int>();
-    auto K = numbers(c, "K", 9, where);
-    auto R = numbers(c, "R", 9, where);
-    auto t = numbers(c, "t", 3, where);
-    if (!K) return tl::unexpected(K.error());
-    if (!R) return tl::unexpected(R.error());
-    if (!t) return tl::unexpected(t.error());
-    Mat3 Km, Rm;
-    for (int i = 0; i < 9; ++i) Km(i / 3, i % 3) = (*K)[i], Rm(i / 3, i % 3) = (*R)[i];
-    n.model.K = geom::Intrinsics::fromMatrix(Km);
-    if (c.contains("dist")) {
-      auto d = numbers(c, "dist", 5, where);
-      if (!d) return tl::unexpected(d.error());
-      n.model.dist = {(*d)[0], (*d)[1], (*d)[2], (*d)[3], (*d)[4]};
-    }
-    if ((Rm.transpose() * Rm - Mat3::Identity()).norm() > 1e-6 || Rm.determinant() < 0)
-      return fail(ErrorCode::kParse, where + ": 'R' is not a rotation matrix");
-    n.model.pose.R = Rm;
-    n.model.pose.t = Vec3((*t)[0], (*t)[1], (*t)[2]);
-    out.push_back(std::move(n));
+    auto cam = cameraFromJson(c, where_doc + " camera " + std::to_string(out.size()), out.size());
+    if (!cam) return tl::unexpected(cam.error());
+    out.push_back({cam->name, cam->model, -1});
   }
   return out;
 }

@@ -116,7 +116,9 @@ json provenanceJson(const Provenance& p) {
   return {{"method", p.method}, {"time", p.time}};
 }
 
-Result<RigCamera> cameraFrom(const json& c, const std::string& where, size_t index) {
+}  // namespace
+
+Result<RigCamera> cameraFromJson(const json& c, const std::string& where, size_t index) {
   if (!c.is_object()) return fail(ErrorCode::kParse, where + ": not an object");
   RigCamera out;
   out.name = stringField(c, "name", "camera" + std::to_string(index));
@@ -137,6 +139,8 @@ Result<RigCamera> cameraFrom(const json& c, const std::string& where, size_t ind
   out.calibrated = provenance(c);
   return out;
 }
+
+namespace {
 
 Result<TiltMountModel> tiltFrom(const json& j, const std::string& where) {
   if (!j.is_object()) return fail(ErrorCode::kParse, where + ": 'tilt' must be an object");
@@ -298,8 +302,8 @@ Result<RigModel> rigFromJson(const json& doc, const std::string& where) {
   }
   if (doc.contains("cameras")) {
     for (const auto& c : doc["cameras"]) {
-      auto cam = cameraFrom(c, where + " camera " + std::to_string(rig.cameras.size()),
-                            rig.cameras.size());
+      auto cam = cameraFromJson(c, where + " camera " + std::to_string(rig.cameras.size()),
+                                rig.cameras.size());
       if (!cam) return tl::unexpected(cam.error());
       if (rig.camera(cam->name))
         return fail(ErrorCode::kParse, where + ": camera '" + cam->name + "' twice");

@@ -101,6 +101,9 @@ struct RigModel {
 // kParse for a malformed document, kInvalidInput for an unsupported version.
 Result<RigModel> rigFromJson(const nlohmann::json& doc, const std::string& where);
 Result<RigModel> rigFromText(std::string_view text, const std::string& where);
+// One camera entry of a rig.json or cameras.json (`index` names an unnamed one).
+Result<RigCamera> cameraFromJson(const nlohmann::json& entry, const std::string& where,
+                                 size_t index);
 // Version 2; numbers with full double precision.
 nlohmann::json rigToJson(const RigModel& rig);
 

@@ -206,35 +206,39 @@ TEST(SimMeshContent, ConfiguredViewerWinsOverTheScenes) {
   expectCubeShown(c, dir, Vec3(0.6, 0.9, 1.3), "config");
 }
 
-// The dome's truth has no plane: a rig without a planar surface cannot take the
-// planar 3D path (the calibrated, non-planar case is in daemon_calibrate_tests).
+// `content load` of the cube on a daemon started with `launch`: the ERROR reply,
+// checked to be `unavailable`.
+json unavailableLoad(const TempDir& dir, DaemonProcess::Launch launch) {
+  dir.write("cube.obj", kCubeObj);
+  DaemonProcess d(dir, std::move(launch));
+  EXPECT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", dir.file("cube.obj")}}, 30s);
+  if (!load) {
+    ADD_FAILURE() << "no reply";
+    return nullptr;
+  }
+  EXPECT_EQ((*load)["class"], "ERROR") << load->dump();
+  EXPECT_EQ((*load)["code"], "unavailable") << load->dump();
+  return *load;
+}
+
 // Without a rig model the daemon has no geometry: the virtual rig's devices alone
 // give no projector pose and no surface.
 TEST(SimMeshContent, UncalibratedRigIsUnavailable) {
   TempDir dir;
-  dir.write("cube.obj", kCubeObj);
-  DaemonProcess d(dir, DaemonProcess::Launch{{"--sim", "corner_stereo"}, {}, -1, true});
-  ASSERT_TRUE(d.started()) << d.log();
-  Connection c(d.socketPath());
-  auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", dir.file("cube.obj")}}, 30s);
-  ASSERT_TRUE(load);
-  EXPECT_EQ((*load)["class"], "ERROR") << load->dump();
-  EXPECT_EQ((*load)["code"], "unavailable") << load->dump();
+  unavailableLoad(dir, DaemonProcess::Launch{{"--sim", "corner_stereo"}, {}, -1, true});
   EXPECT_FALSE(std::filesystem::exists(dir.path() + "/state/rig.json"));
 }
 
+// The dome's truth has no plane: a rig without a planar surface cannot take the
+// planar 3D path (the calibrated, non-planar case is in daemon_calibrate_tests).
 TEST(SimMeshContent, NonPlanarSurfaceIsUnavailable) {
   TempDir dir;
-  dir.write("cube.obj", kCubeObj);
-  DaemonProcess d(dir, simWithTruth(dir, "dome3"));
-  ASSERT_TRUE(d.started()) << d.log();
-  Connection c(d.socketPath());
-  auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", dir.file("cube.obj")}}, 30s);
-  ASSERT_TRUE(load);
-  EXPECT_EQ((*load)["class"], "ERROR") << load->dump();
-  EXPECT_EQ((*load)["code"], "unavailable") << load->dump();
-  EXPECT_NE((*load)["message"].get<std::string>().find("display surface"), std::string::npos)
-      << load->dump();
+  const json load = unavailableLoad(dir, simWithTruth(dir, "dome3"));
+  ASSERT_TRUE(load.is_object());
+  EXPECT_NE(load["message"].get<std::string>().find("display surface"), std::string::npos)
+      << load.dump();
 }
 
 // wall_oblique's wall and projector (at half resolution) with a tracked viewer who stands
