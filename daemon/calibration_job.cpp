@@ -58,6 +58,11 @@ cv::Mat grayImage(const procam_image& img) {
       cv::cvtColor(cv::Mat(h, w, CV_8UC3, img.data, img.stride), gray, cv::COLOR_RGB2GRAY);
       return gray;
     }
+    case PROCAM_PIXEL_RGBA8: {
+      cv::Mat gray;
+      cv::cvtColor(cv::Mat(h, w, CV_8UC4, img.data, img.stride), gray, cv::COLOR_RGBA2GRAY);
+      return gray;
+    }
   }
   return {};
 }

@@ -123,6 +123,7 @@ Result<void> Daemon::setup() {
   if (auto ok = server_->start(); !ok) return ok;
   setupAutoKeystone();
   setupTrackers();
+  loadRigSurfaces();
   loadContentAtStart();
   refreshOutputs();
 

@@ -18,8 +18,11 @@
 #include "device_manager.hpp"
 #include "device_set.hpp"
 #include "event_loop.hpp"
+#include "geometry/intersect.hpp"
 #include "keystone_runtime.hpp"
 #include "registry.hpp"
+#include "render/projective_mesh.hpp"
+#include "render/render_path.hpp"
 #include "rig_store.hpp"
 #include "settings.hpp"
 #include "state_file.hpp"
@@ -117,6 +120,16 @@ class Daemon {
   std::optional<Mat3> currentWarp(cv::Size content_size) const;
   cv::Size currentSourceSize() const;
   void refreshOutputs(std::function<void(bool shown)> done = {});
+  // What render::choosePath needs about an output, from the rig model and the viewer.
+  render::SceneTraits sceneTraits(const std::string& output, bool mesh_content) const;
+  // rig_surfaces.cpp: the rig's surface meshes (read on the I/O worker), the viewer's
+  // eye, and image content on a non-planar surface (kNotFound with the reason when the
+  // rig or the viewer do not allow it).
+  void loadRigSurfaces();
+  std::optional<Vec3> viewerEye() const;
+  Result<std::shared_ptr<const render::RenderSetup>> nonPlanarSetup(const std::string& output,
+                                                                    cv::Size mode,
+                                                                    cv::Size content);
   bool calibrating() const;
   // Marks `op_id` as the calibration operation using `devices` (commands_calibrate.cpp).
   void beginCalibrationOp(const std::string& op_id, std::vector<std::string> devices);
@@ -152,6 +165,13 @@ class Daemon {
   Settings settings_;
   std::unique_ptr<StateFile> settings_file_;
   rig::RigModel rig_;  // the state directory's rig.json: the only source of geometry
+  struct RigSurfaceMesh {
+    geom::MeshIntersector intersector;
+    render::SurfaceMesh mesh;
+  };
+  // rig_'s surface meshes by projector name ("" for the unified mesh).
+  std::map<std::string, std::shared_ptr<const RigSurfaceMesh>> rig_surfaces_;
+  uint64_t rig_generation_ = 0;
   std::vector<std::string> warnings_;
   plugins::DriverRegistry registry_;
   std::chrono::steady_clock::time_point started_;

@@ -1,6 +1,7 @@
 #pragma once
 // The daemon's state for automatic keystone and for what the outputs show
 // (daemon_keystone.cpp). Touched on the loop thread only.
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -12,7 +13,9 @@
 #include <vector>
 
 #include "auto_keystone.hpp"
+#include "driver.hpp"
 #include "output_frames.hpp"
+#include "render/cpu_renderer.hpp"
 
 namespace procam::daemon {
 
@@ -37,6 +40,28 @@ struct KeystoneRuntime {
   uint64_t solves = 0;
 
   // Outputs.
+  struct OutputState {
+    std::weak_ptr<plugins::Device> device;             // the one the setup was handed to
+    std::shared_ptr<const render::RenderSetup> setup;  // handed over (or on its way)
+    std::shared_ptr<const void> content;               // what `version` numbers
+    uint64_t version = 0;
+    std::shared_ptr<render::CpuRenderer> fallback;     // outputs that do not render
+    std::string path;                                  // render path drawn
+    std::string chosen;                                // render::choosePath's answer
+    std::string path_note;                             // why they differ, if they do
+    std::chrono::steady_clock::time_point stats_time;  // statistics last asked for
+    // The non-planar setup of image content and what it was made for (rig_surfaces.cpp).
+    std::shared_ptr<const render::RenderSetup> np_setup;
+    std::shared_ptr<const void> np_surface;
+    Vec3 np_eye = Vec3::Zero();
+    cv::Size np_content;
+    Mat34 np_projector = Mat34::Zero();
+    bool np_tracked = false;
+    std::optional<Mat34> viewer;  // world -> content pixels of the frame drawn
+  };
+  std::map<std::string, OutputState> output_state;
+  std::map<std::string, std::shared_ptr<const cv::Mat>> patterns;  // "name WxH" -> RGBA
+  int stats_timer = -1;                    // one-shot: statistics of frames drawn without them
   std::shared_ptr<const cv::Mat> content;  // RGBA, decoded on a worker
   std::map<std::string, Mesh3d> meshes;    // 3D content: output name -> what it draws
   nlohmann::json mesh_info;                // `content` in replies while meshes are shown

@@ -6,6 +6,7 @@
 #include "content/still_sources.hpp"
 #include "content/test_pattern.hpp"
 #include "render/cpu_renderer.hpp"
+#include "render/frame_stats.hpp"
 
 namespace procam::daemon {
 
@@ -27,17 +28,10 @@ Mat3 fitHomography(cv::Size source, cv::Size output) {
   return H;
 }
 
-FrameStats statsOf(const cv::Mat& rgb) {
-  FrameStats st;
-  cv::Mat maxc;
-  std::vector<cv::Mat> ch;
-  cv::split(rgb, ch);
-  cv::max(ch[0], ch[1], maxc);
-  cv::max(maxc, ch[2], maxc);
-  st.lit_fraction = double(cv::countNonZero(maxc)) / double(rgb.total());
-  const cv::Scalar m = cv::mean(rgb);
-  st.mean_rgb = {m[0], m[1], m[2]};
-  return st;
+// Nothing to show: a black image the size of the smallest content.
+std::shared_ptr<const cv::Mat> blackImage() {
+  static const auto black = std::make_shared<const cv::Mat>(2, 2, CV_8UC4, cv::Scalar::all(0));
+  return black;
 }
 
 }  // namespace
@@ -49,6 +43,13 @@ procam_image rgbImage(const cv::Mat& rgb) {
                       PROCAM_PIXEL_RGB8,
                       rgb.data,
                       0};
+}
+
+std::shared_ptr<const cv::Mat> patternImage(const std::string& name, cv::Size size) {
+  content::RgbImage p = content::renderTestPattern(name, size.width, size.height);
+  auto rgba = std::make_shared<cv::Mat>();
+  cv::cvtColor(cv::Mat(p.height, p.width, CV_8UC3, p.pixels.data()), *rgba, cv::COLOR_RGB2RGBA);
+  return rgba;
 }
 
 Result<std::shared_ptr<const cv::Mat>> decodeContent(const std::string& path) {
@@ -64,53 +65,54 @@ cv::Size sourceSize(const FrameRequest& r) {
   return r.output_size;
 }
 
-Result<OutputFrame> renderOutputFrame(const FrameRequest& r) {
+Result<PlannedFrame> planFrame(const FrameRequest& r) {
   if (r.output_size.width < 2 || r.output_size.height < 2) {
     return fail(ErrorCode::kInvalidInput, "output frame must be at least 2x2");
   }
-  OutputFrame out;
-  cv::Mat source;
+  PlannedFrame out;
+  out.setup.output_size = r.output_size;
   if (showsPattern(r)) {
-    content::RgbImage p =
-        content::renderTestPattern(r.pattern, r.output_size.width, r.output_size.height);
-    cv::cvtColor(cv::Mat(p.height, p.width, CV_8UC3, p.pixels.data()), source, cv::COLOR_RGB2RGBA);
-    out.stats.source = "pattern:" + r.pattern;
+    if (!r.pattern_image || r.pattern_image->size() != r.output_size) {
+      return fail(ErrorCode::kInvalidInput, "pattern image missing or not of the output size");
+    }
+    out.image = r.pattern_image;
+    out.source = "pattern:" + r.pattern;
   } else if (r.mesh3d && r.mesh3d->mesh) {
-    out.stats.source = "content";
+    out.setup.path = render::RenderPath::kPlanar3d;
+    out.setup.planar3d = r.mesh3d->planar3d;
+    out.mesh = r.mesh3d->mesh;
+    out.source = "content";
+    return out;
   } else if (r.content) {
     if (r.content->type() != CV_8UC4 || r.content->cols < 2 || r.content->rows < 2) {
       return fail(ErrorCode::kInvalidInput, "content must be RGBA of at least 2x2 pixels");
     }
-    source = *r.content;
-    out.stats.source = "content";
+    out.image = r.content;
+    out.source = "content";
   } else {
-    out.rgb = cv::Mat(r.output_size, CV_8UC3, cv::Scalar::all(0));
-    out.stats.source = "none";
-    return out;
+    out.image = blackImage();
+    out.source = "none";
   }
-  render::RenderSetup setup;
-  setup.output_size = r.output_size;
-  render::Content content{&source, nullptr, 1};
-  if (source.empty()) {
-    setup.path = render::RenderPath::kPlanar3d;
-    setup.planar3d = r.mesh3d->planar3d;
-    content = {nullptr, r.mesh3d->mesh.get(), 1};
-  } else {
-    setup.content_size = source.size();
-    setup.path = render::RenderPath::kHomography;
-    setup.homography = r.homography ? *r.homography : fitHomography(source.size(), r.output_size);
-  }
+  out.setup.path = render::RenderPath::kHomography;
+  out.setup.content_size = out.image->size();
+  const bool own = out.source != "none" && r.homography;
+  out.setup.homography = own ? *r.homography : fitHomography(out.image->size(), r.output_size);
+  return out;
+}
+
+Result<OutputFrame> renderOutputFrame(const FrameRequest& r) {
+  auto plan = planFrame(r);
+  if (!plan) return tl::unexpected(plan.error());
   render::CpuRenderer renderer;
-  if (auto ok = renderer.configure(setup); !ok) return tl::unexpected(ok.error());
-  if (auto ok = renderer.render(content); !ok) {
+  if (auto ok = renderer.configure(plan->setup); !ok) return tl::unexpected(ok.error());
+  if (auto ok = renderer.render({plan->image.get(), plan->mesh.get(), 1}); !ok) {
     return tl::unexpected(ok.error());
   }
-  cv::Mat rgba;
-  if (auto ok = renderer.readFrame(rgba); !ok) return tl::unexpected(ok.error());
-  cv::cvtColor(rgba, out.rgb, cv::COLOR_RGBA2RGB);
-  const std::string source_name = out.stats.source;
-  out.stats = statsOf(out.rgb);
-  out.stats.source = source_name;
+  OutputFrame out;
+  out.rgba = renderer.frame().clone();
+  auto st = render::frameStats(out.rgba);
+  if (!st) return tl::unexpected(st.error());
+  out.stats = {plan->source, st->lit_fraction, st->mean_rgb};
   return out;
 }
 

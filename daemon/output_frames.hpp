@@ -1,8 +1,8 @@
 #pragma once
-// What a projector output shows: the alignment pattern (when one is chosen), 3D
-// content (a mesh through the planar 3D path) or the content image, pre-warped by the keystone
-// homography through the CPU reference renderer (pipelines/render), as an RGB8 frame. Pure: runs on
-// a worker.
+// What a projector output is asked to draw: the alignment pattern (when one is chosen),
+// 3D content (a mesh through the planar 3D path) or the content image, pre-warped by the
+// keystone homography (or fitted into the frame), as a render setup (geometry) plus content
+// that the output renders itself (procam_plugin.h, output operations version 2). Pure.
 #include <array>
 #include <memory>
 #include <opencv2/core.hpp>
@@ -24,8 +24,9 @@ struct Mesh3d {
 
 struct FrameRequest {
   cv::Size output_size;
-  std::string pattern = "off";             // not "off": shown instead of the content
-  std::shared_ptr<const cv::Mat> content;  // CV_8UC4 RGBA; null: none
+  std::string pattern = "off";                   // not "off": shown instead of the content
+  std::shared_ptr<const cv::Mat> pattern_image;  // RGBA of the pattern (patternImage())
+  std::shared_ptr<const cv::Mat> content;        // CV_8UC4 RGBA; null: none
   // Content pixels -> framebuffer pixels; none: the source is fitted into the
   // frame, centred, aspect kept (identity when the sizes agree).
   std::optional<Mat3> homography;
@@ -40,12 +41,18 @@ struct FrameStats {
   std::array<double, 3> mean_rgb{};  // 0..255
 };
 
-struct OutputFrame {
-  cv::Mat rgb;  // CV_8UC3, R G B order, output size
-  FrameStats stats;
+// One output's frame as the output renders it: the geometry and the content.
+struct PlannedFrame {
+  render::RenderSetup setup;
+  std::shared_ptr<const cv::Mat> image;             // RGBA (image paths)
+  std::shared_ptr<const render::ColoredMesh> mesh;  // planar 3D path
+  std::string source;                               // as FrameStats::source
 };
 
-// The plugin ABI's view of an RGB8 frame (no copy: `rgb` must outlive it).
+// The RGBA image of a test pattern at an output's size.
+std::shared_ptr<const cv::Mat> patternImage(const std::string& name, cv::Size size);
+
+// The plugin ABI's view of an RGB8 frame shown 1:1 (no copy: `rgb` must outlive it).
 procam_image rgbImage(const cv::Mat& rgb);
 
 // The size of the image the homography applies to: the output size for a
@@ -56,7 +63,15 @@ cv::Size sourceSize(const FrameRequest& request);
 // cannot be read.
 Result<std::shared_ptr<const cv::Mat>> decodeContent(const std::string& path);
 
-// kInvalidInput for empty sizes or content of the wrong type; renderer errors.
+// kInvalidInput for empty sizes, content of the wrong type or a pattern without its image.
+Result<PlannedFrame> planFrame(const FrameRequest& request);
+
+struct OutputFrame {
+  cv::Mat rgba;  // CV_8UC4, output size
+  FrameStats stats;
+};
+
+// The frame drawn by the CPU reference renderer (tests, and outputs that do not render).
 Result<OutputFrame> renderOutputFrame(const FrameRequest& request);
 
 }  // namespace procam::daemon

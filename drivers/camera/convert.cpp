@@ -49,6 +49,8 @@ const char* toString(procam_pixel_format pixel) {
       return "gray16";
     case PROCAM_PIXEL_RGB8:
       return "rgb8";
+    case PROCAM_PIXEL_RGBA8:
+      return "rgba8";
   }
   return "unknown";
 }
@@ -56,7 +58,16 @@ const char* toString(procam_pixel_format pixel) {
 namespace {
 
 int cvType(procam_pixel_format pixel) {
-  return pixel == PROCAM_PIXEL_GRAY16 ? CV_16UC1 : pixel == PROCAM_PIXEL_RGB8 ? CV_8UC3 : CV_8UC1;
+  switch (pixel) {
+    case PROCAM_PIXEL_GRAY16:
+      return CV_16UC1;
+    case PROCAM_PIXEL_RGB8:
+      return CV_8UC3;
+    case PROCAM_PIXEL_RGBA8:
+      return CV_8UC4;
+    default:
+      return CV_8UC1;
+  }
 }
 
 uint32_t minStride(SourceFormat f, uint32_t width) {

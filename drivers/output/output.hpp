@@ -2,6 +2,9 @@
 // A projector output: renders content through its renderer and presents the frame
 // (scan-out on a real display, memory for the headless output, the virtual rig for the
 // mock). Plain C++ interface; every implementation owns its handles (RAII).
+// Threads: an output is driven by one thread at a time. A GLES output leaves its context
+// free after creation and keeps it current on the thread that draws (a context switch per
+// frame would wait for the GPU); it can be destroyed on any thread.
 #include <cstdint>
 #include <functional>
 #include <opencv2/core.hpp>
@@ -23,6 +26,11 @@ class ProjectorOutput {
   // Renders and presents the content; false (nothing done) when neither content nor
   // geometry changed since the last frame.
   virtual Result<bool> show(const render::Content& content) = 0;
+  // The frame last presented (CV_8UC4 RGBA, row 0 at the top); may read it back from the
+  // GPU. kInvalidInput before the first frame.
+  virtual Result<void> readFrame(cv::Mat& rgba) = 0;
+  // The next show() draws even when nothing changed (something else was shown meanwhile).
+  virtual void redraw() = 0;
 };
 
 }  // namespace procam::output

@@ -18,6 +18,9 @@ class CpuRenderer final : public Renderer {
   Result<void> configure(const RenderSetup& setup) override;
   Result<bool> render(const Content& content) override;
   Result<void> readFrame(cv::Mat& out) override;
+  void redraw() override { gate_.geometryChanged(); }
+  // The current frame (CV_8UC4, output size), shared: valid until the next render.
+  const cv::Mat& frame() const { return frame_; }
 
   const WarpMap& map() const { return map_; }  // the main-path map of the current setup
   void setKernel(RemapKernel kernel) { kernel_ = kernel; }

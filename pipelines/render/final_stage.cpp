@@ -1,6 +1,7 @@
 #include "render/final_stage.hpp"
 
 #include <cmath>
+#include <cstring>
 
 namespace procam::render {
 
@@ -8,6 +9,18 @@ Lut FinalStage::identityLut() {
   Lut lut{};
   for (int i = 0; i < 256; ++i) lut[i] = static_cast<uint8_t>(i);
   return lut;
+}
+
+bool sameStage(const FinalStage& a, const FinalStage& b) {
+  if (a.weight_lut != b.weight_lut || a.output_lut != b.output_lut) return false;
+  if (a.alpha.empty() || b.alpha.empty()) return a.alpha.empty() == b.alpha.empty();
+  if (a.alpha.size() != b.alpha.size() || a.alpha.type() != b.alpha.type()) return false;
+  for (int y = 0; y < a.alpha.rows; ++y) {
+    if (std::memcmp(a.alpha.ptr(y), b.alpha.ptr(y), a.alpha.cols * a.alpha.elemSize()) != 0) {
+      return false;
+    }
+  }
+  return true;
 }
 
 bool FinalStage::isIdentity() const {

@@ -26,6 +26,9 @@ struct FinalStage {
   bool isIdentity() const;
 };
 
+// Same mask (by value) and lookup tables.
+bool sameStage(const FinalStage& a, const FinalStage& b);
+
 // weight_lut for a projector whose light output goes as code^gamma: weight a maps to
 // 255 * (a/255)^(1/gamma), so emitted light scales with a. kInvalidInput unless gamma > 0.
 Result<Lut> weightLutForGamma(double gamma);

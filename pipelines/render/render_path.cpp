@@ -11,7 +11,8 @@ Result<PathChoice> choosePath(const SceneTraits& scene) {
     case SurfaceKind::kPlanar:
       // A plane never pays for two passes: image content (or an untracked viewer) is one
       // homography; 3D content for a tracked viewer folds the homography into A'4x4 P_T.
-      c.path = scene.viewer == ViewerKind::kTracked && scene.content == ContentKind::kMesh3d
+      // A static viewer is a tracked one who stands still: the same single pass.
+      c.path = scene.viewer != ViewerKind::kUntracked && scene.content == ContentKind::kMesh3d
                    ? RenderPath::kPlanar3d
                    : RenderPath::kHomography;
       // Planar tiles are registered exactly by homography chains (§4.2.4): no grid warp.

@@ -7,7 +7,24 @@ bool validSize(cv::Size s) {
   return s.width > 0 && s.height > 0;
 }
 
+bool sameGrid(const WarpGrid& a, const WarpGrid& b) {
+  return a.cols == b.cols && a.rows == b.rows && a.origin == b.origin && a.step == b.step &&
+         a.source == b.source;
+}
+
 }  // namespace
+
+bool sameSetup(const RenderSetup& a, const RenderSetup& b) {
+  if (a.output_size != b.output_size || a.content_size != b.content_size || a.path != b.path ||
+      a.homography != b.homography || a.projector != b.projector || a.viewer != b.viewer ||
+      a.planar3d != b.planar3d || a.surface.vertices != b.surface.vertices ||
+      a.surface.triangles != b.surface.triangles || !sameGrid(a.lookup, b.lookup) ||
+      a.post_warp.has_value() != b.post_warp.has_value()) {
+    return false;
+  }
+  if (a.post_warp && !sameGrid(*a.post_warp, *b.post_warp)) return false;
+  return sameStage(a.final_stage, b.final_stage);
+}
 
 Result<void> validateSetup(const RenderSetup& s) {
   if (!validSize(s.output_size)) return fail(ErrorCode::kInvalidInput, "setup: empty output size");

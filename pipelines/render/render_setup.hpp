@@ -48,6 +48,10 @@ struct RenderSetup {
 // Checks sizes, finiteness and that the path's inputs are present.
 Result<void> validateSetup(const RenderSetup& setup);
 
+// True when both setups draw the same frame from the same content (every field equal,
+// masks and meshes compared by value): an output is configured again only when not.
+bool sameSetup(const RenderSetup& a, const RenderSetup& b);
+
 struct Content {
   const cv::Mat* image = nullptr;     // CV_8UC4 of content_size (image paths)
   const ColoredMesh* mesh = nullptr;  // kPlanar3d

@@ -19,6 +19,8 @@ class Renderer {
   virtual Result<bool> render(const Content& content) = 0;
   // Copies the current frame into `out` (CV_8UC4, output size, row 0 = top).
   virtual Result<void> readFrame(cv::Mat& out) = 0;
+  // The next render() draws even when nothing changed (the frame was overwritten).
+  virtual void redraw() = 0;
 };
 
 }  // namespace procam::render

@@ -34,12 +34,21 @@ class GlRenderer final : public render::Renderer {
   Result<void> configure(const render::RenderSetup& setup) override;
   Result<bool> render(const render::Content& content) override;
   Result<void> readFrame(cv::Mat& out) override;
+  void redraw() override { gate_.geometryChanged(); }
+
+  // Copies the offscreen frame to `framebuffer` (a window surface's, usually 0) with image
+  // row 0 at the top, as a display scans it out. kInvalidInput for a non-offscreen target.
+  Result<void> blitTo(GLuint framebuffer);
+  // Content uploads since creation (still content is uploaded once, not per frame).
+  uint64_t uploads() const { return uploads_; }
 
  private:
   struct Stage {
     Texture color;
     Renderbuffer depth;
     Framebuffer fbo;
+    cv::Size size;  // of the storage made; empty: none yet
+    bool with_depth = false;
   };
   struct Geometry {
     VertexArray vao;
@@ -51,7 +60,7 @@ class GlRenderer final : public render::Renderer {
 
   explicit GlRenderer(GlTarget target) : target_(target) {}
   Result<void> makeStage(Stage& stage, cv::Size size, bool with_depth);
-  Result<void> uploadContent(const cv::Mat& image);
+  Result<void> uploadContent(const cv::Mat& image, bool streaming);
   Result<void> upload3d(const render::ColoredMesh& mesh);
   void drawSampled(const SampleProgram& p, const Geometry& g, const Mat4& clip, const Mat4& tex,
                    GLuint source);
@@ -68,6 +77,21 @@ class GlRenderer final : public render::Renderer {
   Geometry main_, post_, quad_;
   Mat4 main_clip_ = Mat4::Identity(), main_tex_ = Mat4::Zero();
   Texture mask_, weight_lut_, output_lut_;
+  bool final_stage_made_ = false;
+  bool final_identity_ = false;  // the final stage changes nothing: skipped
+  cv::Size main_quad_size_;      // the homography quad's output size in main_ (empty: none)
+  cv::Size final_quad_size_;     // the final stage quad's
+  // The content texture holds version `uploaded_` while content_valid_; the main geometry
+  // holds the mesh of that version on the planar 3D path.
+  cv::Size content_size_;
+  bool content_valid_ = false;
+  uint64_t uploaded_ = 0;
+  uint64_t uploads_ = 0;
+  uint64_t renders_ = 0;      // render() calls that drew
+  uint64_t last_upload_ = 0;  // renders_ at the last upload
+  Buffer unpack_[2];          // pixel-buffer objects for content that changes every frame
+  size_t unpack_size_ = 0;
+  int unpack_next_ = 0;
 };
 
 // Upper-left 3x3 of a 4x4 set to m, rest zero (mat3 uniforms carried in mat4 slots).

@@ -1,7 +1,8 @@
 #pragma once
-// Output without a display: GLES 3 on Mesa's surfaceless EGL platform, frames rendered
-// into a framebuffer object, read back to memory, handed to a sink (the virtual rig) and
-// written as PNG on request.
+// Output without a display: GLES 3 on the surfaceless EGL platform, frames rendered
+// into a framebuffer object. With a sink (the virtual rig) every frame is read back to
+// memory and handed to it; without one a frame is read back only on request (readFrame,
+// lastFrame, writePng), so a frame costs the GPU's time alone.
 #include <memory>
 #include <string>
 
@@ -21,12 +22,15 @@ class HeadlessOutput final : public ProjectorOutput {
   cv::Size size() const override { return size_; }
   Result<void> configure(const render::RenderSetup& setup) override;
   Result<bool> show(const render::Content& content) override;
+  Result<void> readFrame(cv::Mat& rgba) override;
+  void redraw() override { renderer_->redraw(); }
 
   void setSink(FrameSink sink) { sink_ = std::move(sink); }
-  const cv::Mat& lastFrame() const { return frame_; }  // RGBA, empty before the first frame
+  // RGBA, empty before the first frame (read back when needed).
+  const cv::Mat& lastFrame();
   uint64_t frameCount() const { return frames_; }
   // Writes the last frame as an RGBA PNG; kInvalidInput before the first frame, kIo on failure.
-  Result<void> writePng(const std::string& path) const;
+  Result<void> writePng(const std::string& path);
   std::string glRenderer() const { return context_->renderer(); }
 
  private:
@@ -37,6 +41,7 @@ class HeadlessOutput final : public ProjectorOutput {
   cv::Size size_;
   cv::Mat frame_;
   uint64_t frames_ = 0;
+  uint64_t read_ = 0;  // the frame number frame_ holds
   FrameSink sink_;
 };
 

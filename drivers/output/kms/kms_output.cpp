@@ -57,7 +57,11 @@ Result<std::unique_ptr<KmsOutput>> KmsOutput::create(const KmsConfig& config) {
   auto ctx = egl::EglContext::forGbm(out->gbm_, out->surface_, GBM_FORMAT_XRGB8888);
   if (!ctx) return tl::unexpected(ctx.error());
   out->context_ = std::move(*ctx);
-  auto r = gl::GlRenderer::create(gl::GlTarget{false, 0});
+  egl::CurrentScope current(*out->context_);
+  if (auto ok = current.bind(); !ok) return tl::unexpected(ok.error());
+  // Rendered offscreen and blitted to the scan-out buffer, so that the frame shown can be
+  // read back (status, snapshots) after the swap made the window's buffer undefined.
+  auto r = gl::GlRenderer::create(gl::GlTarget{true, 0});
   if (!r) return tl::unexpected(r.error());
   out->renderer_ = std::move(*r);
   return out;
@@ -65,8 +69,11 @@ Result<std::unique_ptr<KmsOutput>> KmsOutput::create(const KmsConfig& config) {
 
 KmsOutput::~KmsOutput() {
   if (flip_pending_) (void)waitForFlip();
-  if (context_ && renderer_) (void)context_->makeCurrent();
-  renderer_.reset();
+  if (context_ && renderer_) {
+    egl::CurrentScope current(*context_);
+    (void)current.bind();
+    renderer_.reset();
+  }
   context_.reset();
   if (saved_crtc_) {
     // Give the display back as it was found.
@@ -92,8 +99,14 @@ Result<bool> KmsOutput::show(const render::Content& content) {
   if (auto ok = context_->makeCurrent(); !ok) return tl::unexpected(ok.error());
   auto rendered = renderer_->render(content);
   if (!rendered || !*rendered) return rendered;
+  if (auto ok = renderer_->blitTo(0); !ok) return tl::unexpected(ok.error());
   if (auto ok = present(); !ok) return tl::unexpected(ok.error());
   return true;
+}
+
+Result<void> KmsOutput::readFrame(cv::Mat& rgba) {
+  if (auto ok = context_->makeCurrent(); !ok) return ok;
+  return renderer_->readFrame(rgba);
 }
 
 Result<uint32_t> KmsOutput::framebufferFor(gbm_bo* bo) {

@@ -33,6 +33,8 @@ class KmsOutput final : public ProjectorOutput {
   cv::Size size() const override { return {mode_.hdisplay, mode_.vdisplay}; }
   Result<void> configure(const render::RenderSetup& setup) override;
   Result<bool> show(const render::Content& content) override;
+  Result<void> readFrame(cv::Mat& rgba) override;
+  void redraw() override { renderer_->redraw(); }
 
   const FrameStats& stats() const { return stats_; }
   const std::string& connectorName() const { return connector_name_; }

@@ -36,4 +36,10 @@ Result<bool> MockOutput::show(const render::Content& content) {
   return true;
 }
 
+Result<void> MockOutput::readFrame(cv::Mat& rgba) {
+  if (frame_.empty()) return fail(ErrorCode::kInvalidInput, "mock output: no frame yet");
+  rgba = frame_;
+  return {};
+}
+
 }  // namespace procam::output

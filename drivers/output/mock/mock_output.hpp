@@ -23,6 +23,8 @@ class MockOutput final : public ProjectorOutput {
   cv::Size size() const override { return size_; }
   Result<void> configure(const render::RenderSetup& setup) override;
   Result<bool> show(const render::Content& content) override;
+  Result<void> readFrame(cv::Mat& rgba) override;
+  void redraw() override { renderer_.redraw(); }
 
   const cv::Mat& lastFrame() const { return frame_; }  // RGBA
 

@@ -1,17 +1,20 @@
 // The projector outputs behind the driver plugin ABI (plugins/include/procamd/
-// procam_plugin.h): "headless" (EGL surfaceless, frames kept in memory) and, when built,
-// "kms" (DRM/KMS scan-out). A frame handed over the ABI is shown 1:1: the output's
-// renderer runs the identity homography and the final stage.
+// procam_plugin.h): "headless" (EGL surfaceless, frames kept on the GPU) and, when built,
+// "kms" (DRM/KMS scan-out). Both render by themselves (output operations version 2): the
+// daemon's render setup is drawn by the GLES renderer, content is uploaded only when its
+// version changes. A frame handed over with `show` is shown 1:1 (identity homography).
 #include <procamd/procam_plugin.h>
 
 #include <climits>
 #include <cstring>
 #include <memory>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <string>
 
 #include "headless/headless_output.hpp"
 #include "support/driver_support.hpp"
+#include "support/render_abi.hpp"
 #if PROCAM_OUTPUT_PLUGIN_KMS
 #include "kms/kms_output.hpp"
 #endif
@@ -19,11 +22,18 @@
 namespace procam::output {
 namespace {
 
+// Versions of frames shown 1:1 have the top bit set, so that they never equal the
+// daemon's content versions in the renderer's upload check.
+constexpr uint64_t kShowVersion = 1ull << 63;
+
 struct Device {
   std::unique_ptr<ProjectorOutput> out;
   double refresh_hz = 0;
-  cv::Mat rgba;
-  uint64_t version = 0;
+  cv::Mat rgba;                              // a frame shown 1:1, converted
+  uint64_t shown = 0;                        // frames shown 1:1
+  bool showing = true;                       // configured for 1:1 frames
+  std::optional<render::RenderSetup> setup;  // the daemon's, once configured
+  plugins::MeshCache mesh;
 };
 
 int getMode(void* self, uint32_t* w, uint32_t* h, double* hz) {
@@ -35,6 +45,14 @@ int getMode(void* self, uint32_t* w, uint32_t* h, double* hz) {
   return PROCAM_OK;
 }
 
+Result<void> configureOneToOne(Device& d) {
+  render::RenderSetup setup;
+  setup.output_size = setup.content_size = d.out->size();
+  if (auto ok = d.out->configure(setup); !ok) return ok;
+  d.showing = true;
+  return {};
+}
+
 int show(void* self, const procam_image* frame, char* err, size_t err_len) {
   try {
     auto* d = static_cast<Device*>(self);
@@ -42,16 +60,78 @@ int show(void* self, const procam_image* frame, char* err, size_t err_len) {
     if (!frame || !frame->data || int(frame->width) != s.width || int(frame->height) != s.height) {
       return plugins::report(err, err_len, "frame must match the output mode", PROCAM_EINVAL);
     }
-    const int type = frame->format == PROCAM_PIXEL_RGB8    ? CV_8UC3
+    const int type = frame->format == PROCAM_PIXEL_RGBA8   ? CV_8UC4
+                     : frame->format == PROCAM_PIXEL_RGB8  ? CV_8UC3
                      : frame->format == PROCAM_PIXEL_GRAY8 ? CV_8UC1
                                                            : -1;
     if (type < 0) {
-      return plugins::report(err, err_len, "outputs take RGB8 or GRAY8 frames", PROCAM_EINVAL);
+      return plugins::report(err, err_len, "outputs take RGBA8, RGB8 or GRAY8 frames",
+                             PROCAM_EINVAL);
+    }
+    if (!d->showing) {
+      if (auto ok = configureOneToOne(*d); !ok) return plugins::report(err, err_len, ok.error());
     }
     const cv::Mat in(s, type, frame->data, frame->stride);
-    cv::cvtColor(in, d->rgba, type == CV_8UC3 ? cv::COLOR_RGB2RGBA : cv::COLOR_GRAY2RGBA);
-    auto shown = d->out->show({&d->rgba, nullptr, ++d->version});
+    if (type == CV_8UC4) {
+      d->rgba = in;  // no copy: the renderer uploads it during show
+    } else {
+      cv::cvtColor(in, d->rgba, type == CV_8UC3 ? cv::COLOR_RGB2RGBA : cv::COLOR_GRAY2RGBA);
+    }
+    auto shown = d->out->show({&d->rgba, nullptr, kShowVersion | ++d->shown});
+    d->rgba.release();
     if (!shown) return plugins::report(err, err_len, shown.error());
+    return PROCAM_OK;
+  } catch (const std::exception& e) {
+    return plugins::report(err, err_len, e.what(), PROCAM_EINTERNAL);
+  }
+}
+
+int configure(void* self, const procam_render_setup* setup, char* err, size_t err_len) {
+  try {
+    auto* d = static_cast<Device*>(self);
+    if (!setup) return plugins::report(err, err_len, "no render setup", PROCAM_EINVAL);
+    auto s = plugins::setupFromAbi(*setup);
+    if (!s) return plugins::report(err, err_len, s.error());
+    if (s->output_size != d->out->size()) {
+      return plugins::report(err, err_len, "render setup size differs from the output mode",
+                             PROCAM_EINVAL);
+    }
+    if (auto ok = d->out->configure(*s); !ok) return plugins::report(err, err_len, ok.error());
+    d->setup = std::move(*s);
+    d->showing = false;
+    return PROCAM_OK;
+  } catch (const std::exception& e) {
+    return plugins::report(err, err_len, e.what(), PROCAM_EINTERNAL);
+  }
+}
+
+int render(void* self, const procam_content* content, int* out_drawn, procam_frame_stats* stats,
+           char* err, size_t err_len) {
+  try {
+    auto* d = static_cast<Device*>(self);
+    if (out_drawn) *out_drawn = 0;
+    if (!d->setup) return plugins::report(err, err_len, "render before configure", PROCAM_EINVAL);
+    if (!content) return plugins::report(err, err_len, "no content", PROCAM_EINVAL);
+    if (d->showing) {
+      // A 1:1 frame was shown meanwhile: back to the daemon's setup, drawn again.
+      if (auto ok = d->out->configure(*d->setup); !ok) {
+        return plugins::report(err, err_len, ok.error());
+      }
+      d->showing = false;
+    }
+    cv::Mat header;
+    auto c = plugins::contentFromAbi(*content, *d->setup, header, d->mesh);
+    if (!c) return plugins::report(err, err_len, c.error());
+    auto drawn = d->out->show(*c);
+    if (!drawn) return plugins::report(err, err_len, drawn.error());
+    if (out_drawn) *out_drawn = *drawn ? 1 : 0;
+    if (stats) {
+      cv::Mat frame;
+      if (auto ok = d->out->readFrame(frame); !ok) return plugins::report(err, err_len, ok.error());
+      auto st = plugins::abiFrameStats(frame);
+      if (!st) return plugins::report(err, err_len, st.error());
+      *stats = *st;
+    }
     return PROCAM_OK;
   } catch (const std::exception& e) {
     return plugins::report(err, err_len, e.what(), PROCAM_EINTERNAL);
@@ -65,12 +145,10 @@ void destroy(void* self) {
   delete static_cast<Device*>(self);
 }
 
-const procam_output_ops kOps = {PROCAM_OUTPUT_OPS_VERSION, &getMode, &show};
+const procam_output_ops kOps = {PROCAM_OUTPUT_OPS_VERSION, &getMode, &show, &configure, &render};
 
 int finish(std::unique_ptr<Device> d, procam_device* out, char* err, size_t err_len) {
-  render::RenderSetup setup;
-  setup.output_size = setup.content_size = d->out->size();
-  if (auto ok = d->out->configure(setup); !ok) return plugins::report(err, err_len, ok.error());
+  if (auto ok = configureOneToOne(*d); !ok) return plugins::report(err, err_len, ok.error());
   out->family = PROCAM_FAMILY_OUTPUT;
   out->self = d.release();
   out->poll_fd = &noPollFd;

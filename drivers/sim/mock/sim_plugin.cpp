@@ -6,13 +6,16 @@
 #include <memory>
 #include <mutex>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "render/cpu_renderer.hpp"
 #include "sim/sensors.hpp"
 #include "sim_unplug.hpp"
 #include "sim_world.hpp"
 #include "support/driver_support.hpp"
+#include "support/render_abi.hpp"
 
 namespace procam::sim::mock {
 namespace {
@@ -22,10 +25,20 @@ constexpr int kSimScore = 100;
 using plugins::property;
 using plugins::report;
 
+// An output's own renderer (output operations version 2): one CPU reference renderer per
+// output, its warp map built once per render setup.
+struct OutputRender {
+  render::CpuRenderer renderer;
+  std::optional<render::RenderSetup> setup;
+  bool showing = true;  // a frame shown 1:1 replaced the rendered one
+  plugins::MeshCache mesh;
+};
+
 struct Device {
   std::shared_ptr<SimWorld> world;
   std::string name;
   std::vector<uint8_t> buffer;  // camera frames
+  std::unique_ptr<OutputRender> output;
 };
 
 // PROCAM_OK while the device is plugged in (sim_unplug.hpp).
@@ -120,7 +133,10 @@ int outputShow(void* self, const procam_image* frame, char* err, size_t len) {
   }
   try {
     cv::Mat bgr;
-    if (frame->format == PROCAM_PIXEL_RGB8) {
+    if (frame->format == PROCAM_PIXEL_RGBA8) {
+      cv::cvtColor(cv::Mat(frame->height, frame->width, CV_8UC4, frame->data, frame->stride), bgr,
+                   cv::COLOR_RGBA2BGR);
+    } else if (frame->format == PROCAM_PIXEL_RGB8) {
       cv::cvtColor(cv::Mat(frame->height, frame->width, CV_8UC3, frame->data, frame->stride), bgr,
                    cv::COLOR_RGB2BGR);
     } else if (frame->format == PROCAM_PIXEL_GRAY8) {
@@ -131,12 +147,72 @@ int outputShow(void* self, const procam_image* frame, char* err, size_t len) {
       return report(err, len, "unsupported pixel format", PROCAM_EINVAL);
     }
     dev->world->show(dev->name, std::move(bgr));
+    if (dev->output) dev->output->showing = true;
   } catch (const std::exception& e) {
     return report(err, len, e.what(), PROCAM_EINTERNAL);
   }
   return PROCAM_OK;
 }
-const procam_output_ops kOutputOps = {PROCAM_OUTPUT_OPS_VERSION, outputMode, outputShow};
+
+int outputConfigure(void* self, const procam_render_setup* setup, char* err, size_t len) {
+  auto* dev = static_cast<Device*>(self);
+  const ProjectorSpec* p = projectorSpec(dev);
+  if (!p) return report(err, len, "projector gone", PROCAM_ENODEV);
+  if (int rc = presence(dev->name, err, len); rc != PROCAM_OK) return rc;
+  try {
+    if (!setup) return report(err, len, "no render setup", PROCAM_EINVAL);
+    auto s = plugins::setupFromAbi(*setup);
+    if (!s) return report(err, len, s.error().message, PROCAM_EINVAL);
+    if (s->output_size != cv::Size(p->width, p->height)) {
+      return report(err, len, "render setup size differs from the projector's", PROCAM_EINVAL);
+    }
+    if (!dev->output) dev->output = std::make_unique<OutputRender>();
+    if (auto ok = dev->output->renderer.configure(*s); !ok) {
+      return report(err, len, ok.error().message, PROCAM_EINVAL);
+    }
+    dev->output->setup = std::move(*s);
+    return PROCAM_OK;
+  } catch (const std::exception& e) {
+    return report(err, len, e.what(), PROCAM_EINTERNAL);
+  }
+}
+
+int outputRender(void* self, const procam_content* content, int* drawn, procam_frame_stats* stats,
+                 char* err, size_t len) {
+  auto* dev = static_cast<Device*>(self);
+  if (drawn) *drawn = 0;
+  if (int rc = presence(dev->name, err, len); rc != PROCAM_OK) return rc;
+  try {
+    OutputRender* o = dev->output.get();
+    if (!o || !o->setup) return report(err, len, "render before configure", PROCAM_EINVAL);
+    if (!content) return report(err, len, "no content", PROCAM_EINVAL);
+    cv::Mat header;
+    auto c = plugins::contentFromAbi(*content, *o->setup, header, o->mesh);
+    if (!c) return report(err, len, c.error().message, PROCAM_EINVAL);
+    if (o->showing) o->renderer.redraw();
+    auto rendered = o->renderer.render(*c);
+    if (!rendered) return report(err, len, rendered.error().message, PROCAM_EINVAL);
+    if (*rendered || o->showing) {
+      // The simulated projector lights the world with a BGR frame.
+      cv::Mat bgr;
+      cv::cvtColor(o->renderer.frame(), bgr, cv::COLOR_RGBA2BGR);
+      dev->world->show(dev->name, std::move(bgr));
+      o->showing = false;
+      if (drawn) *drawn = 1;
+    }
+    if (stats) {
+      auto st = plugins::abiFrameStats(o->renderer.frame());
+      if (!st) return report(err, len, st.error().message, PROCAM_EINTERNAL);
+      *stats = *st;
+    }
+    return PROCAM_OK;
+  } catch (const std::exception& e) {
+    return report(err, len, e.what(), PROCAM_EINTERNAL);
+  }
+}
+
+const procam_output_ops kOutputOps = {PROCAM_OUTPUT_OPS_VERSION, outputMode, outputShow,
+                                      outputConfigure, outputRender};
 
 // --- camera ---
 const CameraSpec* cameraSpec(const Device* dev) {
@@ -212,7 +288,7 @@ int create(const procam_device_desc* d, const procam_config*, procam_device* out
     if (int rc = presence(name, err, len); rc != PROCAM_OK) return rc;
     auto world = SimWorld::open(scene);
     if (!world) return report(err, len, world.error().message, PROCAM_EINVAL);
-    auto dev = std::make_unique<Device>(Device{*world, name, {}});
+    auto dev = std::make_unique<Device>(Device{*world, name, {}, nullptr});
     bool known = false;
     const Scene& s = (*world)->scene();
     if constexpr (Family == PROCAM_FAMILY_CAMERA) {

@@ -40,7 +40,7 @@ extern "C" {
 #define PROCAM_CAMERA_OPS_VERSION 1u
 #define PROCAM_TILT_OPS_VERSION 1u
 #define PROCAM_TRACKER_OPS_VERSION 1u
-#define PROCAM_OUTPUT_OPS_VERSION 1u
+#define PROCAM_OUTPUT_OPS_VERSION 2u
 
 #define PROCAM_PLUGIN_ABI_SYMBOL "procam_plugin_abi_version"
 #define PROCAM_PLUGIN_ENTRY_SYMBOL "procam_plugin_entry"
@@ -91,7 +91,8 @@ typedef struct procam_config {
 typedef enum procam_pixel_format {
   PROCAM_PIXEL_GRAY8 = 1,
   PROCAM_PIXEL_GRAY16 = 2,
-  PROCAM_PIXEL_RGB8 = 3
+  PROCAM_PIXEL_RGB8 = 3,
+  PROCAM_PIXEL_RGBA8 = 4 /* R G B A bytes; outputs take it without conversion */
 } procam_pixel_format;
 
 typedef struct procam_image {
@@ -151,11 +152,97 @@ typedef struct procam_tracker_ops {
   int (*get_rate)(void* self, double* out_hz);
 } procam_tracker_ops;
 
-/* Projector output: shows one full frame of the mode's size. */
+/* Projector output.
+ *
+ * Version 1: `get_mode` and `show`, one full frame of the mode's size shown 1:1
+ * (calibration patterns, latency probes).
+ *
+ * Version 2 adds rendering by the output itself: the daemon hands over the
+ * geometry once (`configure`, a render setup: which path, its matrices, meshes,
+ * warp grids, the blending stage) and then the content (`render`), and the
+ * output draws the frame on its own back-end (GLES outputs on the GPU, CPU
+ * outputs with a warp map built once per setup). `configure` is called again
+ * only when the geometry changes; `render` re-draws only when the content's
+ * version or the geometry changed since the last frame. Everything a setup or
+ * content points to is only valid during the call: an output copies what it
+ * keeps. Paths, matrices and conventions: ARCHITECTURE.md ("Rendering"). */
+typedef enum procam_render_path {
+  PROCAM_RENDER_HOMOGRAPHY = 1,    /* projector pixel ~ H content pixel */
+  PROCAM_RENDER_PLANAR_3D = 2,     /* mesh content through A'4x4 (world -> pixel, depth) */
+  PROCAM_RENDER_TWO_PASS_MESH = 3, /* content = the viewer's image, projected on the surface */
+  PROCAM_RENDER_LOOKUP_WARP = 4    /* per-node content coordinates of every output pixel */
+} procam_render_path;
+
+/* A warp grid: `cols` x `rows` nodes (>= 2 each) at output pixels origin + (i, j) step,
+ * each holding the source pixel it shows as (x, y) in `source`, row-major. Between
+ * nodes the warp is linear over two triangles per cell split from node (i, j) to
+ * (i + 1, j + 1). cols == 0: no grid. */
+typedef struct procam_warp_grid {
+  uint32_t cols, rows;
+  double origin[2];
+  double step[2];
+  const double* source;
+} procam_warp_grid;
+
+typedef struct procam_render_setup {
+  uint32_t output_width, output_height;   /* the output's mode */
+  uint32_t content_width, content_height; /* image paths */
+  procam_render_path path;
+  double homography[9]; /* HOMOGRAPHY, row-major */
+  double planar3d[16];  /* PLANAR_3D, row-major: world -> (x w, y w, z w, w), z in [-1, 1] */
+  /* TWO_PASS_MESH: the display surface (world, metres) and the 3x4 row-major
+   * world -> projector and world -> content pixel matrices. */
+  const double* surface_vertices; /* 3 per vertex */
+  size_t n_surface_vertices;
+  const int32_t* surface_triangles; /* 3 per triangle */
+  size_t n_surface_triangles;
+  double projector[12];
+  double viewer[12];
+  procam_warp_grid lookup;    /* LOOKUP_WARP */
+  procam_warp_grid post_warp; /* optional, any path: output pixel -> rendered pixel */
+  /* The final stage, always last: alpha mask (output size, NULL = all 255), weight
+   * LUT (256 entries, NULL = identity), output LUT (3 x 256, R then G then B; NULL =
+   * identity): w = weight_lut[alpha], v = (c w + 127) / 255, out = output_lut[c][v]. */
+  const uint8_t* alpha;
+  uint32_t alpha_stride;
+  const uint8_t* weight_lut;
+  const uint8_t* output_lut;
+} procam_render_setup;
+
+/* Content for `render`: an RGBA8 image of the setup's content size (image paths) or
+ * a mesh with one RGBA colour per vertex (PLANAR_3D). `version` changes whenever the
+ * content changes: an output uploads content only when it does. */
+typedef struct procam_content {
+  const procam_image* image;
+  const double* mesh_vertices; /* 3 per vertex, world metres */
+  const uint8_t* mesh_colors;  /* 4 per vertex */
+  size_t n_mesh_vertices;
+  const int32_t* mesh_triangles; /* 3 per triangle */
+  size_t n_mesh_triangles;
+  uint64_t version;
+} procam_content;
+
+/* What a frame holds, for status: the fraction of pixels with any colour channel
+ * above 0 and the mean of R, G, B (0..255). */
+typedef struct procam_frame_stats {
+  double lit_fraction;
+  double mean_rgb[3];
+} procam_frame_stats;
+
 typedef struct procam_output_ops {
   uint32_t version; /* PROCAM_OUTPUT_OPS_VERSION */
   int (*get_mode)(void* self, uint32_t* out_width, uint32_t* out_height, double* out_refresh_hz);
+  /* Shows one frame 1:1 (RGB8, RGBA8 or GRAY8 of the mode's size); the frame
+   * replaces whatever `render` drew until the next `render`. */
   int (*show)(void* self, const procam_image* frame, char* err, size_t err_len);
+  /* Version 2. */
+  int (*configure)(void* self, const procam_render_setup* setup, char* err, size_t err_len);
+  /* Draws and presents the content through the configured setup. `*out_drawn` = 1
+   * when a frame was drawn, 0 when neither content version nor geometry changed.
+   * `stats` may be NULL; when not, it receives the current frame's statistics
+   * (drawn or not), which may cost a GPU read-back. */
+  int (*render)(void* self, const procam_content* content, int* out_drawn,
+                procam_frame_stats* stats, char* err, size_t err_len);
 } procam_output_ops;
 
 /* A created device. `poll_fd` returns a file descriptor the daemon may watch

@@ -223,11 +223,12 @@ TEST(OutputFrames, PatternsContentAndTheWarp) {
   FrameRequest r;
   r.output_size = cv::Size(64, 32);
   r.pattern = "white";
+  r.pattern_image = patternImage(r.pattern, r.output_size);
   auto white = renderOutputFrame(r);
   ASSERT_TRUE(white) << white.error().message;
   EXPECT_EQ(white->stats.source, "pattern:white");
   EXPECT_DOUBLE_EQ(white->stats.lit_fraction, 1.0);
-  EXPECT_EQ(white->rgb.size(), r.output_size);
+  EXPECT_EQ(white->rgba.size(), r.output_size);
 
   // Half size towards the origin, pixel edges to pixel edges: the top-left
   // quarter (32 x 16 pixel centres) is lit.
@@ -250,14 +251,14 @@ TEST(OutputFrames, PatternsContentAndTheWarp) {
   EXPECT_DOUBLE_EQ(fitted->stats.lit_fraction, 0.5);
   EXPECT_DOUBLE_EQ(fitted->stats.mean_rgb[0], 127.5);
   EXPECT_DOUBLE_EQ(fitted->stats.mean_rgb[1], 0.0);
-  EXPECT_EQ(fitted->rgb.at<cv::Vec3b>(16, 32), cv::Vec3b(255, 0, 0));  // R G B
-  EXPECT_EQ(fitted->rgb.at<cv::Vec3b>(16, 8), cv::Vec3b(0, 0, 0));
+  EXPECT_EQ(fitted->rgba.at<cv::Vec4b>(16, 32), cv::Vec4b(255, 0, 0, 255));  // R G B A
+  EXPECT_EQ(fitted->rgba.at<cv::Vec4b>(16, 8), cv::Vec4b(0, 0, 0, 0));
 
   r.content.reset();
   auto none = renderOutputFrame(r);
   ASSERT_TRUE(none);
   EXPECT_EQ(none->stats.source, "none");
-  EXPECT_EQ(cv::countNonZero(none->rgb.reshape(1)), 0);
+  EXPECT_EQ(cv::countNonZero(none->rgba.reshape(1)), 0);
 }
 
 TEST(OutputFrames, DecodedContentIsRgba) {

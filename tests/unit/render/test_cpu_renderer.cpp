@@ -20,6 +20,8 @@ TEST(RenderPath, FollowsTheDesignTable) {
             RenderPath::kHomography);
   EXPECT_EQ(pick(SurfaceKind::kPlanar, ViewerKind::kTracked, ContentKind::kMesh3d, 1).path,
             RenderPath::kPlanar3d);
+  EXPECT_EQ(pick(SurfaceKind::kPlanar, ViewerKind::kStatic, ContentKind::kMesh3d, 1).path,
+            RenderPath::kPlanar3d);
   const auto tiled = pick(SurfaceKind::kPlanar, ViewerKind::kUntracked, ContentKind::kImage, 3);
   EXPECT_EQ(tiled.path, RenderPath::kHomography);
   EXPECT_TRUE(tiled.blend);

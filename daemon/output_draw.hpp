@@ -1,0 +1,48 @@
+#pragma once
+// Drawing the outputs. Each output renders its own frame from a render setup and content
+// (procam_plugin.h, output operations version 2): the setup is handed over only when the
+// geometry changed, the content with a version that changes only when the content does.
+// An output whose driver lacks those operations gets its frame from a CPU reference
+// renderer kept for it (its warp map built once per setup) through `show`. The daemon plans
+// on the loop (daemon_keystone.cpp) and draws on its compute worker.
+#include <memory>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+
+#include "core/error.hpp"
+#include "driver.hpp"
+#include "render/cpu_renderer.hpp"
+#include "render/frame_stats.hpp"
+#include "render/render_setup.hpp"
+
+namespace procam::daemon {
+
+struct OutputDraw {
+  std::string name;
+  std::shared_ptr<plugins::Device> device;  // kept alive while the draw runs
+  std::shared_ptr<const render::RenderSetup> setup;
+  bool configure = false;                // hand the setup over first (the geometry changed)
+  std::shared_ptr<const cv::Mat> image;  // RGBA content (image paths)
+  std::shared_ptr<const render::ColoredMesh> mesh;  // planar 3D path
+  uint64_t version = 0;                             // of the content
+  bool want_stats = false;
+  std::string source;                             // FrameStats::source of this frame
+  std::shared_ptr<render::CpuRenderer> fallback;  // set: the output does not render itself
+};
+
+struct OutputDrawn {
+  std::string name;
+  std::string source;
+  bool ok = false;
+  bool drawn = false;       // a new frame is shown
+  bool configured = false;  // the setup was handed over and taken
+  int rc = 0;               // the driver's status when !ok (PROCAM_ENODEV: gone)
+  std::string error;
+  std::optional<render::FrameStats> stats;
+};
+
+// Runs on a worker; never throws.
+OutputDrawn drawOutput(const OutputDraw& job);
+
+}  // namespace procam::daemon

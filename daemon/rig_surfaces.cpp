@@ -1,0 +1,128 @@
+// The rig's display surfaces as the renderer needs them: the per-projector mesh files of
+// rig.json read on the I/O worker, and the render setup of image content on a non-planar
+// surface for the viewer ([Raskar02] §3.2.3 two-pass for a tracked viewer, §4.1.5 lookup
+// warp for a static one; render/viewer_view.hpp).
+#include <filesystem>
+
+#include "content/mesh_content.hpp"
+#include "daemon.hpp"
+#include "log.hpp"
+#include "render/viewer_view.hpp"
+
+namespace procam::daemon {
+namespace {
+
+// A mesh named in rig.json is a file in the state directory, never a path out of it.
+bool plainFileName(const std::string& name) {
+  return !name.empty() && name.find('/') == std::string::npos && name[0] != '.';
+}
+
+}  // namespace
+
+void Daemon::loadRigSurfaces() {
+  const uint64_t generation = ++rig_generation_;
+  std::map<std::string, std::string> files = rig_.surface.meshes;
+  if (!rig_.surface.unified_mesh.empty()) files[""] = rig_.surface.unified_mesh;
+  if (files.empty()) {
+    rig_surfaces_.clear();
+    return;
+  }
+  io_worker_->submit([this, generation, files, dir = options_.state_dir] {
+    auto loaded = std::make_shared<std::map<std::string, std::shared_ptr<const RigSurfaceMesh>>>();
+    auto problems = std::make_shared<std::vector<std::string>>();
+    for (const auto& [projector, file] : files) {
+      if (!plainFileName(file)) {
+        problems->push_back("surface mesh '" + file +
+                            "' is not a file name in the state directory");
+        continue;
+      }
+      auto mesh = content::loadMeshContent(std::filesystem::path(dir) / file);
+      if (!mesh) {
+        problems->push_back("surface mesh " + file + ": " + mesh.error().message);
+        continue;
+      }
+      render::SurfaceMesh surface;
+      surface.vertices = mesh->mesh.vertices;
+      for (const auto& f : mesh->mesh.faces) surface.triangles.push_back({f.x(), f.y(), f.z()});
+      auto intersector = geom::MeshIntersector::build(std::move(mesh->mesh));
+      if (!intersector) {
+        problems->push_back("surface mesh " + file + ": " + intersector.error().message);
+        continue;
+      }
+      (*loaded)[projector] = std::make_shared<const RigSurfaceMesh>(
+          RigSurfaceMesh{std::move(*intersector), std::move(surface)});
+    }
+    return [this, generation, loaded, problems] {
+      for (const auto& p : *problems) warn(p);
+      if (generation != rig_generation_) return;  // the rig changed again meanwhile
+      rig_surfaces_ = std::move(*loaded);
+      refreshOutputs();
+    };
+  });
+}
+
+std::optional<Vec3> Daemon::viewerEye() const {
+  if (const nlohmann::json v = viewerJson(); v.is_object() && v["position"].is_array()) {
+    return Vec3(v["position"][0].get<double>(), v["position"][1].get<double>(),
+                v["position"][2].get<double>());
+  }
+  if (const auto& c = config_.content_viewer) return Vec3((*c)[0], (*c)[1], (*c)[2]);
+  return rig_.viewer.position;
+}
+
+Result<std::shared_ptr<const render::RenderSetup>> Daemon::nonPlanarSetup(const std::string& output,
+                                                                          cv::Size mode,
+                                                                          cv::Size content) {
+  const render::SceneTraits traits = sceneTraits(output, false);
+  if (traits.surface != render::SurfaceKind::kNonPlanar) {
+    return fail(ErrorCode::kNotFound, "the surface is planar");
+  }
+  const rig::RigProjector* p = rig_.projectorForOutput(output);
+  if (!p || !p->pose_known) return fail(ErrorCode::kNotFound, "the projector has no pose");
+  if (p->width != mode.width || p->height != mode.height) {
+    return fail(ErrorCode::kNotFound, "the output's mode differs from the calibrated projector's");
+  }
+  auto surface = rig_surfaces_.find(p->name);
+  if (surface == rig_surfaces_.end()) surface = rig_surfaces_.find("");
+  if (surface == rig_surfaces_.end()) {
+    return fail(ErrorCode::kNotFound, "the surface mesh is not loaded");
+  }
+  const auto eye = viewerEye();
+  if (!eye) {
+    return fail(ErrorCode::kNotFound,
+                "no viewer ([content] viewer, a tracker or the rig model's viewer)");
+  }
+  const Mat34 P = p->model().projectionMatrix();
+  auto& st = keystone_rt_.output_state[output];
+  const bool tracked = traits.viewer == render::ViewerKind::kTracked;
+  if (st.np_setup && st.np_surface == surface->second && st.np_eye == *eye &&
+      st.np_content == content && st.np_projector == P && st.np_tracked == tracked) {
+    return st.np_setup;
+  }
+  auto V = render::viewerContentMatrix(surface->second->intersector, P, mode, *eye, content);
+  if (!V) return tl::unexpected(V.error());
+  render::RenderSetup setup;
+  setup.output_size = mode;
+  setup.content_size = content;
+  if (tracked) {
+    setup.path = render::RenderPath::kTwoPassMesh;
+    setup.surface = surface->second->mesh;
+    setup.projector = P;
+    setup.viewer = *V;
+  } else {
+    setup.path = render::RenderPath::kLookupWarp;
+    auto grid = render::lookupGridForViewer(surface->second->intersector, P, mode, *V);
+    if (!grid) return tl::unexpected(grid.error());
+    setup.lookup = std::move(*grid);
+    setup.viewer = *V;  // reported in status; the grid is what is drawn
+  }
+  st.np_setup = std::make_shared<const render::RenderSetup>(std::move(setup));
+  st.np_surface = surface->second;
+  st.np_eye = *eye;
+  st.np_content = content;
+  st.np_projector = P;
+  st.np_tracked = tracked;
+  return st.np_setup;
+}
+
+}  // namespace procam::daemon

@@ -1,0 +1,173 @@
+#include "render/viewer_view.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
+
+#include "keystone/inscribed_rect.hpp"
+
+namespace procam::render {
+namespace {
+
+struct ProjectorRays {
+  Mat3 Minv;
+  Vec3 centre;
+  geom::Ray through(double x, double y) const {
+    return {centre, (Minv * Vec3(x, y, 1)).normalized()};
+  }
+};
+
+Result<ProjectorRays> raysOf(const Mat34& P) {
+  const Mat3 M = P.leftCols<3>();
+  if (!P.allFinite() || std::abs(M.determinant()) < 1e-300) {
+    return fail(ErrorCode::kInvalidInput, "viewer view: singular projector matrix");
+  }
+  const Mat3 Minv = M.inverse();
+  return ProjectorRays{Minv, -Minv * P.col(3)};
+}
+
+}  // namespace
+
+Result<Mat34> viewerContentMatrix(const geom::MeshIntersector& surface, const Mat34& projector,
+                                  cv::Size size, const Vec3& eye, cv::Size content) {
+  if (size.width < 2 || size.height < 2 || content.width < 2 || content.height < 2 ||
+      !eye.allFinite()) {
+    return fail(ErrorCode::kInvalidInput, "viewer view: bad sizes or eye");
+  }
+  auto rays = raysOf(projector);
+  if (!rays) return tl::unexpected(rays.error());
+  const auto centre_hit =
+      surface.intersect(rays->through(0.5 * (size.width - 1), 0.5 * (size.height - 1)));
+  if (!centre_hit) {
+    return fail(ErrorCode::kDegenerate, "viewer view: the projector's centre misses the surface");
+  }
+  // Eye frame: x right, y down, z towards the footprint's centre; world +Z up.
+  const Vec3 f = (centre_hit->point - eye).normalized();
+  Vec3 r = f.cross(Vec3::UnitZ());
+  if (r.norm() < 1e-6) {
+    return fail(ErrorCode::kDegenerate, "viewer view: the eye looks straight up or down");
+  }
+  r.normalize();
+  const Vec3 d = f.cross(r);
+  Mat3 R;
+  R.row(0) = r.transpose();
+  R.row(1) = d.transpose();
+  R.row(2) = f.transpose();
+  // The footprint's border as the eye sees it, on the plane z = 1 (y up for the
+  // rectangle solver).
+  constexpr int kPerSide = 48;
+  std::vector<cv::Point2f> border;
+  const double x1 = size.width - 0.5, y1 = size.height - 0.5;
+  // A point of the frame's edge, or where the surface begins on the way from it to the
+  // frame's centre (a measured surface rarely reaches the frame's edge).
+  const Vec2 mid(0.5 * (size.width - 1), 0.5 * (size.height - 1));
+  auto sample = [&](double x, double y) -> bool {
+    for (int k = 0; k < 64; ++k) {
+      const Vec2 p = Vec2(x, y) + (k / 64.0) * (mid - Vec2(x, y));
+      const auto hit = surface.intersect(rays->through(p.x(), p.y()));
+      if (!hit) continue;
+      const Vec3 q = R * (hit->point - eye);
+      if (q.z() <= 1e-9) return false;
+      border.emplace_back(float(q.x() / q.z()), float(-q.y() / q.z()));
+      return true;
+    }
+    return true;  // nothing on this line: the footprint is bounded by the others
+  };
+  bool seen = true;
+  for (int i = 0; i < kPerSide; ++i) {
+    const double a = double(i) / kPerSide;
+    seen = seen && sample(-0.5 + a * size.width, -0.5);
+    seen = seen && sample(x1, -0.5 + a * size.height);
+    seen = seen && sample(x1 - a * size.width, y1);
+    seen = seen && sample(-0.5, y1 - a * size.height);
+  }
+  if (!seen)
+    return fail(ErrorCode::kDegenerate, "viewer view: part of the footprint is behind the eye");
+  if (border.size() < kPerSide) {
+    return fail(ErrorCode::kDegenerate,
+                "viewer view: too little of the footprint is on the surface (" +
+                    std::to_string(border.size()) + " of " + std::to_string(4 * kPerSide) +
+                    " edge samples)");
+  }
+  std::vector<cv::Point2f> hull;
+  cv::convexHull(border, hull);
+  std::vector<Vec2> polygon;
+  for (const auto& p : hull) polygon.emplace_back(p.x, p.y);
+  const double aspect = double(content.width) / content.height;
+  auto rect = keystone::largestInscribedRect(polygon, aspect);
+  if (!rect) return tl::unexpected(rect.error());
+  // The footprint seen over a fold, or a measured surface with holes, need not be convex:
+  // shrink about the centre until every point of the rectangle's border is shown, i.e. the
+  // eye's ray through it meets the surface at a point inside the projector's frame.
+  auto shown = [&](double x, double y_up) {
+    const auto hit = surface.intersect({eye, (R.transpose() * Vec3(x, -y_up, 1)).normalized()});
+    if (!hit) return false;
+    const Vec3 p = projector * hit->point.homogeneous();
+    if (p.z() <= 0) return false;
+    const double u = p.x() / p.z(), v = p.y() / p.z();
+    return u >= -0.5 && v >= -0.5 && u <= size.width - 0.5 && v <= size.height - 0.5;
+  };
+  keystone::AxisRect fit = *rect;
+  for (int iteration = 0; iteration < 80; ++iteration) {
+    bool inside = true;
+    for (int i = 0; i < 16 && inside; ++i) {
+      const double a = -1 + 2.0 * i / 16;
+      for (const Vec2& c : {Vec2(a, -1), Vec2(1, a), Vec2(-a, 1), Vec2(-1, -a)}) {
+        if (!shown(fit.centre.x() + c.x() * fit.half_width,
+                   fit.centre.y() + c.y() * fit.half_height)) {
+          inside = false;
+          break;
+        }
+      }
+    }
+    if (inside) break;
+    fit.half_width *= 0.98;
+    fit.half_height *= 0.98;
+  }
+  // Content pixel edges on the rectangle's edges: u + 0.5 = (x - left) * W / width, and
+  // v + 0.5 = (top - y_up) * H / height.
+  const double s = content.width / (2 * fit.half_width);
+  const double left = fit.centre.x() - fit.half_width, top = fit.centre.y() + fit.half_height;
+  Mat3 K;
+  K << s, 0, -left * s - 0.5, 0, s, top * s - 0.5, 0, 0, 1;
+  // y_up = -y: the plane's y down is the content's v down.
+  Mat34 Rt;
+  Rt.leftCols<3>() = R;
+  Rt.col(3) = -R * eye;
+  const Mat34 V = K * Rt;
+  if (!V.allFinite()) return fail(ErrorCode::kDegenerate, "viewer view: degenerate rectangle");
+  return V;
+}
+
+Result<WarpGrid> lookupGridForViewer(const geom::MeshIntersector& surface, const Mat34& projector,
+                                     cv::Size size, const Mat34& viewer, int step) {
+  if (size.width < 2 || size.height < 2 || step < 1 || !viewer.allFinite()) {
+    return fail(ErrorCode::kInvalidInput, "lookup grid: bad size, step or viewer");
+  }
+  auto rays = raysOf(projector);
+  if (!rays) return tl::unexpected(rays.error());
+  WarpGrid g;
+  g.cols = (size.width - 1 + step - 1) / step + 1;
+  g.rows = (size.height - 1 + step - 1) / step + 1;
+  g.origin = Vec2(0, 0);
+  // Nodes span pixel centre 0 to the last pixel centre exactly.
+  g.step = Vec2(double(size.width - 1) / (g.cols - 1), double(size.height - 1) / (g.rows - 1));
+  g.source.assign(static_cast<size_t>(g.cols) * g.rows, Vec2(kOutside, kOutside));
+  cv::parallel_for_(cv::Range(0, g.rows), [&](const cv::Range& range) {
+    for (int j = range.start; j < range.end; ++j) {
+      for (int i = 0; i < g.cols; ++i) {
+        const Vec2 n = g.node(i, j);
+        const auto hit = surface.intersect(rays->through(n.x(), n.y()));
+        if (!hit) continue;
+        const Vec3 q = viewer * hit->point.homogeneous();
+        if (q.z() <= 0) continue;
+        g.source[static_cast<size_t>(j) * g.cols + i] = q.hnormalized();
+      }
+    }
+  });
+  return g;
+}
+
+}  // namespace procam::render

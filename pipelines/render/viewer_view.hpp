@@ -1,0 +1,32 @@
+#pragma once
+// Image content on a non-planar display for a viewer whose eye is known ([Raskar02]
+// §3.2.3, §4.1.5): the content is the image the viewer should see. Its image plane is a
+// pinhole view from the eye looking at the surface point at the centre of the projector's
+// image, with world +Z up, and the content fills the largest upright rectangle of its
+// aspect inside the projector's footprint as the eye sees it. A projector pixel then shows
+// the content pixel where the eye's ray through that pixel's surface point crosses the
+// plane: the two-pass path draws exactly that (§3.2.3), the lookup warp samples it on a
+// grid (§4.1.5).
+#include <opencv2/core.hpp>
+
+#include "core/error.hpp"
+#include "core/types.hpp"
+#include "geometry/intersect.hpp"
+#include "render/warp_map.hpp"
+
+namespace procam::render {
+
+// projector: world -> projector pixels (third row positive in front). Returns the
+// world -> content pixel matrix (RenderSetup::viewer). kDegenerate when the centre ray
+// misses the surface, too little of the footprint is seen, or part of it lies behind the
+// eye; kInvalidInput for empty sizes or non-finite input.
+Result<Mat34> viewerContentMatrix(const geom::MeshIntersector& surface, const Mat34& projector,
+                                  cv::Size projector_size, const Vec3& eye, cv::Size content_size);
+
+// The lookup warp for that viewer: nodes every `step` projector pixels (the last row and
+// column on the frame's edge) holding the content pixel each shows; nodes whose ray misses
+// the surface or lands behind the eye hold kOutside.
+Result<WarpGrid> lookupGridForViewer(const geom::MeshIntersector& surface, const Mat34& projector,
+                                     cv::Size projector_size, const Mat34& viewer, int step = 8);
+
+}  // namespace procam::render
