@@ -68,15 +68,13 @@ std::optional<std::pair<Vec3, long>> TiltTracker::stillMean() const {
 std::optional<Vec3> TiltTracker::add(const procam_tilt_sample& s) {
   // A timer may poll faster than the sensor delivers: the same sample twice.
   if (last_ns_ && s.timestamp_ns <= *last_ns_) return std::nullopt;
-  tilt::TiltSample raw;
-  raw.specific_force = Vec3(s.specific_force[0], s.specific_force[1], s.specific_force[2]);
-  raw.timestamp_ns = s.timestamp_ns;
-  if (!gate_.check(raw)) return std::nullopt;
   last_ns_ = s.timestamp_ns;
-  const Vec3 raw_g = raw.specific_force / tilt::kStandardGravity;
+  // The driver dropped garbage samples already (its sample gate).
+  const Vec3 raw_g =
+      Vec3(s.specific_force[0], s.specific_force[1], s.specific_force[2]) / kStandardGravity;
   auto out =
       filter_.update(mount_.calibration.apply(raw_g), static_cast<double>(s.timestamp_ns) * 1e-9);
-  if (!out) return std::nullopt;  // only non-finite input, which the gate already refused
+  if (!out) return std::nullopt;  // non-finite input: the filter refuses it
   if (!out->still) {
     raw_sum_.setZero();
     raw_count_ = 0;

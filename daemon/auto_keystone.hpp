@@ -1,7 +1,7 @@
 #pragma once
-// Automatic keystone: tilt samples -> sample gate -> low-pass, stillness and
-// hysteresis (keystone::TiltFilter) -> a new gravity direction -> the keystone
-// solve ([Raskar02] §3.2.5, run on a worker) -> the pre-warp homography. Tilt only:
+// Automatic keystone: tilt samples (gated by their driver, drivers/tilt/plugin) ->
+// low-pass, stillness and hysteresis (keystone::TiltFilter) -> a new gravity direction -> the
+// keystone solve ([Raskar02] §3.2.5, run on a worker) -> the pre-warp homography. Tilt only:
 // gravity fixes pitch and roll; yaw needs the camera ([Raskar02] §6.2.2) and is 0 here.
 #include <array>
 #include <cstdint>
@@ -19,7 +19,6 @@
 #include "keystone/six_position.hpp"
 #include "keystone/tilt_filter.hpp"
 #include "procamd/procam_plugin.h"
-#include "tilt/sample_gate.hpp"
 
 namespace procam::daemon {
 
@@ -57,7 +56,6 @@ class TiltTracker {
   // still hold and how many samples it averages; nullopt while moving.
   std::optional<std::pair<Vec3, long>> stillMean() const;
 
-  const tilt::SampleCounts& counts() const { return gate_.counts(); }
   bool still() const { return still_; }
   const TiltMount& mount() const { return mount_; }
 
@@ -67,7 +65,6 @@ class TiltTracker {
 
   keystone::TiltFilter filter_;
   TiltMount mount_;
-  tilt::SampleGate gate_;
   std::optional<uint64_t> last_ns_;
   bool still_ = false;
   Vec3 raw_sum_ = Vec3::Zero();  // raw readings (g) of the current still hold

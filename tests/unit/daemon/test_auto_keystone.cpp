@@ -1,5 +1,5 @@
 // Auto keystone's pieces and the output frames, without the daemon: the tilt
-// tracker (gate, calibration, filter, hysteresis), the solve from gravity, the
+// tracker (calibration, filter, hysteresis), the solve from gravity, the
 // [keystone] configuration, rig.json intrinsics and frame rendering.
 #include <gtest/gtest.h>
 
@@ -55,11 +55,7 @@ TEST(TiltTracker, CalibratedStillReadingsGiveTheTrueGravityAndFewUpdates) {
   int published = 0;
   std::optional<Vec3> last;
   for (int k = 0; k < 2000; ++k) {  // 20 s at 100 Hz
-    // A few micro-g of zero-mean dither: identical readings would count as a
-    // stuck sensor (the sample gate).
-    const Vec3 dither = 1e-6 * Vec3((k * 7919) % 13 - 6, (k * 104729) % 11 - 5, (k * 31) % 7 - 3);
-    if (auto d =
-            tracker->add(reading(mount.sensor_from_projector, down, offset + dither, 0.01 * k))) {
+    if (auto d = tracker->add(reading(mount.sensor_from_projector, down, offset, 0.01 * k))) {
       ++published;
       last = *d;
     }
@@ -69,10 +65,11 @@ TEST(TiltTracker, CalibratedStillReadingsGiveTheTrueGravityAndFewUpdates) {
   // The first sample, then refinements of the still hold after 2, 4, 8, 16 s.
   EXPECT_LE(published, 6);
   EXPECT_TRUE(tracker->still());
-  EXPECT_EQ(tracker->counts().accepted, 2000u);
 }
 
-TEST(TiltTracker, GarbageAndRepeatedSamplesAreDropped) {
+TEST(TiltTracker, RepeatedAndNonFiniteSamplesAreIgnored) {
+  // Garbage is the driver's to drop (its sample gate); what reaches the tracker
+  // anyway must not disturb it.
   auto tracker = TiltTracker::create(KeystoneConfig{}, TiltMount{});
   ASSERT_TRUE(tracker);
   const Vec3 down(0, 1, 0);
@@ -82,10 +79,14 @@ TEST(TiltTracker, GarbageAndRepeatedSamplesAreDropped) {
   procam_tilt_sample nan = reading(Mat3::Identity(), down, Vec3::Zero(), 1.01);
   nan.specific_force[0] = NAN;
   EXPECT_FALSE(tracker->add(nan));
-  // |f| = 3 g: a shake, not gravity.
-  EXPECT_FALSE(tracker->add(reading(Mat3::Identity(), 3 * down, Vec3::Zero(), 1.02)));
-  EXPECT_EQ(tracker->counts().not_finite, 1u);
-  EXPECT_EQ(tracker->counts().bad_norm, 1u);
+  // The next good sample, turned by 10 degrees, moves the estimate part of the way
+  // (a 10 Hz low-pass over 10 ms) and it stays finite.
+  const Vec3 turned(0, std::cos(10 * kDeg), -std::sin(10 * kDeg));
+  auto next = tracker->add(reading(Mat3::Identity(), turned, Vec3::Zero(), 1.02));
+  ASSERT_TRUE(next);
+  EXPECT_TRUE(next->allFinite());
+  EXPECT_GT(angle(*next, down), 1 * kDeg);
+  EXPECT_LT(angle(*next, down), 9 * kDeg);
 }
 
 TEST(SixPositionCollector, SixHoldsRecoverOffsetAndGain) {
@@ -121,15 +122,14 @@ TEST(TiltTracker, StillMeanIsTheRawReading) {
   ASSERT_TRUE(tracker);
   const Vec3 raw(0.1, 0.2, 0.98);
   for (int k = 0; k < 100; ++k) {
-    const Vec3 dither = 1e-6 * Vec3(k % 3 - 1, 0, 0);
     procam_tilt_sample s{};
-    for (int i = 0; i < 3; ++i) s.specific_force[i] = (raw + dither)[i] * kG;
+    for (int i = 0; i < 3; ++i) s.specific_force[i] = raw[i] * kG;
     s.timestamp_ns = static_cast<uint64_t>(k * 1e7);
     tracker->add(s);
   }
   auto mean = tracker->stillMean();
   ASSERT_TRUE(mean);
-  EXPECT_LT((mean->first - raw).norm(), 1e-6);
+  EXPECT_LT((mean->first - raw).norm(), 1e-12);
   EXPECT_GT(mean->second, 50);
 }
 
