@@ -113,7 +113,7 @@ void Daemon::probeKeystoneInputs() {
 
 void Daemon::useKeystoneInputs(ProjectorModel projector, TiltMount mount) {
   KeystoneRuntime& k = keystone_rt_;
-  auto tracker = TiltTracker::create(config_.keystone, std::move(mount));
+  auto tracker = TiltTracker::create(tiltFilterOptions(config_.keystone), std::move(mount));
   if (!tracker) {
     k.unavailable = tracker.error().message;
     warn("automatic keystone: " + k.unavailable);
@@ -189,7 +189,8 @@ void Daemon::watchTiltSensor() {
 void Daemon::onTiltSample(const procam_tilt_sample& sample) {
   KeystoneRuntime& k = keystone_rt_;
   if (!k.tracker) return;
-  if (auto down = k.tracker->add(sample)) {
+  const Vec3 f(sample.specific_force[0], sample.specific_force[1], sample.specific_force[2]);
+  if (auto down = k.tracker->add(f, sample.timestamp_ns)) {
     k.down = *down;
     k.down_time = static_cast<double>(sample.timestamp_ns) * 1e-9;
     requestSolve();
