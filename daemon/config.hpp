@@ -26,7 +26,8 @@ struct DeviceConfig {
 
 enum class RecalibratePolicy { kOff, kOnDrift };
 
-// [keystone]: the automatic keystone loop (daemon/auto_keystone.hpp).
+// [keystone]: the automatic keystone loop (keystone/tilt_tracker.hpp), read by
+// daemon/auto_keystone.hpp.
 struct KeystoneConfig {
   double cutoff_hz = 10.0;       // tilt low-pass cut-off
   double hysteresis_deg = 0.02;  // re-solve only when gravity turns by more than this

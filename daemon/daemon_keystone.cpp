@@ -115,7 +115,7 @@ void Daemon::probeKeystoneInputs() {
 
 void Daemon::useKeystoneInputs(ProjectorModel projector, TiltMount mount) {
   KeystoneRuntime& k = keystone_rt_;
-  auto tracker = TiltTracker::create(config_.keystone, std::move(mount));
+  auto tracker = TiltTracker::create(tiltFilterOptions(config_.keystone), std::move(mount));
   if (!tracker) {
     k.unavailable = tracker.error().message;
     warn("automatic keystone: " + k.unavailable);
@@ -191,7 +191,8 @@ void Daemon::watchTiltSensor() {
 void Daemon::onTiltSample(const procam_tilt_sample& sample) {
   KeystoneRuntime& k = keystone_rt_;
   if (!k.tracker) return;
-  if (auto down = k.tracker->add(sample)) {
+  const Vec3 f(sample.specific_force[0], sample.specific_force[1], sample.specific_force[2]);
+  if (auto down = k.tracker->add(f, sample.timestamp_ns)) {
     k.down = *down;
     k.down_time = static_cast<double>(sample.timestamp_ns) * 1e-9;
     requestSolve();
@@ -295,19 +296,29 @@ json Daemon::keystoneJson() const {
         {"size", {k.projector->width, k.projector->height}},
         {"source", k.projector->source}};
   }
+  auto* self = const_cast<Daemon*>(this);
   if (k.tracker) {
-    const auto& c = k.tracker->counts();
     const Vec3& off = k.tracker->mount().calibration.offset;
     j["tilt"] = {{"device", k.tilt_device},
                  {"still", k.tracker->still()},
-                 {"accepted", c.accepted},
-                 {"rejected", c.rejected()},
+                 {"accepted", nullptr},
+                 {"rejected", nullptr},
+                 {"rejected_by", nullptr},
                  {"calibration",
                   {{"source", k.tracker->mount().calibration_source},
                    {"offset_g", {off.x(), off.y(), off.z()}}}}};
     if (k.calibration_rms_g >= 0) j["tilt"]["calibration"]["rms_g"] = k.calibration_rms_g;
+    // The driver's sample gate counts (procam_tilt_ops::get_counts), when it has them.
+    const DeviceEntry* tilt = self->devices_.find(k.tilt_device);
+    if (auto c = tilt && tilt->usable() ? plugins::tiltCounts(tilt->device.raw()) : std::nullopt) {
+      j["tilt"]["accepted"] = c->accepted;
+      j["tilt"]["rejected"] = plugins::rejectedSamples(*c);
+      j["tilt"]["rejected_by"] = {{"not_finite", c->not_finite},
+                                  {"out_of_range", c->out_of_range},
+                                  {"stuck", c->stuck},
+                                  {"bad_norm", c->bad_norm}};
+    }
   }
-  auto* self = const_cast<Daemon*>(this);
   if (DeviceEntry* out = self->devices_.firstUsable(PROCAM_FAMILY_OUTPUT)) {
     if (auto mode = outputMode(*out)) j["output_size"] = {mode->width, mode->height};
   }

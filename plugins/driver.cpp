@@ -219,4 +219,21 @@ std::optional<double> trackerRate(const procam_device& d) {
   return hz;
 }
 
+// get_counts came with version 2 of the tilt table: a version 1 table ends before it.
+constexpr uint32_t kTiltCountsVersion = 2;
+
+std::optional<procam_tilt_counts> tiltCounts(const procam_device& d) {
+  if (d.family != PROCAM_FAMILY_TILT || !d.ops.tilt || d.ops.tilt->version < kTiltCountsVersion ||
+      !d.ops.tilt->get_counts) {
+    return std::nullopt;
+  }
+  procam_tilt_counts c{};
+  if (d.ops.tilt->get_counts(d.self, &c) != PROCAM_OK) return std::nullopt;
+  return c;
+}
+
+uint64_t rejectedSamples(const procam_tilt_counts& c) {
+  return c.not_finite + c.out_of_range + c.stuck + c.bad_norm;
+}
+
 }  // namespace procam::plugins

@@ -89,4 +89,10 @@ Result<std::vector<DeviceDescription>> enumerateDevices(
 // The tracker's own sample rate when its driver reports one.
 std::optional<double> trackerRate(const procam_device& device);
 
+// A tilt driver's sample counts (procam_tilt_ops::get_counts) when its table has them
+// (version 2 or later) and it reports them.
+std::optional<procam_tilt_counts> tiltCounts(const procam_device& device);
+// The samples those counts say the driver rejected, for every reason.
+uint64_t rejectedSamples(const procam_tilt_counts& counts);
+
 }  // namespace procam::plugins

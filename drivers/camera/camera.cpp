@@ -20,9 +20,9 @@ const char* toString(Control control) {
   return "unknown control";
 }
 
-tl::unexpected<CameraError> unsupported(const std::string& device, Control control) {
-  return camFail(Status::kNotSupported,
-                 device + ": " + toString(control) + " is not supported by this device");
+tl::unexpected<Error> unsupported(const std::string& device, Control control) {
+  return fail(ErrorCode::kNotSupported,
+              device + ": " + toString(control) + " is not supported by this device");
 }
 
 uint64_t monotonicNs() {

@@ -4,39 +4,19 @@
 // (8- or 16-bit mono, RGB8; rows top to bottom) with a CLOCK_MONOTONIC timestamp; the
 // conversion from what the device sends happens once, in convert.hpp.
 //
-// Errors carry the plugin ABI's status (PROCAM_E*), so a backend says exactly what went
-// wrong: a control the device does not have is kNotSupported, never silently ignored.
+// Errors are procam::Result with ErrorCode's device codes (kNoDevice, kTimeout, kAgain,
+// kNotSupported, kEnded), each one status of the plugin ABI, so a backend says exactly
+// what went wrong: a control the device does not have is kNotSupported, never silently
+// ignored.
 #include <procamd/procam_plugin.h>
 
 #include <cstdint>
 #include <opencv2/core/mat.hpp>
 #include <string>
-#include <tl/expected.hpp>
+
+#include "core/error.hpp"
 
 namespace procam::camera {
-
-enum class Status {
-  kInvalid = PROCAM_EINVAL,
-  kNoDevice = PROCAM_ENODEV,
-  kIo = PROCAM_EIO,
-  kTimeout = PROCAM_ETIMEDOUT,
-  kAgain = PROCAM_EAGAIN,
-  kNotSupported = PROCAM_ENOTSUP,
-  kInternal = PROCAM_EINTERNAL,
-  kEnded = PROCAM_EEND,
-};
-
-struct CameraError {
-  Status status;
-  std::string message;
-};
-
-template <class T>
-using CamResult = tl::expected<T, CameraError>;
-
-inline tl::unexpected<CameraError> camFail(Status status, std::string message) {
-  return tl::unexpected<CameraError>(CameraError{status, std::move(message)});
-}
 
 // Image size and pipeline pixel format of the frames a camera delivers.
 struct FrameFormat {
@@ -65,22 +45,22 @@ class Camera {
  public:
   virtual ~Camera() = default;
   // Opens the device and starts streaming in the negotiated format.
-  virtual CamResult<void> start() = 0;
+  virtual Result<void> start() = 0;
   virtual void stop() = 0;
   virtual FrameFormat format() const = 0;
   // The next frame, waiting at most `timeout_ms` (0: only one already waiting; kAgain
   // when there is none). kNoDevice when the device went away.
-  virtual CamResult<const Frame*> capture(int timeout_ms) = 0;
+  virtual Result<const Frame*> capture(int timeout_ms) = 0;
   // kNotSupported naming the control when the device does not have it. kAutoExposure
   // takes 0 (manual) or 1 (automatic).
-  virtual CamResult<void> setControl(Control control, double value) = 0;
+  virtual Result<void> setControl(Control control, double value) = 0;
   // A descriptor that becomes readable when a frame is waiting, or -1.
   virtual int pollFd() const { return -1; }
   virtual std::string name() const = 0;
 };
 
 // "not supported by this device" for a control, with the device's name.
-tl::unexpected<CameraError> unsupported(const std::string& device, Control control);
+tl::unexpected<Error> unsupported(const std::string& device, Control control);
 
 // Monotonic clock now, in nanoseconds.
 uint64_t monotonicNs();

@@ -93,24 +93,24 @@ cv::Mat wrap(const SourceImage& s) {
 
 }  // namespace
 
-CamResult<void> convertFrame(const SourceImage& src, procam_pixel_format want, bool zero_copy,
-                             cv::Mat& storage, Frame& out) {
+Result<void> convertFrame(const SourceImage& src, procam_pixel_format want, bool zero_copy,
+                          cv::Mat& storage, Frame& out) {
   if (src.width == 0 || src.height == 0 || !src.data)
-    return camFail(Status::kInvalid, std::string("empty ") + toString(src.format) + " frame");
+    return fail(ErrorCode::kInvalidInput, std::string("empty ") + toString(src.format) + " frame");
   out.pixel = want;
   if (src.format == SourceFormat::kMjpeg) {
     // imdecode gives BGR (or gray); one more pass to RGB is the conversion.
     const cv::Mat bytes(1, int(src.bytes), CV_8UC1, const_cast<uint8_t*>(src.data));
     if (want == PROCAM_PIXEL_GRAY16)
-      return camFail(Status::kInvalid, "MJPEG frames are 8-bit; gray16 is not possible");
+      return fail(ErrorCode::kInvalidInput, "MJPEG frames are 8-bit; gray16 is not possible");
     const int flags = want == PROCAM_PIXEL_GRAY8 ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR;
     cv::Mat decoded = cv::imdecode(bytes, flags);
-    if (decoded.empty()) return camFail(Status::kInvalid, "MJPEG frame does not decode");
+    if (decoded.empty()) return fail(ErrorCode::kInvalidInput, "MJPEG frame does not decode");
     if (uint32_t(decoded.cols) != src.width || uint32_t(decoded.rows) != src.height)
-      return camFail(Status::kInvalid, "MJPEG frame is " + std::to_string(decoded.cols) + "x" +
-                                           std::to_string(decoded.rows) + ", expected " +
-                                           std::to_string(src.width) + "x" +
-                                           std::to_string(src.height));
+      return fail(ErrorCode::kInvalidInput, "MJPEG frame is " + std::to_string(decoded.cols) + "x" +
+                                                std::to_string(decoded.rows) + ", expected " +
+                                                std::to_string(src.width) + "x" +
+                                                std::to_string(src.height));
     if (want == PROCAM_PIXEL_RGB8)
       cv::cvtColor(decoded, storage, cv::COLOR_BGR2RGB);
     else
@@ -121,10 +121,10 @@ CamResult<void> convertFrame(const SourceImage& src, procam_pixel_format want, b
   }
   const uint32_t row = minStride(src.format, src.width);
   if (src.stride < row || src.bytes < std::size_t(src.stride) * (src.height - 1) + row)
-    return camFail(Status::kInvalid, std::string(toString(src.format)) + " frame of " +
-                                         std::to_string(src.bytes) + " bytes is too short for " +
-                                         std::to_string(src.width) + "x" +
-                                         std::to_string(src.height));
+    return fail(ErrorCode::kInvalidInput,
+                std::string(toString(src.format)) + " frame of " + std::to_string(src.bytes) +
+                    " bytes is too short for " + std::to_string(src.width) + "x" +
+                    std::to_string(src.height));
   const cv::Mat in = wrap(src);
   const procam_pixel_format natural = naturalPixel(src.format);
   if (want == natural && src.format != SourceFormat::kYuyv && src.format != SourceFormat::kBgr24) {
@@ -163,7 +163,7 @@ CamResult<void> convertFrame(const SourceImage& src, procam_pixel_format want, b
         cv::cvtColor(in, storage, cv::COLOR_YUV2GRAY_YUYV);
         storage.convertTo(storage, CV_8U, 255.0 / 219.0, -16.0 * 255.0 / 219.0);
       } else {
-        return camFail(Status::kInvalid, "YUYV frames are 8-bit; gray16 is not possible");
+        return fail(ErrorCode::kInvalidInput, "YUYV frames are 8-bit; gray16 is not possible");
       }
       break;
     case SourceFormat::kRgb24:
@@ -174,7 +174,7 @@ CamResult<void> convertFrame(const SourceImage& src, procam_pixel_format want, b
       else if (want == PROCAM_PIXEL_GRAY8)
         cv::cvtColor(in, storage, bgr ? cv::COLOR_BGR2GRAY : cv::COLOR_RGB2GRAY);
       else
-        return camFail(Status::kInvalid, "8-bit colour frames cannot become gray16");
+        return fail(ErrorCode::kInvalidInput, "8-bit colour frames cannot become gray16");
       break;
     }
     case SourceFormat::kMjpeg:

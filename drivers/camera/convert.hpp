@@ -42,7 +42,7 @@ struct SourceImage {
 // frame's lifetime); otherwise the result lands in `storage`, reused across frames.
 // kInvalid for a truncated buffer, a JPEG that does not decode, or an impossible
 // conversion (16-bit from 8-bit colour).
-CamResult<void> convertFrame(const SourceImage& src, procam_pixel_format want, bool zero_copy,
-                             cv::Mat& storage, Frame& out);
+Result<void> convertFrame(const SourceImage& src, procam_pixel_format want, bool zero_copy,
+                          cv::Mat& storage, Frame& out);
 
 }  // namespace procam::camera

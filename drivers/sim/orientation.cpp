@@ -1,29 +1,6 @@
 #include "sim/orientation.hpp"
 
-#include <Eigen/Geometry>
-
 namespace procam::sim {
-
-namespace {
-Mat3 axisRotation(const Vec3& axis, double angle) {
-  return Eigen::AngleAxisd(angle, axis).toRotationMatrix();
-}
-}  // namespace
-
-Mat3 worldFromDeviceYpr(double yaw, double pitch, double roll) {
-  // Device axes at zero angles: x = +X (right), y = -Z (down), z = +Y (forward).
-  Mat3 base;
-  base.col(0) = Vec3::UnitX();
-  base.col(1) = -Vec3::UnitZ();
-  base.col(2) = Vec3::UnitY();
-  return axisRotation(Vec3::UnitZ(), yaw) * axisRotation(Vec3::UnitX(), pitch) *
-         axisRotation(Vec3::UnitY(), roll) * base;
-}
-
-Mat3 parentFromChildYpr(double yaw, double pitch, double roll) {
-  return axisRotation(-Vec3::UnitY(), yaw) * axisRotation(Vec3::UnitX(), pitch) *
-         axisRotation(Vec3::UnitZ(), roll);
-}
 
 geom::Pose poseFromCenter(const Vec3& center, const Mat3& world_from_device) {
   geom::Pose pose;

@@ -2,6 +2,8 @@
 #include <cmath>
 #include <set>
 
+#include "core/units.hpp"
+#include "geometry/yaw_pitch_roll.hpp"
 #include "sim/mesh_io.hpp"
 #include "sim/orientation.hpp"
 #include "sim/scene.hpp"
@@ -23,10 +25,13 @@ bool hasAnyYpr(const Fields& f) {
   return f.has("yaw_deg") || f.has("pitch_deg") || f.has("roll_deg");
 }
 
-Mat3 readYpr(const Fields& f, Mat3 (*build)(double, double, double)) {
-  return build(degToRad(f.numberIn("yaw_deg", 0, -360, 360)),
-               degToRad(f.numberIn("pitch_deg", 0, -360, 360)),
-               degToRad(f.numberIn("roll_deg", 0, -360, 360)));
+// yaw_deg, pitch_deg, roll_deg (each default 0) in geometry/yaw_pitch_roll.hpp's convention.
+geom::YawPitchRoll readYpr(const Fields& f) {
+  geom::YawPitchRoll a;
+  a.yaw = degToRad(f.numberIn("yaw_deg", 0, -360, 360));
+  a.pitch = degToRad(f.numberIn("pitch_deg", 0, -360, 360));
+  a.roll = degToRad(f.numberIn("roll_deg", 0, -360, 360));
+  return a;
 }
 
 // position + (look_at [+ up] | yaw_deg/pitch_deg/roll_deg), world frame.
@@ -44,7 +49,7 @@ WorldPose readWorldPose(const Fields& f) {
     out.world_from_device = geom::Pose::lookAt(out.center, target, up).R.transpose();
   } else {
     f.unitVec3("up", Vec3::UnitZ());  // accepted but meaningless without look_at
-    out.world_from_device = readYpr(f, worldFromDeviceYpr);
+    out.world_from_device = geom::worldFromDevice(readYpr(f));
   }
   return out;
 }
@@ -123,7 +128,7 @@ class Reader {
       if (p.kind != Placement::Kind::kAttached) f.error("offset", "only valid with attached_to");
       const Fields off = f.table("offset");
       const Vec3 position = off.optionalVec3("position").value_or(Vec3::Zero());
-      p.offset = childFromParent(position, readYpr(off, parentFromChildYpr));
+      p.offset = childFromParent(position, geom::parentFromChild(readYpr(off)));
       off.finish();
     }
     return p;
@@ -199,7 +204,7 @@ class Reader {
       b.center = f.vec3("center");
       b.half = 0.5 * f.vec3("size");
       if (b.half.minCoeff() <= 0) f.error("size", "all sizes must be > 0");
-      b.axes = readYpr(f, worldFromYpr);
+      b.axes = worldTurn(readYpr(f));
       s.shape = b;
     } else if (s.type == "cylinder") {
       geom::Cylinder c;
@@ -237,7 +242,7 @@ class Reader {
       f.errorHere("give either mount or mount_matrix, not both");
     if (f.has("mount")) {
       const Fields m = f.table("mount");
-      s.sensor_from_projector = readYpr(m, parentFromChildYpr).transpose();
+      s.sensor_from_projector = geom::parentFromChild(readYpr(m)).transpose();
       m.finish();
     } else if (f.has("mount_matrix")) {
       const Mat3 m = f.matrix3("mount_matrix");
@@ -287,8 +292,9 @@ class Reader {
   }
 
  private:
-  static Mat3 worldFromYpr(double yaw, double pitch, double roll) {
-    return worldFromDeviceYpr(yaw, pitch, roll) * worldFromDeviceYpr(0, 0, 0).transpose();
+  // A body (box, mesh) turned in the world by the angles a device at rest would turn by.
+  static Mat3 worldTurn(const geom::YawPitchRoll& a) {
+    return geom::worldFromDevice(a) * geom::worldFromDevice({}).transpose();
   }
 
   static std::string uniqueName(const Fields& f, std::set<std::string>& names) {
@@ -333,7 +339,7 @@ class Reader {
     if (!loaded) f.error("file", loaded.error().message);
     const Vec3 position = f.optionalVec3("position").value_or(Vec3::Zero());
     const double scale = f.numberIn("scale", 1, 0, 1e9, true);
-    const Mat3 R = readYpr(f, worldFromYpr);
+    const Mat3 R = worldTurn(readYpr(f));
     for (auto& v : loaded->vertices) v = position + R * (scale * v);
     auto built = geom::MeshIntersector::build(std::move(*loaded));
     if (!built) f.error("file", built.error().message);
@@ -377,7 +383,7 @@ class SceneBuilder {
     if (root.has("viewer")) {
       scene.viewer_ = reader.viewer(root.table("viewer"));
     } else {  // at the origin, looking along +Y, 60 degrees wide
-      scene.viewer_.placement.fixed = poseFromCenter(Vec3::Zero(), worldFromDeviceYpr(0, 0, 0));
+      scene.viewer_.placement.fixed = poseFromCenter(Vec3::Zero(), geom::worldFromDevice({}));
       scene.viewer_.K.fx = scene.viewer_.K.fy = 0.5 * 640 / std::tan(degToRad(30));
       scene.viewer_.K.cx = 319.5;
       scene.viewer_.K.cy = 239.5;

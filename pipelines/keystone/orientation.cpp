@@ -7,24 +7,6 @@
 namespace procam::keystone {
 namespace {
 
-Mat3 rotX(double a) {
-  return Eigen::AngleAxisd(a, Vec3::UnitX()).toRotationMatrix();
-}
-Mat3 rotY(double a) {
-  return Eigen::AngleAxisd(a, Vec3::UnitY()).toRotationMatrix();
-}
-Mat3 rotZ(double a) {
-  return Eigen::AngleAxisd(a, Vec3::UnitZ()).toRotationMatrix();
-}
-
-// Projector axes of the reference pose expressed in the wall frame (columns): x_p = X,
-// y_p = -Z, z_p = Y.
-Mat3 referenceProjectorToWall() {
-  Mat3 C;
-  C << 1, 0, 0, 0, 0, 1, 0, -1, 0;
-  return C;
-}
-
 Result<Vec3> unitOrError(const Vec3& v, const char* what) {
   const double n = v.norm();
   if (!std::isfinite(n) || n < 1e-12)
@@ -33,26 +15,6 @@ Result<Vec3> unitOrError(const Vec3& v, const char* what) {
 }
 
 }  // namespace
-
-Mat3 rotationFromAngles(const Angles& a) {
-  // Projector -> wall: turn right (about -Z), tilt up (about the turned X), roll
-  // clockwise seen from behind (about the optical axis Y).
-  const Mat3 projector_to_wall =
-      rotZ(-a.yaw) * rotX(a.pitch) * rotY(a.roll) * referenceProjectorToWall();
-  return projector_to_wall.transpose();
-}
-
-Angles anglesFromRotation(const Mat3& R) {
-  Angles out;
-  const Vec3 down = -R.col(2);  // wall -Z in the projector frame
-  out.pitch = std::atan2(-down.z(), std::hypot(down.x(), down.y()));
-  out.roll = std::atan2(down.x(), down.y());
-  // Undo roll and pitch; what is left is rotZ(-yaw) acting on the reference.
-  const Mat3 rest = R.transpose() * referenceProjectorToWall().transpose() *
-                    rotY(out.roll).transpose() * rotX(out.pitch).transpose();
-  out.yaw = std::atan2(-rest(1, 0), rest(0, 0));
-  return out;
-}
 
 Vec3 downFromSpecificForce(const Mat3& mount, const Vec3& specific_force) {
   return -(mount * specific_force);

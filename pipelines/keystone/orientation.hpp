@@ -8,24 +8,20 @@
 // points up. Projector frame: x right, y down, z forward (ARCHITECTURE.md). R maps W to the
 // projector frame: x_p = R x_w.
 //
-// Angle convention (the one the command line documents): reference pose = optical axis
-// along +Y (square to the wall), image upright. Then, applied in this order about the
-// projector's own axes: yaw (positive turns the optical axis to the right, seen from
-// above), pitch (positive tilts it up), roll (positive turns the image clockwise as seen
-// from behind the projector).
+// Angles: the yaw/pitch/roll convention of geometry/yaw_pitch_roll.hpp with the wall frame
+// as its reference: square to the wall and upright at zero angles; positive yaw turns the
+// optical axis to the right, positive pitch tilts it up, positive roll turns the image
+// clockwise as seen from behind the projector.
 #include "core/error.hpp"
 #include "core/types.hpp"
+#include "geometry/yaw_pitch_roll.hpp"
 
 namespace procam::keystone {
 
-struct Angles {
-  double pitch = 0, roll = 0, yaw = 0;  // radians
-};
-
-// World (wall frame) -> projector rotation of the angle convention above.
-Mat3 rotationFromAngles(const Angles& a);
-// Inverse of rotationFromAngles for |pitch| < 90°.
-Angles anglesFromRotation(const Mat3& R);
+using Angles = geom::YawPitchRoll;
+// Wall frame -> projector rotation of those angles, and back (for |pitch| < 90°).
+using geom::anglesFromRotation;
+using geom::rotationFromAngles;
 
 // Direction of gravity in the projector frame from a tilt sensor's specific force
 // reading (gravity's reaction, +1 g "up" at rest) and the sensor -> projector mounting

@@ -14,18 +14,34 @@ int report(char* err, std::size_t len, const std::string& message, int status) {
   return status;
 }
 
+namespace {
+
+// The device codes of ErrorCode and kInvalidInput, one status each, both ways.
+constexpr std::pair<ErrorCode, int> kStatuses[] = {{ErrorCode::kInvalidInput, PROCAM_EINVAL},
+                                                   {ErrorCode::kNoDevice, PROCAM_ENODEV},
+                                                   {ErrorCode::kIo, PROCAM_EIO},
+                                                   {ErrorCode::kTimeout, PROCAM_ETIMEDOUT},
+                                                   {ErrorCode::kAgain, PROCAM_EAGAIN},
+                                                   {ErrorCode::kNotSupported, PROCAM_ENOTSUP},
+                                                   {ErrorCode::kEnded, PROCAM_EEND},
+                                                   {ErrorCode::kInternal, PROCAM_EINTERNAL}};
+
+}  // namespace
+
 int statusOf(ErrorCode code) {
-  switch (code) {
-    case ErrorCode::kNotFound:
-      return PROCAM_ENODEV;
-    case ErrorCode::kInvalidInput:
-    case ErrorCode::kParse:
-      return PROCAM_EINVAL;
-    case ErrorCode::kIo:
-      return PROCAM_EIO;
-    default:
-      return PROCAM_EINTERNAL;
+  if (code == ErrorCode::kNotFound) return PROCAM_ENODEV;
+  if (code == ErrorCode::kParse) return PROCAM_EINVAL;
+  for (const auto& [c, status] : kStatuses) {
+    if (c == code) return status;
   }
+  return PROCAM_EINTERNAL;
+}
+
+ErrorCode codeOf(int status) {
+  for (const auto& [code, s] : kStatuses) {
+    if (s == status) return code;
+  }
+  return ErrorCode::kInternal;
 }
 
 int report(char* err, std::size_t len, const Error& error) {

@@ -17,9 +17,13 @@ namespace procam::plugins {
 // Writes `message` into the caller's buffer (truncated, always terminated) and returns
 // `status`.
 int report(char* err, std::size_t len, const std::string& message, int status);
-// PROCAM_E* for an error: kNotFound -> ENODEV, kInvalidInput/kParse -> EINVAL, kIo -> EIO,
-// anything else -> EINTERNAL.
+// PROCAM_E* for an error: each device code of ErrorCode (kIo, kNoDevice, kTimeout, kAgain,
+// kNotSupported, kEnded, kInternal) to its status, kNotFound -> ENODEV,
+// kInvalidInput/kParse -> EINVAL, anything else -> EINTERNAL.
 int statusOf(ErrorCode code);
+// The ErrorCode of a PROCAM_E* status another driver returned (statusOf's inverse on
+// the device codes and kInvalidInput); kInternal for an unknown status.
+ErrorCode codeOf(int status);
 // report() of an Error with its status.
 int report(char* err, std::size_t len, const Error& error);
 

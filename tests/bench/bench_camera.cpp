@@ -110,7 +110,7 @@ void benchAravis(const fs::path& out, double seconds) {
     o.pixel_format = "Mono8";
     o.fps = asked;
     AravisCamera cam(o);
-    CamResult<void> ok = camFail(Status::kNoDevice, "not started");
+    procam::Result<void> ok = procam::fail(procam::ErrorCode::kNoDevice, "not started");
     for (int i = 0; i < 100 && !ok; ++i) {
       ok = cam.start();
       if (!ok) std::this_thread::sleep_for(std::chrono::milliseconds(100));

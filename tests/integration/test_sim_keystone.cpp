@@ -204,6 +204,54 @@ double quadFraction(const std::array<Vec2, 4>& q) {
   return 0.5 * std::abs(area2) / (1280.0 * 720.0);
 }
 
+TEST(SimKeystone, TheTiltDriversRejectedSamplesShowInStatus) {
+  TempDir dir;
+  const std::string level = levelScene();
+  ASSERT_FALSE(level.empty());
+  // The same rig with a broken accelerometer: 2.5 g too much on its z (up) axis, clamped
+  // at its 2 g full scale, so |f| is about 2 g for every sample and its driver's gate
+  // drops them all (|f| outside [0.5, 1.5] g; the noise on x and y keeps them apart, so
+  // none is a stuck repeat).
+  std::string broken = level;
+  const std::string bias = "bias_mg = [50.0, -50.0, 50.0]";
+  const auto at = broken.find(bias);
+  ASSERT_NE(at, std::string::npos);
+  broken.replace(at, bias.size(), "bias_mg = [0.0, 0.0, 2500.0]");
+  dir.write("level.toml", level);
+  dir.write("broken.toml", broken);
+  // The rig model is the healthy rig's (a broken sensor has no six-position fit).
+  DaemonProcess::Launch launch{
+      {"--sim", dir.file("broken.toml"), "--rig", truthRigFile(dir, dir.file("level.toml"))},
+      {},
+      -1,
+      true};
+  DaemonProcess d(dir, launch);
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  ASSERT_TRUE(eventually([&] {
+    auto on = c.call({{"cmd", "keystone"}, {"action", "auto"}, {"enable", true}});
+    return on && (*on)["class"] == "KEYSTONE";
+  }));
+  std::optional<json> status;
+  ASSERT_TRUE(eventually(
+      [&] {
+        status = c.call({{"cmd", "status"}});
+        if (!status) return false;
+        const json r = status->value(json::json_pointer("/keystone/tilt/rejected"), json());
+        return r.is_number() && r.get<int>() >= 50;
+      },
+      20s))
+      << (status ? status->dump() : "no reply");
+  const json& tilt = (*status)["keystone"]["tilt"];
+  EXPECT_EQ(tilt["accepted"].get<int>(), 0) << tilt.dump();
+  EXPECT_EQ(tilt["rejected_by"]["bad_norm"].get<int>(), tilt["rejected"].get<int>());
+  EXPECT_EQ(tilt["rejected_by"]["stuck"].get<int>(), 0);
+  EXPECT_EQ(tilt["rejected_by"]["not_finite"].get<int>(), 0);
+  EXPECT_EQ(tilt["rejected_by"]["out_of_range"].get<int>(), 0);
+  // Nothing reached the filter: no solution.
+  EXPECT_FALSE((*status)["keystone"].contains("estimate")) << status->dump();
+}
+
 TEST(SimKeystone, SixPositionCalibrationStepsOverTheSocket) {
   TempDir dir;
   dir.write("level.toml", levelScene());

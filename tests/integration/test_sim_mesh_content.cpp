@@ -251,7 +251,7 @@ ambient = 0.02
 name = "proj"
 resolution = [960, 540]
 intrinsics = { fx = 1200.0, fy = 1200.0, cx = 479.5, cy = 269.5 }
-pose = { position = [1.3, 0.0, 0.5], yaw_deg = 30.0, pitch_deg = 15.0, roll_deg = 0.0 }
+pose = { position = [1.3, 0.0, 0.5], yaw_deg = -30.0, pitch_deg = 15.0, roll_deg = 0.0 }
 gamma = 2.2
 brightness = 11.0
 

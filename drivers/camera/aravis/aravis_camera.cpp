@@ -181,13 +181,13 @@ AravisCamera::~AravisCamera() {
   stop();
 }
 
-CamResult<void> AravisCamera::start() {
+Result<void> AravisCamera::start() {
   stop();
   if (options_.buffers < 2)
-    return camFail(Status::kInvalid, name() + ": at least 2 stream buffers are needed");
+    return fail(ErrorCode::kInvalidInput, name() + ": at least 2 stream buffers are needed");
   GError* error = nullptr;
   camera_ = arv_camera_new(options_.id.empty() ? nullptr : options_.id.c_str(), &error);
-  if (!camera_) return camFail(Status::kNoDevice, name() + ": cannot open: " + take(error));
+  if (!camera_) return fail(ErrorCode::kNoDevice, name() + ": cannot open: " + take(error));
   lost_ = false;
   gone_fd_.drain();
   {
@@ -205,64 +205,64 @@ CamResult<void> AravisCamera::start() {
   return ok;
 }
 
-CamResult<void> AravisCamera::configure() {
+Result<void> AravisCamera::configure() {
   GError* error = nullptr;
-  auto failed = [&](Status s, const std::string& what) {
-    return camFail(s, name() + ": " + what + ": " + take(error));
+  auto failed = [&](ErrorCode s, const std::string& what) {
+    return fail(s, name() + ": " + what + ": " + take(error));
   };
   // Acquisition may still run from a previous client that vanished.
   arv_camera_stop_acquisition(camera_, &error);
   g_clear_error(&error);
   if (options_.width > 0 && options_.height > 0) {
     arv_camera_set_region(camera_, 0, 0, int(options_.width), int(options_.height), &error);
-    if (error) return failed(Status::kNotSupported, "region");
+    if (error) return failed(ErrorCode::kNotSupported, "region");
   }
   if (!options_.pixel_format.empty()) {
     arv_camera_set_pixel_format_from_string(camera_, options_.pixel_format.c_str(), &error);
-    if (error) return failed(Status::kNotSupported, "pixel format " + options_.pixel_format);
+    if (error) return failed(ErrorCode::kNotSupported, "pixel format " + options_.pixel_format);
   }
   if (arv_camera_is_gv_device(camera_)) {
     if (options_.packet_size > 0)
       arv_camera_gv_set_packet_size(camera_, options_.packet_size, &error);
     else
       arv_camera_gv_auto_packet_size(camera_, &error);
-    if (error) return failed(Status::kIo, "packet size");
+    if (error) return failed(ErrorCode::kIo, "packet size");
   }
   if (options_.fps > 0) {
     arv_camera_set_frame_rate(camera_, options_.fps, &error);
-    if (error) return failed(Status::kNotSupported, "frame rate");
+    if (error) return failed(ErrorCode::kNotSupported, "frame rate");
   }
   int x = 0, y = 0, w = 0, h = 0;
   arv_camera_get_region(camera_, &x, &y, &w, &h, &error);
-  if (error) return failed(Status::kIo, "reading the region");
+  if (error) return failed(ErrorCode::kIo, "reading the region");
   if (options_.width > 0 && (uint32_t(w) != options_.width || uint32_t(h) != options_.height))
-    return camFail(Status::kNotSupported, name() + ": asked for " + std::to_string(options_.width) +
+    return fail(ErrorCode::kNotSupported, name() + ": asked for " + std::to_string(options_.width) +
                                               "x" + std::to_string(options_.height) +
                                               ", the camera set " + std::to_string(w) + "x" +
                                               std::to_string(h));
   const ArvPixelFormat pf = arv_camera_get_pixel_format(camera_, &error);
-  if (error) return failed(Status::kIo, "reading the pixel format");
+  if (error) return failed(ErrorCode::kIo, "reading the pixel format");
   const auto src = sourceOf(pf);
   if (!src)
-    return camFail(Status::kNotSupported,
-                   name() + ": pixel format 0x" + std::to_string(pf) +
-                       " cannot be converted (use Mono8, Mono16, RGB8Packed, BGR8Packed, YUV422)");
+    return fail(ErrorCode::kNotSupported,
+                name() + ": pixel format 0x" + std::to_string(pf) +
+                    " cannot be converted (use Mono8, Mono16, RGB8Packed, BGR8Packed, YUV422)");
   source_ = *src;
   const procam_pixel_format pixel = options_.pixel.value_or(naturalPixel(source_));
   if (pixel == PROCAM_PIXEL_GRAY16 && source_ != SourceFormat::kY16)
-    return camFail(Status::kNotSupported, name() + ": gray16 needs a Mono16 stream");
+    return fail(ErrorCode::kNotSupported, name() + ": gray16 needs a Mono16 stream");
   format_ = {uint32_t(w), uint32_t(h), pixel};
 
   stream_ = arv_camera_create_stream(camera_, nullptr, nullptr, &error);
-  if (!stream_) return failed(Status::kIo, "creating the stream");
+  if (!stream_) return failed(ErrorCode::kIo, "creating the stream");
   const guint payload = arv_camera_get_payload(camera_, &error);
-  if (error) return failed(Status::kIo, "reading the payload size");
+  if (error) return failed(ErrorCode::kIo, "reading the payload size");
   for (unsigned i = 0; i < options_.buffers; ++i)
     arv_stream_push_buffer(stream_, arv_buffer_new_allocate(payload));
   arv_camera_set_acquisition_mode(camera_, ARV_ACQUISITION_MODE_CONTINUOUS, &error);
-  if (error) return failed(Status::kIo, "acquisition mode");
+  if (error) return failed(ErrorCode::kIo, "acquisition mode");
   arv_camera_start_acquisition(camera_, &error);
-  if (error) return failed(Status::kIo, "starting acquisition");
+  if (error) return failed(ErrorCode::kIo, "starting acquisition");
   failed_ = 0;
   return {};
 }
@@ -301,12 +301,12 @@ void AravisCamera::stop() {
   g_clear_object(&camera_);
 }
 
-CamResult<void> AravisCamera::checkAlive() const {
+Result<void> AravisCamera::checkAlive() const {
   if (lost_) {
     std::lock_guard lock(watchdog_mutex_);
-    return camFail(Status::kNoDevice,
-                   name() + ": " +
-                       (gone_reason_.empty() ? "control lost (the camera is gone)" : gone_reason_));
+    return fail(ErrorCode::kNoDevice,
+                name() + ": " +
+                    (gone_reason_.empty() ? "control lost (the camera is gone)" : gone_reason_));
   }
   GError* error = nullptr;
   arv_camera_get_payload(camera_, &error);
@@ -317,13 +317,13 @@ CamResult<void> AravisCamera::checkAlive() const {
       if (gone_reason_.empty()) gone_reason_ = reason;
     }
     markGone();  // stop() then skips the commands a gone camera would time out on
-    return camFail(Status::kNoDevice, name() + ": " + reason);
+    return fail(ErrorCode::kNoDevice, name() + ": " + reason);
   }
   return {};
 }
 
-CamResult<const Frame*> AravisCamera::capture(int timeout_ms) {
-  if (!stream_) return camFail(Status::kInvalid, name() + ": not streaming");
+Result<const Frame*> AravisCamera::capture(int timeout_ms) {
+  if (!stream_) return fail(ErrorCode::kInvalidInput, name() + ": not streaming");
   releaseHeld();
   if (lost_) return tl::unexpected(checkAlive().error());
   ArvBuffer* b = timeout_ms == 0
@@ -333,19 +333,19 @@ CamResult<const Frame*> AravisCamera::capture(int timeout_ms) {
   if (!b) {
     if (timeout_ms == 0) {
       if (lost_) return tl::unexpected(checkAlive().error());
-      return camFail(Status::kAgain, name() + ": no frame waiting");
+      return fail(ErrorCode::kAgain, name() + ": no frame waiting");
     }
     // Silence: either a slow camera or a gone one; ask it something.
     if (auto alive = checkAlive(); !alive) return tl::unexpected(alive.error());
-    return camFail(Status::kTimeout,
-                   name() + ": no frame within " + std::to_string(timeout_ms) + " ms");
+    return fail(ErrorCode::kTimeout,
+                name() + ": no frame within " + std::to_string(timeout_ms) + " ms");
   }
   held_ = b;
   if (arv_buffer_get_status(b) != ARV_BUFFER_STATUS_SUCCESS) {
     ++failed_;
     const int status = int(arv_buffer_get_status(b));
     releaseHeld();
-    return camFail(Status::kIo, name() + ": frame incomplete (Aravis buffer status " +
+    return fail(ErrorCode::kIo, name() + ": frame incomplete (Aravis buffer status " +
                                     std::to_string(status) + ")");
   }
   std::size_t size = 0;
@@ -355,7 +355,7 @@ CamResult<const Frame*> AravisCamera::capture(int timeout_ms) {
   const SourceImage src{source_, data, size, w, h, w * bytesPerPixel(source_)};
   if (auto ok = convertFrame(src, format_.pixel, true, storage_, frame_); !ok) {
     releaseHeld();
-    return camFail(ok.error().status, name() + ": " + ok.error().message);
+    return fail(ok.error().code, name() + ": " + ok.error().message);
   }
   frame_.sequence = arv_buffer_get_frame_id(b);
   const uint64_t sys = arv_buffer_get_system_timestamp(b);
@@ -363,27 +363,28 @@ CamResult<const Frame*> AravisCamera::capture(int timeout_ms) {
   return &frame_;
 }
 
-CamResult<double> AravisCamera::exposure() const {
-  if (!camera_) return camFail(Status::kInvalid, name() + ": not open");
+Result<double> AravisCamera::exposure() const {
+  if (!camera_) return fail(ErrorCode::kInvalidInput, name() + ": not open");
   GError* error = nullptr;
   const double us = arv_camera_get_exposure_time(camera_, &error);
-  if (error) return camFail(Status::kIo, name() + ": reading exposure: " + take(error));
+  if (error) return fail(ErrorCode::kIo, name() + ": reading exposure: " + take(error));
   return us * 1e-6;
 }
 
-CamResult<void> AravisCamera::setControl(Control control, double value) {
-  if (!camera_) return camFail(Status::kInvalid, name() + ": not open");
+Result<void> AravisCamera::setControl(Control control, double value) {
+  if (!camera_) return fail(ErrorCode::kInvalidInput, name() + ": not open");
   if (!std::isfinite(value))
-    return camFail(Status::kInvalid, name() + ": " + toString(control) + " must be finite");
+    return fail(ErrorCode::kInvalidInput, name() + ": " + toString(control) + " must be finite");
   GError* error = nullptr;
   auto io = [&](const char* what) {
-    return camFail(Status::kIo, name() + ": " + what + ": " + take(error));
+    return fail(ErrorCode::kIo, name() + ": " + what + ": " + take(error));
   };
-  auto inRange = [&](double v, double lo, double hi, const char* unit) -> CamResult<void> {
+  auto inRange = [&](double v, double lo, double hi, const char* unit) -> Result<void> {
     if (v >= lo && v <= hi) return {};
-    return camFail(Status::kInvalid, name() + ": " + toString(control) + " " + std::to_string(v) +
-                                         " " + unit + " outside the camera's range [" +
-                                         std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    return fail(ErrorCode::kInvalidInput, name() + ": " + toString(control) + " " +
+                                              std::to_string(v) + " " + unit +
+                                              " outside the camera's range [" + std::to_string(lo) +
+                                              ", " + std::to_string(hi) + "]");
   };
   switch (control) {
     case Control::kAutoExposure: {

@@ -56,13 +56,13 @@ class AravisCamera final : public Camera {
   AravisCamera& operator=(const AravisCamera&) = delete;
 
   // Opens (or reopens, after a failure) the camera and starts continuous acquisition.
-  CamResult<void> start() override;
+  Result<void> start() override;
   void stop() override;
   FrameFormat format() const override { return format_; }
   // kNoDevice with the reason when the camera stopped answering (control lost, or no
   // frame within the timeout and the camera no longer answers a register read).
-  CamResult<const Frame*> capture(int timeout_ms) override;
-  CamResult<void> setControl(Control control, double value) override;
+  Result<const Frame*> capture(int timeout_ms) override;
+  Result<void> setControl(Control control, double value) override;
   std::string name() const override { return "aravis " + options_.id; }
   // Readable once the camera is gone (control lost or a register read not
   // answered): the next capture() then returns kNoDevice. No frame makes it
@@ -70,13 +70,13 @@ class AravisCamera final : public Camera {
   int pollFd() const override { return gone_fd_.fd(); }
 
   // The camera's exposure time in seconds (read back), for checks.
-  CamResult<double> exposure() const;
+  Result<double> exposure() const;
   // Buffers the stream dropped or completed badly since start.
   uint64_t failedFrames() const { return failed_; }
 
  private:
-  CamResult<void> configure();
-  CamResult<void> checkAlive() const;
+  Result<void> configure();
+  Result<void> checkAlive() const;
   void releaseHeld();
   void markGone() const;
   // The watchdog thread: reads a bootstrap register every probe_ms until one

@@ -19,7 +19,7 @@ namespace {
 namespace lc = libcamera;
 
 // libcamera allows one CameraManager per process: share it between cameras.
-CamResult<std::shared_ptr<lc::CameraManager>> manager() {
+Result<std::shared_ptr<lc::CameraManager>> manager() {
   static std::mutex mutex;
   static std::weak_ptr<lc::CameraManager> shared;
   std::lock_guard lock(mutex);
@@ -29,8 +29,8 @@ CamResult<std::shared_ptr<lc::CameraManager>> manager() {
     delete p;
   });
   if (int rc = m->start(); rc < 0)
-    return camFail(Status::kIo,
-                   std::string("libcamera: CameraManager does not start: ") + std::strerror(-rc));
+    return fail(ErrorCode::kIo,
+                std::string("libcamera: CameraManager does not start: ") + std::strerror(-rc));
   shared = m;
   return m;
 }
@@ -52,7 +52,7 @@ struct Mapping {
 
 }  // namespace
 
-CamResult<std::vector<std::string>> libcameraCameraIds() {
+Result<std::vector<std::string>> libcameraCameraIds() {
   auto m = manager();
   if (!m) return tl::unexpected(m.error());
   std::vector<std::string> ids;
@@ -111,7 +111,7 @@ int LibcameraCamera::pollFd() const {
   return s_ ? s_->event_fd : -1;
 }
 
-CamResult<void> LibcameraCamera::start() {
+Result<void> LibcameraCamera::start() {
   stop();
   auto m = manager();
   if (!m) return tl::unexpected(m.error());
@@ -121,52 +121,52 @@ CamResult<void> LibcameraCamera::start() {
   const auto cameras = s.manager->cameras();
   if (cameras.empty()) {
     stop();
-    return camFail(Status::kNoDevice, "libcamera: no camera (CameraManager lists none)");
+    return fail(ErrorCode::kNoDevice, "libcamera: no camera (CameraManager lists none)");
   }
   s.camera = options_.id.empty() ? cameras.front() : s.manager->get(options_.id);
   if (!s.camera) {
     std::string list;
     for (const auto& c : cameras) list += (list.empty() ? "" : ", ") + c->id();
     stop();
-    return camFail(Status::kNoDevice,
-                   "libcamera: no camera '" + options_.id + "' (found: " + list + ")");
+    return fail(ErrorCode::kNoDevice,
+                "libcamera: no camera '" + options_.id + "' (found: " + list + ")");
   }
   options_.id = s.camera->id();
-  auto failed = [&](Status st, const std::string& what) {
+  auto failed = [&](ErrorCode st, const std::string& what) {
     stop();
-    return camFail(st, name() + ": " + what);
+    return fail(st, name() + ": " + what);
   };
-  if (s.camera->acquire() < 0) return failed(Status::kIo, "in use by another process");
+  if (s.camera->acquire() < 0) return failed(ErrorCode::kIo, "in use by another process");
   s.acquired = true;
   s.config = s.camera->generateConfiguration({lc::StreamRole::VideoRecording});
   if (!s.config || s.config->empty())
-    return failed(Status::kNotSupported, "no stream configuration");
+    return failed(ErrorCode::kNotSupported, "no stream configuration");
   lc::StreamConfiguration& sc = s.config->at(0);
   if (options_.width > 0) sc.size = {options_.width, options_.height};
   if (!options_.format.empty()) sc.pixelFormat = lc::PixelFormat::fromString(options_.format);
   sc.bufferCount = std::max(sc.bufferCount, options_.buffers);
   const std::string asked = sc.toString();
   if (s.config->validate() == lc::CameraConfiguration::Invalid)
-    return failed(Status::kNotSupported, "configuration " + asked + " is invalid");
+    return failed(ErrorCode::kNotSupported, "configuration " + asked + " is invalid");
   if ((options_.width > 0 &&
        (sc.size.width != options_.width || sc.size.height != options_.height)) ||
       (!options_.format.empty() && sc.pixelFormat.toString() != options_.format))
-    return failed(Status::kNotSupported,
+    return failed(ErrorCode::kNotSupported,
                   "asked for " + asked + ", the camera offers " + sc.toString());
   const auto src = sourceOf(sc.pixelFormat);
   if (!src)
-    return failed(Status::kNotSupported,
+    return failed(ErrorCode::kNotSupported,
                   "format " + sc.pixelFormat.toString() + " cannot be converted");
   s.source = *src;
-  if (s.camera->configure(s.config.get()) < 0) return failed(Status::kIo, "configure failed");
+  if (s.camera->configure(s.config.get()) < 0) return failed(ErrorCode::kIo, "configure failed");
   s.stream = sc.stream();
   s.stride = sc.stride;
   s.format = {sc.size.width, sc.size.height, options_.pixel.value_or(naturalPixel(s.source))};
   if (s.format.pixel == PROCAM_PIXEL_GRAY16)
-    return failed(Status::kNotSupported, "gray16 needs a 16-bit stream");
+    return failed(ErrorCode::kNotSupported, "gray16 needs a 16-bit stream");
 
   s.allocator = std::make_unique<lc::FrameBufferAllocator>(s.camera);
-  if (s.allocator->allocate(s.stream) < 0) return failed(Status::kIo, "cannot allocate buffers");
+  if (s.allocator->allocate(s.stream) < 0) return failed(ErrorCode::kIo, "cannot allocate buffers");
   for (const auto& buffer : s.allocator->buffers(s.stream)) {
     // Single-plane formats only: one mapping of plane 0.
     const auto& plane = buffer->planes()[0];
@@ -174,20 +174,21 @@ CamResult<void> LibcameraCamera::start() {
     map.length = plane.offset + plane.length;
     map.data = ::mmap(nullptr, map.length, PROT_READ, MAP_SHARED, plane.fd.get(), 0);
     if (map.data == MAP_FAILED)
-      return failed(Status::kIo, std::string("mmap: ") + std::strerror(errno));
+      return failed(ErrorCode::kIo, std::string("mmap: ") + std::strerror(errno));
     s.mappings[buffer.get()] = map;
     auto request = s.camera->createRequest();
     if (!request || request->addBuffer(s.stream, buffer.get()) < 0)
-      return failed(Status::kIo, "cannot create a request");
+      return failed(ErrorCode::kIo, "cannot create a request");
     s.requests.push_back(std::move(request));
   }
   s.event_fd = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
-  if (s.event_fd < 0) return failed(Status::kIo, "eventfd failed");
+  if (s.event_fd < 0) return failed(ErrorCode::kIo, "eventfd failed");
   s.camera->requestCompleted.connect(&s, &State::onCompleted);
-  if (s.camera->start() < 0) return failed(Status::kIo, "start failed");
+  if (s.camera->start() < 0) return failed(ErrorCode::kIo, "start failed");
   s.started = true;
   for (auto& r : s.requests)
-    if (s.camera->queueRequest(r.get()) < 0) return failed(Status::kIo, "cannot queue a request");
+    if (s.camera->queueRequest(r.get()) < 0)
+      return failed(ErrorCode::kIo, "cannot queue a request");
   return {};
 }
 
@@ -206,14 +207,14 @@ void LibcameraCamera::stop() {
   s_.reset();
 }
 
-CamResult<const Frame*> LibcameraCamera::capture(int timeout_ms) {
-  if (!s_ || !s_->started) return camFail(Status::kInvalid, name() + ": not streaming");
+Result<const Frame*> LibcameraCamera::capture(int timeout_ms) {
+  if (!s_ || !s_->started) return fail(ErrorCode::kInvalidInput, name() + ": not streaming");
   State& s = *s_;
   if (s.held) {
     s.frame.image.release();
     lc::Request* r = std::exchange(s.held, nullptr);
     if (s.requeue(r) < 0)
-      return camFail(Status::kNoDevice, name() + ": cannot queue a request (camera gone?)");
+      return fail(ErrorCode::kNoDevice, name() + ": cannot queue a request (camera gone?)");
   }
   uint64_t count = 0;
   (void)!::read(s.event_fd, &count, sizeof count);
@@ -231,10 +232,10 @@ CamResult<const Frame*> LibcameraCamera::capture(int timeout_ms) {
     (void)!::read(s.event_fd, &count, sizeof count);
     r = pop();
     if (!r)
-      return camFail(Status::kTimeout,
-                     name() + ": no frame within " + std::to_string(timeout_ms) + " ms");
+      return fail(ErrorCode::kTimeout,
+                  name() + ": no frame within " + std::to_string(timeout_ms) + " ms");
   }
-  if (!r) return camFail(Status::kAgain, name() + ": no frame waiting");
+  if (!r) return fail(ErrorCode::kAgain, name() + ": no frame waiting");
   {
     std::lock_guard lock(s.mutex);
     if (!s.completed.empty()) {
@@ -246,7 +247,7 @@ CamResult<const Frame*> LibcameraCamera::capture(int timeout_ms) {
   const lc::FrameBuffer* buffer = r->findBuffer(s.stream);
   const auto& meta = buffer->metadata();
   if (meta.status != lc::FrameMetadata::FrameSuccess)
-    return camFail(Status::kIo, name() + ": frame " + std::to_string(meta.sequence) + " failed");
+    return fail(ErrorCode::kIo, name() + ": frame " + std::to_string(meta.sequence) + " failed");
   const Mapping& map = s.mappings.at(buffer);
   const auto& plane = buffer->planes()[0];
   const SourceImage src{s.source,
@@ -256,15 +257,16 @@ CamResult<const Frame*> LibcameraCamera::capture(int timeout_ms) {
                         s.format.height,
                         s.stride};
   if (auto ok = convertFrame(src, s.format.pixel, true, s.storage, s.frame); !ok)
-    return camFail(ok.error().status, name() + ": " + ok.error().message);
+    return fail(ok.error().code, name() + ": " + ok.error().message);
   s.frame.sequence = meta.sequence;
   s.frame.timestamp_ns = meta.timestamp ? meta.timestamp : monotonicNs();
   return &s.frame;
 }
 
-CamResult<void> LibcameraCamera::setControl(Control control, double value) {
-  if (!s_ || !s_->camera) return camFail(Status::kInvalid, name() + ": not open");
-  if (!std::isfinite(value)) return camFail(Status::kInvalid, name() + ": value must be finite");
+Result<void> LibcameraCamera::setControl(Control control, double value) {
+  if (!s_ || !s_->camera) return fail(ErrorCode::kInvalidInput, name() + ": not open");
+  if (!std::isfinite(value))
+    return fail(ErrorCode::kInvalidInput, name() + ": value must be finite");
   State& s = *s_;
   const lc::ControlInfoMap& info = s.camera->controls();
   auto has = [&](const lc::ControlId& id) { return info.find(&id) != info.end(); };

@@ -22,7 +22,7 @@ struct LibcameraOptions {
 };
 
 // The ids of the cameras libcamera finds; kIo when its CameraManager does not start.
-CamResult<std::vector<std::string>> libcameraCameraIds();
+Result<std::vector<std::string>> libcameraCameraIds();
 
 class LibcameraCamera final : public Camera {
  public:
@@ -32,13 +32,13 @@ class LibcameraCamera final : public Camera {
   LibcameraCamera& operator=(const LibcameraCamera&) = delete;
 
   // kNoDevice "no camera" when libcamera lists none (or not the one asked for).
-  CamResult<void> start() override;
+  Result<void> start() override;
   void stop() override;
   FrameFormat format() const override;
-  CamResult<const Frame*> capture(int timeout_ms) override;
+  Result<const Frame*> capture(int timeout_ms) override;
   // Applied to the requests queued from now on. Gain is libcamera's analogue gain
   // (a multiplier, not dB); white balance is ColourTemperature with AWB off.
-  CamResult<void> setControl(Control control, double value) override;
+  Result<void> setControl(Control control, double value) override;
   int pollFd() const override;
   std::string name() const override { return "libcamera " + options_.id; }
 

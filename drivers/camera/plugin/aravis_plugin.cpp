@@ -20,7 +20,7 @@ int probe(const procam_device_desc* d) {
   return plugins::property(d, "ID_USB_INTERFACES").find(":ef0500:") != std::string::npos ? 60 : 0;
 }
 
-CamResult<AravisOptions> parse(const procam_device_desc* d, const CameraOptions& o) {
+Result<AravisOptions> parse(const procam_device_desc* d, const CameraOptions& o) {
   if (auto ok = o.onlyKnown({"id", "width", "height", "pixel_format", "packet_size", "fps",
                              "buffers", "pixel", PROCAM_CAMERA_CONTROL_KEYS});
       !ok)
@@ -33,7 +33,7 @@ CamResult<AravisOptions> parse(const procam_device_desc* d, const CameraOptions&
   else if (d && d->name)
     a.id = d->name;
   if (a.id.empty())
-    return camFail(Status::kInvalid, "aravis camera: no camera id: give the option id");
+    return fail(ErrorCode::kInvalidInput, "aravis camera: no camera id: give the option id");
   auto w = o.whole("width", 1, 65535);
   auto h = o.whole("height", 1, 65535);
   auto packet = o.whole("packet_size", 576, 65535);
@@ -45,7 +45,7 @@ CamResult<AravisOptions> parse(const procam_device_desc* d, const CameraOptions&
   if (!fps) return tl::unexpected(fps.error());
   if (!pixel) return tl::unexpected(pixel.error());
   if (w->has_value() != h->has_value())
-    return camFail(Status::kInvalid, "aravis camera: give both width and height, or neither");
+    return fail(ErrorCode::kInvalidInput, "aravis camera: give both width and height, or neither");
   a.width = uint32_t(w->value_or(0));
   a.height = uint32_t(h->value_or(0));
   a.packet_size = packet->value_or(0);

@@ -5,67 +5,48 @@
 #include <cstdlib>
 #include <cstring>
 #include <exception>
-#include <type_traits>
 
 #include "camera/convert.hpp"
 
 namespace procam::camera::plugin {
 
-int report(char* err, std::size_t len, const CameraError& error) {
-  return plugins::report(err, len, error.message, int(error.status));
-}
-
-namespace {
-
-// A DriverOptions result as a camera result (kInvalidInput -> kInvalid).
-template <class T>
-CamResult<T> lift(Result<T> r) {
-  if (!r) return camFail(Status(plugins::statusOf(r.error().code)), r.error().message);
-  if constexpr (std::is_void_v<T>)
-    return {};
-  else
-    return std::move(*r);
-}
-
-}  // namespace
-
 CameraOptions::CameraOptions(const std::string& driver, const procam_config* config)
     : options_(driver + " camera", config) {}
 
-CamResult<void> CameraOptions::onlyKnown(std::initializer_list<const char*> known) const {
-  return lift(options_.onlyKnown(known));
+Result<void> CameraOptions::onlyKnown(std::initializer_list<const char*> known) const {
+  return options_.onlyKnown(known);
 }
 
-CamResult<std::optional<double>> CameraOptions::number(const char* key) const {
-  return lift(options_.number(key));
+Result<std::optional<double>> CameraOptions::number(const char* key) const {
+  return options_.number(key);
 }
 
-CamResult<std::optional<bool>> CameraOptions::flag(const char* key) const {
-  return lift(options_.flag(key));
+Result<std::optional<bool>> CameraOptions::flag(const char* key) const {
+  return options_.flag(key);
 }
 
-CamResult<std::optional<int>> CameraOptions::whole(const char* key, int lo, int hi) const {
-  auto v = lift(options_.integer(key));
+Result<std::optional<int>> CameraOptions::whole(const char* key, int lo, int hi) const {
+  auto v = options_.integer(key);
   if (!v) return tl::unexpected(v.error());
   if (!*v) return std::optional<int>();
   if (**v < lo || **v > hi)
-    return camFail(Status::kInvalid, options_.who() + ": option " + key + ": " +
-                                         std::to_string(**v) + " is not in " + std::to_string(lo) +
-                                         ".." + std::to_string(hi));
+    return fail(ErrorCode::kInvalidInput, options_.who() + ": option " + key + ": " +
+                                              std::to_string(**v) + " is not in " +
+                                              std::to_string(lo) + ".." + std::to_string(hi));
   return std::optional<int>(int(**v));
 }
 
-CamResult<std::optional<procam_pixel_format>> CameraOptions::pixel() const {
+Result<std::optional<procam_pixel_format>> CameraOptions::pixel() const {
   const auto t = text("pixel");
   if (!t) return std::optional<procam_pixel_format>();
   auto p = parsePixel(*t);
   if (!p)
-    return camFail(Status::kInvalid,
-                   options_.who() + ": option pixel: '" + *t + "' is not gray8, gray16 or rgb8");
+    return fail(ErrorCode::kInvalidInput,
+                options_.who() + ": option pixel: '" + *t + "' is not gray8, gray16 or rgb8");
   return p;
 }
 
-CamResult<void> applyControls(Camera& camera, const CameraOptions& o) {
+Result<void> applyControls(Camera& camera, const CameraOptions& o) {
   // Auto exposure first: a manual exposure on a camera still in auto would be overridden.
   auto autoExposure = o.flag("auto_exposure");
   if (!autoExposure) return tl::unexpected(autoExposure.error());
@@ -109,14 +90,15 @@ int getFormat(void* self, uint32_t* w, uint32_t* h, procam_pixel_format* f) {
 int setExposure(void* self, double seconds, char* err, std::size_t len) {
   try {
     if (!(seconds > 0) || !std::isfinite(seconds))
-      return report(err, len, {Status::kInvalid, "exposure must be a positive number of seconds"});
+      return report(err, len,
+                    {ErrorCode::kInvalidInput, "exposure must be a positive number of seconds"});
     if (auto ok = cam(self)->setControl(Control::kAutoExposure, 0); !ok)
       return report(err, len, ok.error());
     if (auto ok = cam(self)->setControl(Control::kExposure, seconds); !ok)
       return report(err, len, ok.error());
     return PROCAM_OK;
   } catch (const std::exception& e) {
-    return report(err, len, {Status::kInternal, e.what()});
+    return report(err, len, {ErrorCode::kInternal, e.what()});
   }
 }
 
@@ -133,7 +115,7 @@ int capture(void* self, int timeout_ms, procam_image* out, char* err, std::size_
     out->timestamp_ns = (*frame)->timestamp_ns;
     return PROCAM_OK;
   } catch (const std::exception& e) {
-    return report(err, len, {Status::kInternal, e.what()});
+    return report(err, len, {ErrorCode::kInternal, e.what()});
   }
 }
 
@@ -167,7 +149,7 @@ int finishCameraDevice(std::unique_ptr<Camera> camera, const CameraOptions& opti
     out->ops.camera = &kOps;
     return PROCAM_OK;
   } catch (const std::exception& e) {
-    return report(err, len, {Status::kInternal, e.what()});
+    return report(err, len, {ErrorCode::kInternal, e.what()});
   }
 }
 

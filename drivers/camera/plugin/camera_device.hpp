@@ -17,21 +17,21 @@
 namespace procam::camera::plugin {
 
 // Writes the message into the caller's buffer and returns the error's status.
-int report(char* err, std::size_t len, const CameraError& error);
+using plugins::report;
 
 // A driver's options (plugins/support's DriverOptions, "<driver> camera: option K: ..."),
-// with the camera's error type and the keys only cameras have.
+// with the keys only cameras have.
 class CameraOptions {
  public:
   CameraOptions(const std::string& driver, const procam_config* config);
   // kInvalid naming the first key not in `known`.
-  CamResult<void> onlyKnown(std::initializer_list<const char*> known) const;
+  Result<void> onlyKnown(std::initializer_list<const char*> known) const;
   std::optional<std::string> text(const char* key) const { return options_.text(key); }
-  CamResult<std::optional<double>> number(const char* key) const;              // finite
-  CamResult<std::optional<int>> whole(const char* key, int lo, int hi) const;  // lo..hi
-  CamResult<std::optional<bool>> flag(const char* key) const;  // true/false/1/0/yes/no
+  Result<std::optional<double>> number(const char* key) const;              // finite
+  Result<std::optional<int>> whole(const char* key, int lo, int hi) const;  // lo..hi
+  Result<std::optional<bool>> flag(const char* key) const;                  // true/false/1/0/yes/no
   // "gray8" / "gray16" / "rgb8" under key "pixel".
-  CamResult<std::optional<procam_pixel_format>> pixel() const;
+  Result<std::optional<procam_pixel_format>> pixel() const;
 
  private:
   plugins::DriverOptions options_;
@@ -44,7 +44,7 @@ class CameraOptions {
 
 // Sets the configured controls on a started camera; a control the device does not
 // have fails with kNotSupported (the device is not opened half-configured).
-CamResult<void> applyControls(Camera& camera, const CameraOptions& options);
+Result<void> applyControls(Camera& camera, const CameraOptions& options);
 
 // Starts `camera`, applies the configured controls and fills `out`. capture() maps
 // to Camera::capture; set_exposure turns auto exposure off first.
@@ -56,7 +56,7 @@ int finishCameraDevice(std::unique_ptr<Camera> camera, const CameraOptions& opti
 template <class Options>
 int createCamera(const char* driver, const procam_device_desc* d, const procam_config* config,
                  procam_device* out, char* err, std::size_t len,
-                 CamResult<Options> (*parse)(const procam_device_desc*, const CameraOptions&),
+                 Result<Options> (*parse)(const procam_device_desc*, const CameraOptions&),
                  const std::function<std::unique_ptr<Camera>(Options)>& make) {
   try {
     const CameraOptions o(driver, config);
@@ -64,7 +64,7 @@ int createCamera(const char* driver, const procam_device_desc* d, const procam_c
     if (!parsed) return report(err, len, parsed.error());
     return finishCameraDevice(make(std::move(*parsed)), o, out, err, len);
   } catch (const std::exception& e) {
-    return report(err, len, {Status::kInternal, e.what()});
+    return report(err, len, {ErrorCode::kInternal, e.what()});
   }
 }
 

@@ -19,7 +19,7 @@ int probe(const procam_device_desc* d) {
   return 0;
 }
 
-CamResult<LibcameraOptions> parse(const procam_device_desc* d, const CameraOptions& o) {
+Result<LibcameraOptions> parse(const procam_device_desc* d, const CameraOptions& o) {
   if (auto ok = o.onlyKnown(
           {"id", "width", "height", "format", "buffers", "pixel", PROCAM_CAMERA_CONTROL_KEYS});
       !ok)
@@ -37,7 +37,8 @@ CamResult<LibcameraOptions> parse(const procam_device_desc* d, const CameraOptio
     if (!*r) return tl::unexpected(r->error());
   if (!pixel) return tl::unexpected(pixel.error());
   if (w->has_value() != h->has_value())
-    return camFail(Status::kInvalid, "libcamera camera: give both width and height, or neither");
+    return fail(ErrorCode::kInvalidInput,
+                "libcamera camera: give both width and height, or neither");
   l.width = uint32_t(w->value_or(0));
   l.height = uint32_t(h->value_or(0));
   l.buffers = unsigned(n->value_or(4));

@@ -18,7 +18,7 @@ int probe(const procam_device_desc* d) {
   return replay ? 90 : 0;
 }
 
-CamResult<ReplayOptions> parse(const procam_device_desc* d, const CameraOptions& o) {
+Result<ReplayOptions> parse(const procam_device_desc* d, const CameraOptions& o) {
   if (auto ok = o.onlyKnown({"dir", "speed", "loop", "pixel", PROCAM_CAMERA_CONTROL_KEYS}); !ok)
     return tl::unexpected(ok.error());
   ReplayOptions r;
@@ -29,7 +29,7 @@ CamResult<ReplayOptions> parse(const procam_device_desc* d, const CameraOptions&
   else if (d && d->devnode)
     r.dir = d->devnode;
   if (r.dir.empty())
-    return camFail(Status::kInvalid, "replay camera: no recording: give the option dir");
+    return fail(ErrorCode::kInvalidInput, "replay camera: no recording: give the option dir");
   auto speed = o.number("speed");
   auto loop = o.flag("loop");
   auto pixel = o.pixel();
@@ -38,7 +38,8 @@ CamResult<ReplayOptions> parse(const procam_device_desc* d, const CameraOptions&
   if (!pixel) return tl::unexpected(pixel.error());
   r.speed = speed->value_or(1.0);
   if (!(r.speed >= 0))
-    return camFail(Status::kInvalid, "replay camera: speed must be >= 0 (0: as fast as asked)");
+    return fail(ErrorCode::kInvalidInput,
+                "replay camera: speed must be >= 0 (0: as fast as asked)");
   r.loop = loop->value_or(false);
   r.pixel = *pixel;
   return r;

@@ -19,7 +19,7 @@ int probe(const procam_device_desc* d) {
   return v4l2 ? 50 : 0;
 }
 
-CamResult<V4l2Options> parse(const procam_device_desc* d, const CameraOptions& o) {
+Result<V4l2Options> parse(const procam_device_desc* d, const CameraOptions& o) {
   if (auto ok = o.onlyKnown({"device", "width", "height", "format", "fps", "buffers", "pixel",
                              PROCAM_CAMERA_CONTROL_KEYS});
       !ok)
@@ -27,7 +27,7 @@ CamResult<V4l2Options> parse(const procam_device_desc* d, const CameraOptions& o
   V4l2Options v;
   v.device = o.text("device").value_or(d && d->devnode ? d->devnode : "");
   if (v.device.empty())
-    return camFail(Status::kInvalid, "v4l2 camera: no device node: give the option device");
+    return fail(ErrorCode::kInvalidInput, "v4l2 camera: no device node: give the option device");
   auto w = o.whole("width", 1, 65535);
   auto h = o.whole("height", 1, 65535);
   auto n = o.whole("buffers", 4, 64);
@@ -38,18 +38,19 @@ CamResult<V4l2Options> parse(const procam_device_desc* d, const CameraOptions& o
   if (!fps) return tl::unexpected(fps.error());
   if (!pixel) return tl::unexpected(pixel.error());
   if (w->has_value() != h->has_value())
-    return camFail(Status::kInvalid, "v4l2 camera: give both width and height, or neither");
+    return fail(ErrorCode::kInvalidInput, "v4l2 camera: give both width and height, or neither");
   v.width = uint32_t(w->value_or(0));
   v.height = uint32_t(h->value_or(0));
   v.buffers = unsigned(n->value_or(4));
   v.fps = fps->value_or(0);
-  if (v.fps < 0) return camFail(Status::kInvalid, "v4l2 camera: fps must be > 0");
+  if (v.fps < 0) return fail(ErrorCode::kInvalidInput, "v4l2 camera: fps must be > 0");
   v.pixel = *pixel;
   if (auto f = o.text("format")) {
     v.fourcc = parseFourcc(*f);
     if (!v.fourcc)
-      return camFail(Status::kInvalid, "v4l2 camera: option format: '" + *f +
-                                           "' is not one of GREY, Y16, YUYV, MJPG, RGB3, BGR3");
+      return fail(ErrorCode::kInvalidInput,
+                  "v4l2 camera: option format: '" + *f +
+                      "' is not one of GREY, Y16, YUYV, MJPG, RGB3, BGR3");
   }
   return v;
 }

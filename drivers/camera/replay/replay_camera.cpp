@@ -25,7 +25,7 @@ std::string trim(const std::string& s) {
 
 }  // namespace
 
-CamResult<std::vector<ReplayEntry>> parseReplayIndex(const std::string& text) {
+Result<std::vector<ReplayEntry>> parseReplayIndex(const std::string& text) {
   std::vector<ReplayEntry> out;
   std::istringstream in(text);
   std::string line;
@@ -36,21 +36,22 @@ CamResult<std::vector<ReplayEntry>> parseReplayIndex(const std::string& text) {
     const auto comma = line.find(',');
     const std::string where = "index.csv line " + std::to_string(n) + ": ";
     if (comma == std::string::npos)
-      return camFail(Status::kInvalid, where + "expected 'file,timestamp'");
+      return fail(ErrorCode::kInvalidInput, where + "expected 'file,timestamp'");
     const std::string file = trim(line.substr(0, comma));
     const std::string stamp = trim(line.substr(comma + 1));
     if (out.empty() && file == "file" && stamp == "timestamp") continue;  // the header
     char* end = nullptr;
     const double t = std::strtod(stamp.c_str(), &end);
     if (file.empty() || stamp.empty() || *end != '\0' || !std::isfinite(t))
-      return camFail(Status::kInvalid, where + "'" + stamp + "' is not a timestamp in seconds");
+      return fail(ErrorCode::kInvalidInput,
+                  where + "'" + stamp + "' is not a timestamp in seconds");
     if (!out.empty() && !(t > last))
-      return camFail(Status::kInvalid, where + "timestamps must increase");
+      return fail(ErrorCode::kInvalidInput, where + "timestamps must increase");
     if (out.empty()) first = t;
     last = t;
     out.push_back({file, int64_t(std::llround((t - first) * 1e9))});
   }
-  if (out.empty()) return camFail(Status::kInvalid, "index.csv lists no frames");
+  if (out.empty()) return fail(ErrorCode::kInvalidInput, "index.csv lists no frames");
   return out;
 }
 
@@ -60,19 +61,18 @@ ReplayCamera::~ReplayCamera() {
   stop();
 }
 
-CamResult<void> ReplayCamera::start() {
+Result<void> ReplayCamera::start() {
   stop();
   if (!(options_.speed >= 0) || !std::isfinite(options_.speed))
-    return camFail(Status::kInvalid, "replay: speed must be >= 0");
+    return fail(ErrorCode::kInvalidInput, "replay: speed must be >= 0");
   const std::filesystem::path index = std::filesystem::path(options_.dir) / "index.csv";
   std::ifstream in(index);
-  if (!in) return camFail(Status::kNoDevice, "replay: cannot read " + index.string());
+  if (!in) return fail(ErrorCode::kNoDevice, "replay: cannot read " + index.string());
   std::stringstream text;
   text << in.rdbuf();
   auto entries = parseReplayIndex(text.str());
   if (!entries)
-    return camFail(entries.error().status,
-                   "replay " + options_.dir + ": " + entries.error().message);
+    return fail(entries.error().code, "replay " + options_.dir + ": " + entries.error().message);
   entries_ = std::move(*entries);
   // The first image fixes the format every later one must have.
   Frame first;
@@ -80,7 +80,7 @@ CamResult<void> ReplayCamera::start() {
   format_ = {uint32_t(first.image.cols), uint32_t(first.image.rows), first.pixel};
   timer_fd_ = timerfd_create(CLOCK_MONOTONIC, TFD_NONBLOCK | TFD_CLOEXEC);
   if (timer_fd_ < 0)
-    return camFail(Status::kIo, std::string("replay: timerfd: ") + std::strerror(errno));
+    return fail(ErrorCode::kIo, std::string("replay: timerfd: ") + std::strerror(errno));
   next_ = 0;
   start_ns_ = monotonicNs();
   armTimer();
@@ -108,15 +108,15 @@ void ReplayCamera::armTimer() {
   timerfd_settime(timer_fd_, TFD_TIMER_ABSTIME, &spec, nullptr);
 }
 
-CamResult<void> ReplayCamera::load(std::size_t i, Frame& out) {
+Result<void> ReplayCamera::load(std::size_t i, Frame& out) {
   const std::string path = (std::filesystem::path(options_.dir) / entries_[i].file).string();
   decoded_ = cv::imread(path, cv::IMREAD_UNCHANGED);
-  if (decoded_.empty()) return camFail(Status::kIo, "replay: cannot read image " + path);
+  if (decoded_.empty()) return fail(ErrorCode::kIo, "replay: cannot read image " + path);
   SourceFormat f;
   if (decoded_.depth() == CV_16U && decoded_.channels() == 1) {
     f = SourceFormat::kY16;
   } else if (decoded_.depth() != CV_8U) {
-    return camFail(Status::kInvalid, "replay: " + path + " is neither 8- nor 16-bit mono");
+    return fail(ErrorCode::kInvalidInput, "replay: " + path + " is neither 8- nor 16-bit mono");
   } else if (decoded_.channels() == 1) {
     f = SourceFormat::kGrey;
   } else if (decoded_.channels() == 3) {
@@ -125,7 +125,7 @@ CamResult<void> ReplayCamera::load(std::size_t i, Frame& out) {
     cv::cvtColor(decoded_, decoded_, cv::COLOR_BGRA2BGR);
     f = SourceFormat::kBgr24;
   } else {
-    return camFail(Status::kInvalid, "replay: " + path + " has an unsupported channel count");
+    return fail(ErrorCode::kInvalidInput, "replay: " + path + " has an unsupported channel count");
   }
   const procam_pixel_format want =
       options_.pixel.value_or(i == 0 ? naturalPixel(f) : format_.pixel);
@@ -137,24 +137,24 @@ CamResult<void> ReplayCamera::load(std::size_t i, Frame& out) {
                         uint32_t(decoded_.step[0])};
   // The decoded image lives until the next load: wrap it rather than copy it again.
   if (auto ok = convertFrame(src, want, true, storage_, out); !ok)
-    return camFail(ok.error().status, "replay: " + path + ": " + ok.error().message);
+    return fail(ok.error().code, "replay: " + path + ": " + ok.error().message);
   if (i > 0 &&
       (uint32_t(out.image.cols) != format_.width || uint32_t(out.image.rows) != format_.height))
-    return camFail(Status::kInvalid, "replay: " + path + " is " + std::to_string(out.image.cols) +
-                                         "x" + std::to_string(out.image.rows) +
-                                         ", the recording is " + std::to_string(format_.width) +
-                                         "x" + std::to_string(format_.height));
+    return fail(ErrorCode::kInvalidInput,
+                "replay: " + path + " is " + std::to_string(out.image.cols) + "x" +
+                    std::to_string(out.image.rows) + ", the recording is " +
+                    std::to_string(format_.width) + "x" + std::to_string(format_.height));
   // Decoding a file is the one copy a replayed frame costs.
   out.copies = 1 + out.copies;
   out.sequence = i;
   return {};
 }
 
-CamResult<const Frame*> ReplayCamera::capture(int timeout_ms) {
-  if (timer_fd_ < 0) return camFail(Status::kInvalid, "replay: not started");
+Result<const Frame*> ReplayCamera::capture(int timeout_ms) {
+  if (timer_fd_ < 0) return fail(ErrorCode::kInvalidInput, "replay: not started");
   if (next_ >= entries_.size()) {
     if (!options_.loop)
-      return camFail(Status::kEnded, "replay " + options_.dir + ": end of the recording (" +
+      return fail(ErrorCode::kEnded, "replay " + options_.dir + ": end of the recording (" +
                                          std::to_string(entries_.size()) + " frames)");
     next_ = 0;
     start_ns_ = monotonicNs();
@@ -167,13 +167,13 @@ CamResult<const Frame*> ReplayCamera::capture(int timeout_ms) {
     const uint64_t wait = due - now;
     if (timeout_ms == 0) {
       armTimer();
-      return camFail(Status::kAgain, "replay: next frame not due yet");
+      return fail(ErrorCode::kAgain, "replay: next frame not due yet");
     }
     if (timeout_ms > 0 && wait > uint64_t(timeout_ms) * 1'000'000ull) {
       std::this_thread::sleep_for(std::chrono::milliseconds(timeout_ms));
       armTimer();
-      return camFail(Status::kTimeout,
-                     "replay: no frame due within " + std::to_string(timeout_ms) + " ms");
+      return fail(ErrorCode::kTimeout,
+                  "replay: no frame due within " + std::to_string(timeout_ms) + " ms");
     }
     std::this_thread::sleep_for(std::chrono::nanoseconds(wait));
   }
@@ -184,7 +184,7 @@ CamResult<const Frame*> ReplayCamera::capture(int timeout_ms) {
   return &frame_;
 }
 
-CamResult<void> ReplayCamera::setControl(Control control, double) {
+Result<void> ReplayCamera::setControl(Control control, double) {
   // The recording fixed exposure, gain and white balance when it was made.
   return unsupported(name(), control);
 }

@@ -19,7 +19,7 @@ struct ReplayEntry {
 
 // Parses index.csv text: kInvalid with the line number for a malformed line, a
 // timestamp that is not finite or does not increase, or no frames at all.
-CamResult<std::vector<ReplayEntry>> parseReplayIndex(const std::string& text);
+Result<std::vector<ReplayEntry>> parseReplayIndex(const std::string& text);
 
 struct ReplayOptions {
   std::string dir;
@@ -35,13 +35,13 @@ class ReplayCamera final : public Camera {
   ReplayCamera(const ReplayCamera&) = delete;
   ReplayCamera& operator=(const ReplayCamera&) = delete;
 
-  CamResult<void> start() override;
+  Result<void> start() override;
   void stop() override;
   FrameFormat format() const override { return format_; }
   // Frame i is due at start + offset_i / speed; its timestamp is start + offset_i, so
   // the recorded spacing survives any speed.
-  CamResult<const Frame*> capture(int timeout_ms) override;
-  CamResult<void> setControl(Control control, double value) override;
+  Result<const Frame*> capture(int timeout_ms) override;
+  Result<void> setControl(Control control, double value) override;
   // A timerfd that turns readable when the next frame is due.
   int pollFd() const override { return timer_fd_; }
   std::string name() const override { return "replay " + options_.dir; }
@@ -49,7 +49,7 @@ class ReplayCamera final : public Camera {
   std::size_t frameCount() const { return entries_.size(); }
 
  private:
-  CamResult<void> load(std::size_t index, Frame& out);
+  Result<void> load(std::size_t index, Frame& out);
   uint64_t dueNs(std::size_t index) const;
   void armTimer();
 

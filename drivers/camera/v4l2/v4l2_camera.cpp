@@ -95,20 +95,20 @@ V4l2Camera::~V4l2Camera() {
   stop();
 }
 
-CameraError V4l2Camera::errnoError(int negErrno, const std::string& what) const {
+Error V4l2Camera::errnoError(int negErrno, const std::string& what) const {
   const int e = -negErrno;
   const std::string text = name() + ": " + what + ": " + std::strerror(e);
   // The node is gone (unplugged) or never was: the daemon reopens it when it returns.
-  if (e == ENODEV || e == ENXIO || e == ENOENT) return {Status::kNoDevice, text};
-  if (e == EINVAL || e == ERANGE) return {Status::kInvalid, text};
-  if (e == ETIMEDOUT) return {Status::kTimeout, text};
-  return {Status::kIo, text};
+  if (e == ENODEV || e == ENXIO || e == ENOENT) return {ErrorCode::kNoDevice, text};
+  if (e == EINVAL || e == ERANGE) return {ErrorCode::kInvalidInput, text};
+  if (e == ETIMEDOUT) return {ErrorCode::kTimeout, text};
+  return {ErrorCode::kIo, text};
 }
 
-CamResult<void> V4l2Camera::start() {
+Result<void> V4l2Camera::start() {
   stop();
   if (options_.buffers < 4)
-    return camFail(Status::kInvalid, name() + ": at least 4 buffers are needed");
+    return fail(ErrorCode::kInvalidInput, name() + ": at least 4 buffers are needed");
   const int fd = io_->open(options_.device);
   if (fd < 0) return tl::unexpected(errnoError(fd, "open"));
   fd_ = fd;
@@ -119,10 +119,11 @@ CamResult<void> V4l2Camera::start() {
     return tl::unexpected(e);
   }
   info_ = infoOf(options_.device, cap);
-  auto ok = isCapture(cap) ? CamResult<void>()
-                           : camFail(Status::kNotSupported,
-                                     name() + " (" + info_.card +
-                                         "): not a video capture device with streaming I/O");
+  auto ok =
+      isCapture(cap)
+          ? Result<void>()
+          : fail(ErrorCode::kNotSupported,
+                 name() + " (" + info_.card + "): not a video capture device with streaming I/O");
   if (ok) ok = negotiate();
   if (ok) ok = setFrameRate();
   if (ok) ok = mapBuffers();
@@ -137,7 +138,7 @@ CamResult<void> V4l2Camera::start() {
   return ok;
 }
 
-CamResult<void> V4l2Camera::negotiate() {
+Result<void> V4l2Camera::negotiate() {
   std::vector<uint32_t> offered;
   for (uint32_t i = 0;; ++i) {
     v4l2_fmtdesc d{};
@@ -155,7 +156,7 @@ CamResult<void> V4l2Camera::negotiate() {
   for (uint32_t f : offered) list += (list.empty() ? "" : ", ") + fourccText(f);
   if (options_.fourcc) {
     if (!has(*options_.fourcc))
-      return camFail(Status::kNotSupported, name() + ": format " + fourccText(*options_.fourcc) +
+      return fail(ErrorCode::kNotSupported, name() + ": format " + fourccText(*options_.fourcc) +
                                                 " not offered (offers: " + list + ")");
     fourcc_ = *options_.fourcc;
   } else {
@@ -163,8 +164,8 @@ CamResult<void> V4l2Camera::negotiate() {
     for (uint32_t f : kV4l2Preference)
       if (!fourcc_ && has(f)) fourcc_ = f;
     if (!fourcc_)
-      return camFail(
-          Status::kNotSupported,
+      return fail(
+          ErrorCode::kNotSupported,
           name() + ": none of the device's formats can be converted (offers: " + list + ")");
   }
 
@@ -191,7 +192,7 @@ CamResult<void> V4l2Camera::negotiate() {
     for (auto [sw, sh] : sizes) offers += (offers.empty() ? "" : ", ") + sizeText(sw, sh);
     if (asked) {
       if (std::find(sizes.begin(), sizes.end(), std::make_pair(w, h)) == sizes.end())
-        return camFail(Status::kNotSupported, name() + ": " + sizeText(w, h) + " " +
+        return fail(ErrorCode::kNotSupported, name() + ": " + sizeText(w, h) + " " +
                                                   fourccText(fourcc_) +
                                                   " not offered (offers: " + offers + ")");
     } else {
@@ -204,10 +205,10 @@ CamResult<void> V4l2Camera::negotiate() {
   } else if (range) {
     if (asked && (w < range->min_width || w > range->max_width || h < range->min_height ||
                   h > range->max_height))
-      return camFail(Status::kNotSupported,
-                     name() + ": " + sizeText(w, h) + " outside the device's range " +
-                         sizeText(range->min_width, range->min_height) + " .. " +
-                         sizeText(range->max_width, range->max_height));
+      return fail(ErrorCode::kNotSupported,
+                  name() + ": " + sizeText(w, h) + " outside the device's range " +
+                      sizeText(range->min_width, range->min_height) + " .. " +
+                      sizeText(range->max_width, range->max_height));
     if (!asked) {
       w = range->max_width;
       h = range->max_height;
@@ -235,11 +236,11 @@ CamResult<void> V4l2Camera::negotiate() {
   if (int rc = io_->ioctl(fd_, VIDIOC_G_FMT, &fmt); rc < 0)
     return tl::unexpected(errnoError(rc, "VIDIOC_G_FMT"));
   if (fmt.fmt.pix.pixelformat != fourcc_)
-    return camFail(Status::kNotSupported, name() + ": asked for " + fourccText(fourcc_) +
+    return fail(ErrorCode::kNotSupported, name() + ": asked for " + fourccText(fourcc_) +
                                               ", the device chose " +
                                               fourccText(fmt.fmt.pix.pixelformat));
   if (asked && (fmt.fmt.pix.width != w || fmt.fmt.pix.height != h))
-    return camFail(Status::kNotSupported, name() + ": asked for " + sizeText(w, h) +
+    return fail(ErrorCode::kNotSupported, name() + ": asked for " + sizeText(w, h) +
                                               ", the device chose " +
                                               sizeText(fmt.fmt.pix.width, fmt.fmt.pix.height));
   const SourceFormat src = *sourceFormatOf(fourcc_);
@@ -250,27 +251,27 @@ CamResult<void> V4l2Camera::negotiate() {
   stride_ = fmt.fmt.pix.bytesperline ? fmt.fmt.pix.bytesperline : fmt.fmt.pix.width * bpp;
   const procam_pixel_format pixel = options_.pixel.value_or(naturalPixel(src));
   if (pixel == PROCAM_PIXEL_GRAY16 && src != SourceFormat::kY16)
-    return camFail(Status::kNotSupported,
-                   name() + ": " + fourccText(fourcc_) + " is 8-bit; gray16 needs Y16");
+    return fail(ErrorCode::kNotSupported,
+                name() + ": " + fourccText(fourcc_) + " is 8-bit; gray16 needs Y16");
   format_ = {fmt.fmt.pix.width, fmt.fmt.pix.height, pixel};
   return {};
 }
 
-CamResult<void> V4l2Camera::setFrameRate() {
+Result<void> V4l2Camera::setFrameRate() {
   if (!(options_.fps > 0)) return {};
   v4l2_streamparm parm{};
   parm.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
   if (int rc = io_->ioctl(fd_, VIDIOC_G_PARM, &parm); rc < 0 && rc != -ENOTTY && rc != -EINVAL)
     return tl::unexpected(errnoError(rc, "VIDIOC_G_PARM"));
   if (!(parm.parm.capture.capability & V4L2_CAP_TIMEPERFRAME))
-    return camFail(Status::kNotSupported, name() + ": frame rate is not supported by this device");
+    return fail(ErrorCode::kNotSupported, name() + ": frame rate is not supported by this device");
   parm.parm.capture.timeperframe = {1000, uint32_t(std::lround(options_.fps * 1000))};
   if (int rc = io_->ioctl(fd_, VIDIOC_S_PARM, &parm); rc < 0)
     return tl::unexpected(errnoError(rc, "VIDIOC_S_PARM"));
   return {};
 }
 
-CamResult<void> V4l2Camera::mapBuffers() {
+Result<void> V4l2Camera::mapBuffers() {
   v4l2_requestbuffers req{};
   req.count = options_.buffers;
   req.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
@@ -279,7 +280,7 @@ CamResult<void> V4l2Camera::mapBuffers() {
     return tl::unexpected(errnoError(rc, "VIDIOC_REQBUFS (mmap)"));
   // The driver may grant fewer: with fewer than 4 one held frame stalls the stream.
   if (req.count < 4)
-    return camFail(Status::kIo, name() + ": the device granted " + std::to_string(req.count) +
+    return fail(ErrorCode::kIo, name() + ": the device granted " + std::to_string(req.count) +
                                     " buffers, at least 4 are needed");
   buffers_.resize(req.count);
   for (uint32_t i = 0; i < req.count; ++i) {
@@ -321,7 +322,7 @@ void V4l2Camera::stop() {
   fd_ = -1;
 }
 
-CamResult<void> V4l2Camera::requeueHeld() {
+Result<void> V4l2Camera::requeueHeld() {
   if (held_ < 0) return {};
   v4l2_buffer b{};
   b.index = uint32_t(held_);
@@ -334,34 +335,34 @@ CamResult<void> V4l2Camera::requeueHeld() {
   return {};
 }
 
-CamResult<const Frame*> V4l2Camera::capture(int timeout_ms) {
-  if (!streaming_) return camFail(Status::kInvalid, name() + ": not streaming");
+Result<const Frame*> V4l2Camera::capture(int timeout_ms) {
+  if (!streaming_) return fail(ErrorCode::kInvalidInput, name() + ": not streaming");
   if (auto ok = requeueHeld(); !ok) return tl::unexpected(ok.error());
   v4l2_buffer b{};
   b.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
   b.memory = V4L2_MEMORY_MMAP;
   int rc = io_->ioctl(fd_, VIDIOC_DQBUF, &b);
   if (rc == -EAGAIN) {
-    if (timeout_ms == 0) return camFail(Status::kAgain, name() + ": no frame waiting");
+    if (timeout_ms == 0) return fail(ErrorCode::kAgain, name() + ": no frame waiting");
     bool hangup = false;
     const int p = io_->poll(fd_, timeout_ms, &hangup);
     if (p < 0) return tl::unexpected(errnoError(p, "poll"));
     if (p == 0)
-      return camFail(Status::kTimeout,
-                     name() + ": no frame within " + std::to_string(timeout_ms) + " ms");
+      return fail(ErrorCode::kTimeout,
+                  name() + ": no frame within " + std::to_string(timeout_ms) + " ms");
     rc = io_->ioctl(fd_, VIDIOC_DQBUF, &b);
     if (rc == -EAGAIN)
-      return hangup ? camFail(Status::kNoDevice, name() + ": the device hung up")
-                    : camFail(Status::kAgain, name() + ": no frame waiting");
+      return hangup ? fail(ErrorCode::kNoDevice, name() + ": the device hung up")
+                    : fail(ErrorCode::kAgain, name() + ": no frame waiting");
   }
   if (rc < 0) return tl::unexpected(errnoError(rc, "VIDIOC_DQBUF"));
   if (b.index >= buffers_.size())
-    return camFail(Status::kIo,
-                   name() + ": the device returned unknown buffer " + std::to_string(b.index));
+    return fail(ErrorCode::kIo,
+                name() + ": the device returned unknown buffer " + std::to_string(b.index));
   held_ = int(b.index);
   if (b.flags & V4L2_BUF_FLAG_ERROR) {
     (void)requeueHeld();
-    return camFail(Status::kIo, name() + ": the device flagged frame " +
+    return fail(ErrorCode::kIo, name() + ": the device flagged frame " +
                                     std::to_string(b.sequence) + " as corrupt");
   }
   const Mapped& m = buffers_[b.index];
@@ -375,7 +376,7 @@ CamResult<const Frame*> V4l2Camera::capture(int timeout_ms) {
   // The buffer stays dequeued until the next capture, so the frame may point into it.
   if (auto ok = convertFrame(src, format_.pixel, true, storage_, frame_); !ok) {
     (void)requeueHeld();
-    return camFail(ok.error().status, name() + ": " + ok.error().message);
+    return fail(ok.error().code, name() + ": " + ok.error().message);
   }
   frame_.sequence = b.sequence;
   const bool monotonic =
@@ -392,8 +393,8 @@ bool V4l2Camera::hasCtrl(uint32_t id) {
   return io_->ioctl(fd_, VIDIOC_QUERYCTRL, &q) == 0 && !(q.flags & V4L2_CTRL_FLAG_DISABLED);
 }
 
-CamResult<void> V4l2Camera::setCtrl(uint32_t id, int64_t value, Control control) {
-  if (fd_ < 0) return camFail(Status::kInvalid, name() + ": not open");
+Result<void> V4l2Camera::setCtrl(uint32_t id, int64_t value, Control control) {
+  if (fd_ < 0) return fail(ErrorCode::kInvalidInput, name() + ": not open");
   v4l2_queryctrl q{};
   q.id = id;
   if (int rc = io_->ioctl(fd_, VIDIOC_QUERYCTRL, &q); rc < 0) {
@@ -403,19 +404,19 @@ CamResult<void> V4l2Camera::setCtrl(uint32_t id, int64_t value, Control control)
   if (q.flags & (V4L2_CTRL_FLAG_DISABLED | V4L2_CTRL_FLAG_READ_ONLY))
     return unsupported(name(), control);
   if (value < q.minimum || value > q.maximum)
-    return camFail(Status::kInvalid, name() + ": " + toString(control) + " value " +
-                                         std::to_string(value) + " outside the device's range [" +
-                                         std::to_string(q.minimum) + ", " +
-                                         std::to_string(q.maximum) + "]");
+    return fail(ErrorCode::kInvalidInput,
+                name() + ": " + toString(control) + " value " + std::to_string(value) +
+                    " outside the device's range [" + std::to_string(q.minimum) + ", " +
+                    std::to_string(q.maximum) + "]");
   v4l2_control c{id, int32_t(value)};
   if (int rc = io_->ioctl(fd_, VIDIOC_S_CTRL, &c); rc < 0)
     return tl::unexpected(errnoError(rc, std::string("setting ") + toString(control)));
   return {};
 }
 
-CamResult<void> V4l2Camera::setControl(Control control, double value) {
+Result<void> V4l2Camera::setControl(Control control, double value) {
   if (!std::isfinite(value))
-    return camFail(Status::kInvalid, name() + ": " + toString(control) + " must be finite");
+    return fail(ErrorCode::kInvalidInput, name() + ": " + toString(control) + " must be finite");
   switch (control) {
     case Control::kExposure:
       // V4L2_CID_EXPOSURE_ABSOLUTE counts 100 µs units.
@@ -426,7 +427,7 @@ CamResult<void> V4l2Camera::setControl(Control control, double value) {
       if (value == 0) return setCtrl(V4L2_CID_EXPOSURE_AUTO, V4L2_EXPOSURE_MANUAL, control);
       // UVC cameras often offer only aperture priority as their automatic mode.
       auto ok = setCtrl(V4L2_CID_EXPOSURE_AUTO, V4L2_EXPOSURE_AUTO, control);
-      if (!ok && ok.error().status == Status::kInvalid)
+      if (!ok && ok.error().code == ErrorCode::kInvalidInput)
         ok = setCtrl(V4L2_CID_EXPOSURE_AUTO, V4L2_EXPOSURE_APERTURE_PRIORITY, control);
       return ok;
     }
@@ -446,7 +447,8 @@ CamResult<void> V4l2Camera::setControl(Control control, double value) {
                            : value == 60 ? V4L2_CID_POWER_LINE_FREQUENCY_60HZ
                                          : -1;
       if (menu < 0)
-        return camFail(Status::kInvalid, name() + ": power-line frequency must be 0, 50 or 60 Hz");
+        return fail(ErrorCode::kInvalidInput,
+                    name() + ": power-line frequency must be 0, 50 or 60 Hz");
       return setCtrl(V4L2_CID_POWER_LINE_FREQUENCY, menu, control);
     }
   }

@@ -48,13 +48,13 @@ class V4l2Camera final : public Camera {
   V4l2Camera(const V4l2Camera&) = delete;
   V4l2Camera& operator=(const V4l2Camera&) = delete;
 
-  CamResult<void> start() override;
+  Result<void> start() override;
   void stop() override;
   FrameFormat format() const override { return format_; }
   // Queues the previous frame's buffer again, then dequeues the next one; the frame
   // points into the mapped buffer when no conversion is needed.
-  CamResult<const Frame*> capture(int timeout_ms) override;
-  CamResult<void> setControl(Control control, double value) override;
+  Result<const Frame*> capture(int timeout_ms) override;
+  Result<void> setControl(Control control, double value) override;
   int pollFd() const override { return fd_; }
   std::string name() const override { return "v4l2 " + options_.device; }
 
@@ -67,14 +67,14 @@ class V4l2Camera final : public Camera {
     void* data = nullptr;
     std::size_t length = 0;
   };
-  CamResult<void> negotiate();
-  CamResult<void> setFrameRate();
-  CamResult<void> mapBuffers();
-  CamResult<void> requeueHeld();
+  Result<void> negotiate();
+  Result<void> setFrameRate();
+  Result<void> mapBuffers();
+  Result<void> requeueHeld();
   // QUERYCTRL then S_CTRL; kNotSupported when the device has no such control.
-  CamResult<void> setCtrl(uint32_t id, int64_t value, Control control);
+  Result<void> setCtrl(uint32_t id, int64_t value, Control control);
   bool hasCtrl(uint32_t id);
-  CameraError errnoError(int negErrno, const std::string& what) const;
+  Error errnoError(int negErrno, const std::string& what) const;
 
   V4l2Options options_;
   std::unique_ptr<V4l2Io> io_;

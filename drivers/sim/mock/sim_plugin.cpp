@@ -12,10 +12,12 @@
 
 #include "render/cpu_renderer.hpp"
 #include "sim/sensors.hpp"
+#include "sim_tilt.hpp"
 #include "sim_unplug.hpp"
 #include "sim_world.hpp"
 #include "support/driver_support.hpp"
 #include "support/render_abi.hpp"
+#include "tilt/plugin/plugin_support.hpp"
 
 namespace procam::sim::mock {
 namespace {
@@ -60,24 +62,6 @@ void destroy(void* self) {
 int probe(const procam_device_desc* d) {
   return d->subsystem && std::strcmp(d->subsystem, "sim") == 0 ? kSimScore : 0;
 }
-
-// --- tilt ---
-int tiltRead(void* self, procam_tilt_sample* out, char* err, size_t len) {
-  auto* dev = static_cast<Device*>(self);
-  if (int rc = presence(dev->name, err, len); rc != PROCAM_OK) return rc;
-  const double t = dev->world->now();
-  auto s = sampleTilt(dev->world->scene(), dev->name, t);
-  if (!s) return report(err, len, s.error().message, PROCAM_EIO);
-  const TiltSensorSpec* spec = nullptr;
-  for (const auto& ts : dev->world->scene().tiltSensors()) {
-    if (ts.name == dev->name) spec = &ts;
-  }
-  const double unit = spec && spec->report_in_g ? kStandardGravity : 1.0;  // ABI: m/s^2
-  for (int i = 0; i < 3; ++i) out->specific_force[i] = s->value[i] * unit;
-  out->timestamp_ns = static_cast<uint64_t>(t * 1e9);
-  return PROCAM_OK;
-}
-const procam_tilt_ops kTiltOps = {PROCAM_TILT_OPS_VERSION, tiltRead};
 
 // --- tracker ---
 int trackerRead(void* self, procam_pose_sample* out, char* err, size_t len) {
@@ -296,7 +280,11 @@ int create(const procam_device_desc* d, const procam_config*, procam_device* out
       out->ops.camera = &kCameraOps;
     } else if constexpr (Family == PROCAM_FAMILY_TILT) {
       for (const auto& t : s.tiltSensors()) known = known || t.name == name;
-      out->ops.tilt = &kTiltOps;
+      // Through the tilt drivers' wrapper: the same sample gate and counts as hardware.
+      if (known) {
+        return tilt::plugin::finishTiltDevice(std::make_unique<SimTiltSensor>(*world, name),
+                                              tilt::SampleGateOptions{}, out, err, len);
+      }
     } else if constexpr (Family == PROCAM_FAMILY_TRACKER) {
       for (const auto& t : s.trackers()) known = known || t.name == name;
       out->ops.tracker = &kTrackerOps;

@@ -4,6 +4,7 @@
 #include <exception>
 #include <sstream>
 
+#include "core/units.hpp"
 #include "tilt/plugin/plugin_support.hpp"
 #include "tilt/plugin/tilt_plugin.hpp"
 #if PROCAM_TILT_GPIOD
@@ -12,8 +13,6 @@
 
 namespace procam::tilt::plugin {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 #define PROCAM_GPIO_KEYS "chip", "lines", "debounce_ms", "tilt_deg", "table", PROCAM_TILT_GATE_KEYS
 
@@ -48,7 +47,7 @@ Result<BallSwitchConfig> parseSwitch(const PluginOptions& o) {
   if (!(deg > 0 && deg <= 90))
     return fail(ErrorCode::kInvalidInput, "gpio tilt: tilt_deg must be in (0, 90]");
   c.debounce_ns = std::uint64_t(ms * 1e6);
-  c.tilt_angle = deg * kPi / 180;
+  c.tilt_angle = degToRad(deg);
   if (auto table = o.text("table")) {
     const auto names = split(*table);
     if (names.size() != 4)

@@ -46,19 +46,25 @@ int readSample(void* self, procam_tilt_sample* out, char* err, std::size_t len) 
           d->gate.countNotFinite();
         else
           d->gate.countOutOfRange();
-        return report(err, len, PROCAM_TILT_REJECTED_PREFIX + e.message, PROCAM_EAGAIN);
+        return report(err, len, "sample rejected: " + e.message, PROCAM_EAGAIN);
       }
       return report(err, len, e.message, statusOf(e.code));
     }
     auto checked = d->gate.check(*s);
     if (!checked)
-      return report(err, len, PROCAM_TILT_REJECTED_PREFIX + checked.error().message, PROCAM_EAGAIN);
+      return report(err, len, "sample rejected: " + checked.error().message, PROCAM_EAGAIN);
     for (int a = 0; a < 3; ++a) out->specific_force[a] = checked->specific_force(a);
     out->timestamp_ns = checked->timestamp_ns;
     return PROCAM_OK;
   } catch (const std::exception& e) {
     return report(err, len, e.what(), PROCAM_EINTERNAL);
   }
+}
+
+int getCounts(void* self, procam_tilt_counts* out) {
+  const SampleCounts& c = static_cast<const TiltDevice*>(self)->gate.counts();
+  *out = {c.accepted, c.not_finite, c.out_of_range, c.stuck, c.bad_norm};
+  return PROCAM_OK;
 }
 
 int pollFd(void* self) {
@@ -69,7 +75,7 @@ void destroy(void* self) {
   delete static_cast<TiltDevice*>(self);  // the sensor's destructor closes it
 }
 
-const procam_tilt_ops kOps = {PROCAM_TILT_OPS_VERSION, &readSample};
+const procam_tilt_ops kOps = {PROCAM_TILT_OPS_VERSION, &readSample, &getCounts};
 
 }  // namespace
 
@@ -89,10 +95,6 @@ int finishTiltDevice(std::unique_ptr<TiltSensor> sensor, const SampleGateOptions
   } catch (const std::exception& e) {
     return report(err, len, e.what(), PROCAM_EINTERNAL);
   }
-}
-
-const SampleCounts& tiltDeviceCounts(const procam_device& device) {
-  return static_cast<const TiltDevice*>(device.self)->gate.counts();
 }
 
 }  // namespace procam::tilt::plugin

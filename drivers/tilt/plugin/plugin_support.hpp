@@ -33,14 +33,12 @@ class PluginOptions : public plugins::DriverOptions {
 // The gate keys, for onlyKnown() lists.
 #define PROCAM_TILT_GATE_KEYS "gate_range_g", "min_norm_g", "max_norm_g", "stuck_limit"
 
-// Opens `sensor` and fills `out` with a tilt device reading it through a SampleGate.
-// read(): PROCAM_OK with a sample; PROCAM_EAGAIN when no new sample is waiting, or
-// with PROCAM_TILT_REJECTED_PREFIX when a garbage sample was dropped (and counted);
-// PROCAM_EIO/ENODEV when the device fails. poll_fd() is the sensor's pollFd().
+// Opens `sensor` and fills `out` with a tilt device reading it through a SampleGate, the
+// one place garbage tilt samples are dropped (procam_plugin.h, procam_tilt_counts).
+// read(): PROCAM_OK with a sample; PROCAM_EAGAIN when no new sample is waiting or a
+// garbage sample was dropped (and counted); PROCAM_EIO/ENODEV when the device fails.
+// get_counts(): the gate's counts. poll_fd() is the sensor's pollFd().
 int finishTiltDevice(std::unique_ptr<TiltSensor> sensor, const SampleGateOptions& gate,
                      procam_device* out, char* err, std::size_t len);
-
-// The gate counts of a device made by finishTiltDevice.
-const SampleCounts& tiltDeviceCounts(const procam_device& device);
 
 }  // namespace procam::tilt::plugin

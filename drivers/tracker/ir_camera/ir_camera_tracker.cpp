@@ -3,6 +3,8 @@
 #include <array>
 #include <string>
 
+#include "support/driver_support.hpp"
+
 namespace procam::tracker {
 namespace {
 
@@ -26,22 +28,20 @@ void OwnedCamera::release() {
   device_ = {};
 }
 
-CamResult<IrCameraTracker> IrCameraTracker::create(OwnedCamera camera,
-                                                   const IrCameraConfig& config) {
-  if (!camera.valid()) return camera::camFail(Status::kInternal, "ir_camera tracker: no camera");
+Result<IrCameraTracker> IrCameraTracker::create(OwnedCamera camera, const IrCameraConfig& config) {
+  if (!camera.valid()) return fail(ErrorCode::kInternal, "ir_camera tracker: no camera");
   const procam_device& raw = camera.raw();
   uint32_t width = 0, height = 0;
   procam_pixel_format pixel = PROCAM_PIXEL_GRAY8;
   if (const int rc = raw.ops.camera->get_format(raw.self, &width, &height, &pixel); rc != PROCAM_OK)
-    return camera::camFail(static_cast<Status>(rc), "ir_camera tracker: the camera has no format");
+    return fail(plugins::codeOf(rc), "ir_camera tracker: the camera has no format");
   if (pixel != PROCAM_PIXEL_GRAY8 && pixel != PROCAM_PIXEL_GRAY16)
-    return camera::camFail(Status::kInvalid,
-                           std::string("ir_camera tracker: the camera delivers ") +
-                               pixelName(pixel) +
-                               "; IR blobs need gray8 or gray16 (camera.pixel = gray8)");
+    return fail(ErrorCode::kInvalidInput,
+                std::string("ir_camera tracker: the camera delivers ") + pixelName(pixel) +
+                    "; IR blobs need gray8 or gray16 (camera.pixel = gray8)");
   // The detector checks its own options; a blank frame costs nothing.
   if (auto ok = tracking::detectBlobs(cv::Mat(1, 1, CV_8UC1, cv::Scalar(0)), {}, config.blobs); !ok)
-    return camera::camFail(Status::kInvalid, "ir_camera tracker: " + ok.error().message);
+    return fail(ErrorCode::kInvalidInput, "ir_camera tracker: " + ok.error().message);
   geom::CameraModel model;
   model.K = config.K;
   model.dist = config.dist;
@@ -50,7 +50,7 @@ CamResult<IrCameraTracker> IrCameraTracker::create(OwnedCamera camera,
   model.height = static_cast<int>(height);
   auto tracker = tracking::LedTracker::create(model, config.tracker);
   if (!tracker)
-    return camera::camFail(Status::kInvalid, "ir_camera tracker: " + tracker.error().message);
+    return fail(ErrorCode::kInvalidInput, "ir_camera tracker: " + tracker.error().message);
   return IrCameraTracker(std::move(camera), config, std::move(*tracker));
 }
 
@@ -59,22 +59,21 @@ int IrCameraTracker::pollFd() const {
   return raw.poll_fd ? raw.poll_fd(raw.self) : -1;
 }
 
-CamResult<procam_pose_sample> IrCameraTracker::read() {
+Result<procam_pose_sample> IrCameraTracker::read() {
   const procam_device& raw = camera_.raw();
   procam_image image{};
   std::array<char, 256> err{};
   const int rc = raw.ops.camera->capture(raw.self, config_.capture_timeout_ms, &image, err.data(),
                                          err.size() - 1);
-  if (rc != PROCAM_OK)
-    return camera::camFail(static_cast<Status>(rc), std::string("camera: ") + err.data());
+  if (rc != PROCAM_OK) return fail(plugins::codeOf(rc), std::string("camera: ") + err.data());
   if (image.format != PROCAM_PIXEL_GRAY8 && image.format != PROCAM_PIXEL_GRAY16)
-    return camera::camFail(Status::kIo, std::string("camera: a ") + pixelName(image.format) +
-                                            " frame where gray8 or gray16 was negotiated");
+    return fail(ErrorCode::kIo, std::string("camera: a ") + pixelName(image.format) +
+                                    " frame where gray8 or gray16 was negotiated");
   const cv::Mat frame(static_cast<int>(image.height), static_cast<int>(image.width),
                       image.format == PROCAM_PIXEL_GRAY8 ? CV_8UC1 : CV_16UC1, image.data,
                       image.stride);
   auto blobs = tracking::detectBlobs(frame, {}, config_.blobs);
-  if (!blobs) return camera::camFail(Status::kInvalid, blobs.error().message);
+  if (!blobs) return fail(ErrorCode::kInvalidInput, blobs.error().message);
   Points2 centres;
   centres.reserve(blobs->size());
   for (const tracking::Blob& b : *blobs) centres.push_back(b.center);
@@ -88,9 +87,9 @@ CamResult<procam_pose_sample> IrCameraTracker::read() {
     // A frame without a pose is a frame's problem, never the device's.
     const bool unseen =
         pose.error().code == ErrorCode::kNotFound || pose.error().code == ErrorCode::kTooFewPoints;
-    return camera::camFail(Status::kAgain, std::string(unseen ? "LEDs not seen: " : "no pose: ") +
-                                               std::to_string(centres.size()) + " blob(s), " +
-                                               pose.error().message);
+    return fail(ErrorCode::kAgain, std::string(unseen ? "LEDs not seen: " : "no pose: ") +
+                                       std::to_string(centres.size()) + " blob(s), " +
+                                       pose.error().message);
   }
   last_ = *pose;
   procam_pose_sample s{};

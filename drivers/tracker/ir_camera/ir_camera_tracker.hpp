@@ -3,7 +3,8 @@
 // driver of the plugin ABI, seeing the LEDs on the viewer's glasses or cap. Per frame:
 // blobs (threshold, connected components, sub-pixel centroids) -> tracking::LedTracker
 // (constellation pose, tracker -> world registration, motion filter, prediction by the
-// display latency, [Raskar02] §4.1.4). Errors carry the ABI's status (camera::CameraError).
+// display latency, [Raskar02] §4.1.4). Errors are procam::Result with the camera's device
+// codes (kAgain for a frame without a pose).
 #include <procamd/procam_plugin.h>
 
 #include <optional>
@@ -13,10 +14,6 @@
 #include "tracking/led_tracker.hpp"
 
 namespace procam::tracker {
-
-using camera::CameraError;
-using camera::CamResult;
-using camera::Status;
 
 // A camera device created through the plugin ABI, destroyed with its owner.
 class OwnedCamera {
@@ -50,13 +47,13 @@ class IrCameraTracker {
  public:
   // kInvalid for a camera delivering rgb8 (IR blobs need gray8 or gray16), bad blob
   // options or what LedTracker::create refuses.
-  static CamResult<IrCameraTracker> create(OwnedCamera camera, const IrCameraConfig& config);
+  static Result<IrCameraTracker> create(OwnedCamera camera, const IrCameraConfig& config);
 
   // One frame: the viewer's predicted world position, the constellation's orientation
   // and the frame's timestamp. Camera errors pass through (PROCAM_ENODEV when it went
   // away, PROCAM_EEND when a recording ended, PROCAM_EAGAIN when no frame is waiting);
   // PROCAM_EAGAIN with a reason when the frame gives no pose ("LEDs not seen: ...").
-  CamResult<procam_pose_sample> read();
+  Result<procam_pose_sample> read();
   int pollFd() const;
 
   // The last frame's full result (raw, filtered, predicted), none before the first pose.

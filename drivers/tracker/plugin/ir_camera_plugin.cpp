@@ -36,7 +36,7 @@ int probe(const procam_device_desc* d) {
 int readPose(void* self, procam_pose_sample* out, char* err, std::size_t len) {
   try {
     auto s = static_cast<IrCameraTracker*>(self)->read();
-    if (!s) return report(err, len, s.error().message, static_cast<int>(s.error().status));
+    if (!s) return report(err, len, s.error());
     *out = *s;
     return PROCAM_OK;
   } catch (const std::exception& e) {
@@ -176,8 +176,7 @@ int create(const procam_device_desc* d, const procam_config* config, procam_devi
       return report(err, len,
                     std::string(kWho) + ": camera driver '" + driver + "': " + reason.c_str(), rc);
     auto tracker = IrCameraTracker::create(OwnedCamera(camera), *parsed);
-    if (!tracker)
-      return report(err, len, tracker.error().message, static_cast<int>(tracker.error().status));
+    if (!tracker) return report(err, len, tracker.error());
     *out = {};
     out->family = PROCAM_FAMILY_TRACKER;
     out->self = new IrCameraTracker(std::move(*tracker));

@@ -38,7 +38,7 @@ extern "C" {
 
 /* The operations table versions this header describes. */
 #define PROCAM_CAMERA_OPS_VERSION 1u
-#define PROCAM_TILT_OPS_VERSION 1u
+#define PROCAM_TILT_OPS_VERSION 2u
 #define PROCAM_TRACKER_OPS_VERSION 1u
 #define PROCAM_OUTPUT_OPS_VERSION 2u
 
@@ -126,15 +126,25 @@ typedef struct procam_tilt_sample {
   uint64_t timestamp_ns;
 } procam_tilt_sample;
 
+/* A tilt driver gates its own samples: read() drops a garbage sample (not
+ * finite, outside the sensor's range, stuck, |f| far from 1 g) and returns
+ * PROCAM_EAGAIN; the daemon does not gate the samples read() returns again. These
+ * are the driver's counts since the device was created. */
+typedef struct procam_tilt_counts {
+  uint64_t accepted;     /* samples read() returned */
+  uint64_t not_finite;   /* rejected: NaN, Inf or no number at all */
+  uint64_t out_of_range; /* rejected: a component beyond the sensor's range */
+  uint64_t stuck;        /* rejected: the same reading too many times in a row */
+  uint64_t bad_norm;     /* rejected: |specific force| far from 1 g */
+} procam_tilt_counts;
+
 typedef struct procam_tilt_ops {
   uint32_t version; /* PROCAM_TILT_OPS_VERSION */
   int (*read)(void* self, procam_tilt_sample* out, char* err, size_t err_len);
+  /* Version 2, optional (may be NULL): fills `out` with the driver's counts.
+   * The daemon reads this member only from a table of version 2 or later. */
+  int (*get_counts)(void* self, procam_tilt_counts* out);
 } procam_tilt_ops;
-
-/* A tilt read() that drops a garbage sample (not finite, out of the sensor's
- * range, stuck, |f| far from 1 g) returns PROCAM_EAGAIN with a reason that
- * starts with this prefix, so that the daemon can count rejected samples. */
-#define PROCAM_TILT_REJECTED_PREFIX "rejected sample: "
 
 /* Head tracker: viewer position in the world frame (metres) and orientation
  * as a unit quaternion (w, x, y, z). */

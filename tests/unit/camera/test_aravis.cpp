@@ -30,7 +30,7 @@ AravisOptions loopback640() {
 }
 
 // Starts `cam` while the server comes up (it needs a moment to bind its socket).
-CamResult<void> startWithin(AravisCamera& cam, std::chrono::seconds limit) {
+Result<void> startWithin(AravisCamera& cam, std::chrono::seconds limit) {
   const auto end = std::chrono::steady_clock::now() + limit;
   for (;;) {
     auto ok = cam.start();
@@ -81,8 +81,8 @@ TEST_F(AravisLive, ExposureAndThirtyCheckedFrames) {
   ASSERT_TRUE(exposure);
   EXPECT_NEAR(*exposure, 0.01, 1e-6);
   // Out of the camera's range, and controls GenICam does not have.
-  EXPECT_EQ(cam.setControl(Control::kExposure, 1e6).error().status, Status::kInvalid);
-  EXPECT_EQ(cam.setControl(Control::kWhiteBalance, 5000).error().status, Status::kNotSupported);
+  EXPECT_EQ(cam.setControl(Control::kExposure, 1e6).error().code, ErrorCode::kInvalidInput);
+  EXPECT_EQ(cam.setControl(Control::kWhiteBalance, 5000).error().code, ErrorCode::kNotSupported);
 
   uint64_t last_ts = 0, last_id = 0;
   for (int i = 0; i < 30; ++i) {
@@ -124,13 +124,13 @@ TEST_F(AravisLive, KilledCameraIsACleanErrorAndANewOneIsPickedUp) {
   ASSERT_TRUE(cam.capture(2000));
   server_->kill();
   // Frames already in flight may still arrive; then the silence is diagnosed.
-  CamResult<const Frame*> r = cam.capture(0);
+  Result<const Frame*> r = cam.capture(0);
   for (int i = 0; i < 50; ++i) {
     r = cam.capture(200);
-    if (!r && r.error().status != Status::kTimeout) break;
+    if (!r && r.error().code != ErrorCode::kTimeout) break;
   }
   ASSERT_FALSE(r);
-  EXPECT_TRUE(r.error().status == Status::kNoDevice || r.error().status == Status::kIo)
+  EXPECT_TRUE(r.error().code == ErrorCode::kNoDevice || r.error().code == ErrorCode::kIo)
       << r.error().message;
   EXPECT_NE(r.error().message.find("127.0.0.1"), std::string::npos) << r.error().message;
   cam.stop();

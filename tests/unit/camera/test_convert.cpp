@@ -83,7 +83,7 @@ TEST(Convert, MjpegDecodesToRgb) {
   auto bad = convertFrame({SourceFormat::kMjpeg, jpeg.data(), jpeg.size(), 24, 16, 0},
                           PROCAM_PIXEL_RGB8, true, storage, f);
   ASSERT_FALSE(bad);
-  EXPECT_EQ(bad.error().status, Status::kInvalid);
+  EXPECT_EQ(bad.error().code, ErrorCode::kInvalidInput);
 }
 
 TEST(Convert, TruncatedBufferIsRefused) {
@@ -93,7 +93,7 @@ TEST(Convert, TruncatedBufferIsRefused) {
   auto r = convertFrame({SourceFormat::kGrey, px.data(), px.size(), 4, 4, 4}, PROCAM_PIXEL_GRAY8,
                         true, storage, f);
   ASSERT_FALSE(r);
-  EXPECT_EQ(r.error().status, Status::kInvalid);
+  EXPECT_EQ(r.error().code, ErrorCode::kInvalidInput);
 }
 
 }  // namespace

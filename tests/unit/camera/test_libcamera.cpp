@@ -15,11 +15,11 @@ TEST(Libcamera, EmptySystemIsACleanNoCamera) {
   LibcameraCamera cam({});
   auto r = cam.start();
   ASSERT_FALSE(r);
-  EXPECT_EQ(r.error().status, Status::kNoDevice);
+  EXPECT_EQ(r.error().code, ErrorCode::kNoDevice);
   EXPECT_NE(r.error().message.find("no camera"), std::string::npos) << r.error().message;
   EXPECT_EQ(cam.pollFd(), -1);
-  EXPECT_EQ(cam.capture(0).error().status, Status::kInvalid);
-  EXPECT_EQ(cam.setControl(Control::kExposure, 0.01).error().status, Status::kInvalid);
+  EXPECT_EQ(cam.capture(0).error().code, ErrorCode::kInvalidInput);
+  EXPECT_EQ(cam.setControl(Control::kExposure, 0.01).error().code, ErrorCode::kInvalidInput);
   cam.stop();  // stopping what never started is harmless
 
   // Through the plugin ABI: ENODEV with the reason, so the daemon retries later.

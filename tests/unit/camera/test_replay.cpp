@@ -54,7 +54,7 @@ TEST(ReplayIndex, RefusesBadLines) {
        {"a.png,1\nb.png,1\n", "a.png,x\n", "a.png\n", "file,timestamp\n", "a.png,nan\n"}) {
     auto r = parseReplayIndex(text);
     ASSERT_FALSE(r) << text;
-    EXPECT_EQ(r.error().status, Status::kInvalid);
+    EXPECT_EQ(r.error().code, ErrorCode::kInvalidInput);
   }
   EXPECT_NE(parseReplayIndex("a.png,2\nb.png,1\n").error().message.find("line 2"),
             std::string::npos);
@@ -81,7 +81,7 @@ TEST(Replay, DeliversEveryFrameInOrderThenReportsTheEnd) {
   EXPECT_EQ(::poll(&p, 1, 1000), 1);
   auto end = cam.capture(0);
   ASSERT_FALSE(end);
-  EXPECT_EQ(end.error().status, Status::kEnded);
+  EXPECT_EQ(end.error().code, ErrorCode::kEnded);
   EXPECT_NE(end.error().message.find("end of the recording"), std::string::npos);
 }
 
@@ -93,10 +93,10 @@ TEST(Replay, WaitsForTheRecordedTime) {
   // The second frame is 300 ms later: not there yet, and the timer fd is not readable.
   auto early = cam.capture(0);
   ASSERT_FALSE(early);
-  EXPECT_EQ(early.error().status, Status::kAgain);
+  EXPECT_EQ(early.error().code, ErrorCode::kAgain);
   pollfd p{cam.pollFd(), POLLIN, 0};
   EXPECT_EQ(::poll(&p, 1, 0), 0);
-  EXPECT_EQ(cam.capture(10).error().status, Status::kTimeout);
+  EXPECT_EQ(cam.capture(10).error().code, ErrorCode::kTimeout);
   // It becomes readable when the frame is due; then the frame is there without waiting.
   ASSERT_EQ(::poll(&p, 1, 2000), 1);
   auto f = cam.capture(0);
@@ -133,7 +133,7 @@ TEST(Replay, MissingFolderAndMismatchedImages) {
   ReplayCamera none({"/nonexistent/procam-replay", 1.0, false, std::nullopt});
   auto r = none.start();
   ASSERT_FALSE(r);
-  EXPECT_EQ(r.error().status, Status::kNoDevice);
+  EXPECT_EQ(r.error().code, ErrorCode::kNoDevice);
 
   Recording rec(2, 0.01);
   cv::imwrite(rec.dir() + "/frame1.png", cv::Mat(7, 8, CV_8U, cv::Scalar(1)));
@@ -142,7 +142,7 @@ TEST(Replay, MissingFolderAndMismatchedImages) {
   ASSERT_TRUE(cam.capture(0));
   auto bad = cam.capture(0);
   ASSERT_FALSE(bad);
-  EXPECT_EQ(bad.error().status, Status::kInvalid);
+  EXPECT_EQ(bad.error().code, ErrorCode::kInvalidInput);
   EXPECT_NE(bad.error().message.find("8x7"), std::string::npos);
 }
 

@@ -72,7 +72,7 @@ TEST(V4l2Negotiation, RefusesWhatTheDeviceDoesNotOffer) {
     auto cam = camera(uvcLike(), o);
     auto r = cam.start();
     ASSERT_FALSE(r);
-    EXPECT_EQ(r.error().status, Status::kNotSupported);
+    EXPECT_EQ(r.error().code, ErrorCode::kNotSupported);
     EXPECT_NE(r.error().message.find("offers: 320x240, 640x480, 160x120"), std::string::npos)
         << r.error().message;
   }
@@ -92,7 +92,7 @@ TEST(V4l2Negotiation, RefusesWhatTheDeviceDoesNotOffer) {
     auto cam = camera(s, o);
     auto r = cam.start();
     ASSERT_FALSE(r);
-    EXPECT_EQ(r.error().status, Status::kNotSupported);
+    EXPECT_EQ(r.error().code, ErrorCode::kNotSupported);
     EXPECT_FALSE(s->open);  // a failed start closes the node
   }
 }
@@ -118,7 +118,7 @@ TEST(V4l2Buffers, AtLeastFourAreMappedAndQueued) {
   auto cam2 = camera(few);
   auto r = cam2.start();
   ASSERT_FALSE(r);
-  EXPECT_EQ(r.error().status, Status::kIo);
+  EXPECT_EQ(r.error().code, ErrorCode::kIo);
   EXPECT_NE(r.error().message.find("granted 2 buffers"), std::string::npos);
   EXPECT_EQ(few->maps, few->unmaps);
 }
@@ -153,12 +153,12 @@ TEST(V4l2Capture, NothingWaitingTimeoutAndCorruptFrames) {
   auto s = monoCamera();
   auto cam = camera(s);
   ASSERT_TRUE(cam.start());
-  EXPECT_EQ(cam.capture(0).error().status, Status::kAgain);
-  EXPECT_EQ(cam.capture(20).error().status, Status::kTimeout);
+  EXPECT_EQ(cam.capture(0).error().code, ErrorCode::kAgain);
+  EXPECT_EQ(cam.capture(20).error().code, ErrorCode::kTimeout);
   ASSERT_TRUE(s->produce(true));
   auto bad = cam.capture(20);
   ASSERT_FALSE(bad);
-  EXPECT_EQ(bad.error().status, Status::kIo);
+  EXPECT_EQ(bad.error().code, ErrorCode::kIo);
   EXPECT_EQ(s->incoming.size(), 4u);  // the corrupt buffer went straight back
   ASSERT_TRUE(s->produce());
   EXPECT_TRUE(cam.capture(20));
@@ -202,23 +202,23 @@ TEST(V4l2Controls, ManualExposureGainPowerLineAndWhatIsMissing) {
   EXPECT_EQ(s->values[V4L2_CID_EXPOSURE_ABSOLUTE], 200);  // 100 µs units
   auto far = cam.setControl(Control::kExposure, 1.0);     // 10000 > 5000
   ASSERT_FALSE(far);
-  EXPECT_EQ(far.error().status, Status::kInvalid);
+  EXPECT_EQ(far.error().code, ErrorCode::kInvalidInput);
   EXPECT_NE(far.error().message.find("[1, 5000]"), std::string::npos);
   ASSERT_TRUE(cam.setControl(Control::kPowerLine, 50));
   EXPECT_EQ(s->values[V4L2_CID_POWER_LINE_FREQUENCY], V4L2_CID_POWER_LINE_FREQUENCY_50HZ);
-  EXPECT_EQ(cam.setControl(Control::kPowerLine, 55).error().status, Status::kInvalid);
+  EXPECT_EQ(cam.setControl(Control::kPowerLine, 55).error().code, ErrorCode::kInvalidInput);
   auto gain = cam.setControl(Control::kGain, 3);
   ASSERT_FALSE(gain);
-  EXPECT_EQ(gain.error().status, Status::kNotSupported);
+  EXPECT_EQ(gain.error().code, ErrorCode::kNotSupported);
   EXPECT_NE(gain.error().message.find("gain is not supported by this device"), std::string::npos);
-  EXPECT_EQ(cam.setControl(Control::kWhiteBalance, 5000).error().status, Status::kNotSupported);
+  EXPECT_EQ(cam.setControl(Control::kWhiteBalance, 5000).error().code, ErrorCode::kNotSupported);
 
   auto m = monoCamera();
   auto mono = camera(m);
   ASSERT_TRUE(mono.start());
   ASSERT_TRUE(mono.setControl(Control::kGain, 42));
   EXPECT_EQ(m->values[V4L2_CID_GAIN], 42);
-  EXPECT_EQ(mono.setControl(Control::kExposure, 0.01).error().status, Status::kNotSupported);
+  EXPECT_EQ(mono.setControl(Control::kExposure, 0.01).error().code, ErrorCode::kNotSupported);
 }
 
 TEST(V4l2Vanish, UnplugGivesNoDeviceAndACleanStop) {
@@ -230,13 +230,13 @@ TEST(V4l2Vanish, UnplugGivesNoDeviceAndACleanStop) {
   s->vanished = true;
   auto r = cam.capture(100);
   ASSERT_FALSE(r);
-  EXPECT_EQ(r.error().status, Status::kNoDevice);
+  EXPECT_EQ(r.error().code, ErrorCode::kNoDevice);
   cam.stop();
   EXPECT_EQ(s->maps, s->unmaps);
   // Reopening while it is gone fails the same way.
   auto again = cam.start();
   ASSERT_FALSE(again);
-  EXPECT_EQ(again.error().status, Status::kNoDevice);
+  EXPECT_EQ(again.error().code, ErrorCode::kNoDevice);
 }
 
 TEST(V4l2Plugin, ProbeOptionsAndEnodevThroughTheAbi) {

@@ -1,158 +1,27 @@
-// Auto keystone's pieces and the output frames, without the daemon: the tilt
-// tracker (gate, calibration, filter, hysteresis), the solve from gravity, the
-// [keystone] configuration, rig.json intrinsics and frame rendering.
+// Auto keystone's daemon side and the output frames, without the daemon: the
+// [keystone] configuration, rig.json intrinsics and frame rendering. The pure parts
+// (tilt tracker, solve from gravity) are tested in tests/unit/keystone.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <numbers>
 #include <opencv2/imgcodecs.hpp>
 
 #include "auto_keystone.hpp"
 #include "config.hpp"
-#include "keystone/keystone_solver.hpp"
+#include "core/units.hpp"
 #include "output_frames.hpp"
 #include "rig_store.hpp"
 
 namespace procam::daemon {
 namespace {
 
-constexpr double kG = 9.80665;
-constexpr double kDeg = std::numbers::pi / 180;
-
 // The handheld scene's MPU-6050 mount: chip x right, y forward, z up.
 Mat3 handheldMount() {
   Mat3 M;
   M << 1, 0, 0, 0, 0, 1, 0, -1, 0;
   return M;
-}
-
-// A still reading (m/s^2) for gravity `down` (projector frame) through the mount,
-// with a sensor offset (g).
-procam_tilt_sample reading(const Mat3& sensor_from_projector, const Vec3& down, const Vec3& offset,
-                           double t) {
-  const Vec3 f = sensor_from_projector * (-down) + offset;
-  procam_tilt_sample s{};
-  for (int i = 0; i < 3; ++i) s.specific_force[i] = f[i] * kG;
-  s.timestamp_ns = static_cast<uint64_t>(t * 1e9);
-  return s;
-}
-
-double angle(const Vec3& a, const Vec3& b) {
-  return std::atan2(a.cross(b).norm(), a.dot(b));
-}
-
-TEST(TiltTracker, CalibratedStillReadingsGiveTheTrueGravityAndFewUpdates) {
-  TiltMount mount;
-  mount.sensor_from_projector = handheldMount();
-  const Vec3 offset(0.05, -0.05, 0.05);  // the scene's bias, in g
-  mount.calibration.offset = offset;
-  auto tracker = TiltTracker::create(KeystoneConfig{}, mount);
-  ASSERT_TRUE(tracker) << tracker.error().message;
-  const Vec3 down =
-      keystone::rotationFromAngles({12 * kDeg, -7 * kDeg, 0}) * Vec3(0, 0, -1);  // world -Z
-  int published = 0;
-  std::optional<Vec3> last;
-  for (int k = 0; k < 2000; ++k) {  // 20 s at 100 Hz
-    // A few micro-g of zero-mean dither: identical readings would count as a
-    // stuck sensor (the sample gate).
-    const Vec3 dither = 1e-6 * Vec3((k * 7919) % 13 - 6, (k * 104729) % 11 - 5, (k * 31) % 7 - 3);
-    if (auto d =
-            tracker->add(reading(mount.sensor_from_projector, down, offset + dither, 0.01 * k))) {
-      ++published;
-      last = *d;
-    }
-  }
-  ASSERT_TRUE(last);
-  EXPECT_LT(angle(*last, down), 1e-6);
-  // The first sample, then refinements of the still hold after 2, 4, 8, 16 s.
-  EXPECT_LE(published, 6);
-  EXPECT_TRUE(tracker->still());
-  EXPECT_EQ(tracker->counts().accepted, 2000u);
-}
-
-TEST(TiltTracker, GarbageAndRepeatedSamplesAreDropped) {
-  auto tracker = TiltTracker::create(KeystoneConfig{}, TiltMount{});
-  ASSERT_TRUE(tracker);
-  const Vec3 down(0, 1, 0);
-  ASSERT_TRUE(tracker->add(reading(Mat3::Identity(), down, Vec3::Zero(), 1.0)));
-  // The same timestamp again (a timer faster than the sensor): ignored.
-  EXPECT_FALSE(tracker->add(reading(Mat3::Identity(), Vec3(1, 0, 0), Vec3::Zero(), 1.0)));
-  procam_tilt_sample nan = reading(Mat3::Identity(), down, Vec3::Zero(), 1.01);
-  nan.specific_force[0] = NAN;
-  EXPECT_FALSE(tracker->add(nan));
-  // |f| = 3 g: a shake, not gravity.
-  EXPECT_FALSE(tracker->add(reading(Mat3::Identity(), 3 * down, Vec3::Zero(), 1.02)));
-  EXPECT_EQ(tracker->counts().not_finite, 1u);
-  EXPECT_EQ(tracker->counts().bad_norm, 1u);
-}
-
-TEST(SixPositionCollector, SixHoldsRecoverOffsetAndGain) {
-  keystone::AccelCalibration truth;
-  truth.offset = Vec3(0.03, -0.02, 0.05);
-  truth.scale = Vec3(1.02, 0.97, 1.01);
-  SixPositionCollector holds;
-  const char* names[6] = {"+x", "-x", "+y", "-y", "+z", "-z"};
-  for (int i = 0; i < 6; ++i) {
-    const Vec3 up = (i % 2 ? -1.0 : 1.0) * Vec3::Unit(i / 2);
-    // Held 3 degrees off vertical: still accepted.
-    const Vec3 f = Eigen::AngleAxisd(3 * kDeg, Vec3::Unit((i / 2 + 1) % 3)) * up;
-    auto pose = holds.add(truth.scale.cwiseProduct(f) + truth.offset);
-    ASSERT_TRUE(pose) << pose.error().message;
-    EXPECT_EQ(*pose, names[i]);
-    if (i == 4) {
-      EXPECT_EQ(holds.missing(), std::vector<std::string>({"-z"}));
-      EXPECT_EQ(holds.solve().error().code, ErrorCode::kTooFewPoints);
-    }
-  }
-  auto fit = holds.solve();
-  ASSERT_TRUE(fit) << fit.error().message;
-  EXPECT_LT((fit->calibration.offset - truth.offset).norm(), 1e-6);
-  EXPECT_LT((fit->calibration.scale - truth.scale).norm(), 1e-6);
-  // 45 degrees from every axis: not a hold of the procedure.
-  EXPECT_FALSE(holds.add(Vec3(1, 1, 0).normalized()));
-}
-
-TEST(TiltTracker, StillMeanIsTheRawReading) {
-  TiltMount mount;
-  mount.calibration.offset = Vec3(0.1, 0, 0);  // applied to the filter, not to the mean
-  auto tracker = TiltTracker::create(KeystoneConfig{}, mount);
-  ASSERT_TRUE(tracker);
-  const Vec3 raw(0.1, 0.2, 0.98);
-  for (int k = 0; k < 100; ++k) {
-    const Vec3 dither = 1e-6 * Vec3(k % 3 - 1, 0, 0);
-    procam_tilt_sample s{};
-    for (int i = 0; i < 3; ++i) s.specific_force[i] = (raw + dither)[i] * kG;
-    s.timestamp_ns = static_cast<uint64_t>(k * 1e7);
-    tracker->add(s);
-  }
-  auto mean = tracker->stillMean();
-  ASSERT_TRUE(mean);
-  EXPECT_LT((mean->first - raw).norm(), 1e-6);
-  EXPECT_GT(mean->second, 50);
-}
-
-TEST(SolveFromDown, EqualsTheKeystoneSolveAtThatTilt) {
-  ProjectorModel p;
-  p.K = geom::Intrinsics{1400, 1400, 639.5, 359.5, 0};
-  p.width = 1280;
-  p.height = 720;
-  const keystone::Angles a{-15 * kDeg, 9 * kDeg, 0};
-  const Mat3 R = keystone::rotationFromAngles(a);
-  const Vec3 down = R * Vec3(0, 0, -1);
-  auto e = solveFromDown(p, down, 1920, 1080);
-  ASSERT_TRUE(e) << e.error().message;
-  keystone::KeystoneProblem problem{p.K, 1280, 720, R, 1920, 1080, {}};
-  auto truth = keystone::solveKeystone(problem);
-  ASSERT_TRUE(truth);
-  EXPECT_LT((e->H - truth->H).cwiseAbs().maxCoeff(), 1e-9 * truth->H.cwiseAbs().maxCoeff());
-  EXPECT_NEAR(e->angles.pitch, a.pitch, 1e-12);
-  EXPECT_NEAR(e->angles.roll, a.roll, 1e-12);
-  EXPECT_EQ(e->content_width, 1920);
-  // Tilted so far that part of the frame misses the wall: an error, not NaN.
-  const Vec3 up_steep = keystone::rotationFromAngles({89 * kDeg, 0, 0}) * Vec3(0, 0, -1);
-  EXPECT_FALSE(solveFromDown(p, up_steep, 1280, 720));
 }
 
 TEST(KeystoneConfigKeys, ParsedCheckedAndTheMountMustBeARotation) {
@@ -168,6 +37,9 @@ TEST(KeystoneConfigKeys, ParsedCheckedAndTheMountMustBeARotation) {
   ASSERT_TRUE(mount);
   EXPECT_EQ(mount->sensor_from_projector, handheldMount());
   EXPECT_EQ(mount->calibration.offset, Vec3(0.01, 0.0, -0.02));
+  const keystone::TiltFilterOptions filter = tiltFilterOptions(ok->keystone);
+  EXPECT_EQ(filter.cutoff_hz, 5.0);
+  EXPECT_NEAR(filter.hysteresis, degToRad(0.05), 1e-18);
 
   auto bad =
       parseConfig("[keystone]\n\nhysteresis_deg = -1\nmount = [1, 2]\nspeed = 3\n", "k.toml");

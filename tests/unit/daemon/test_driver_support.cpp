@@ -5,6 +5,7 @@
 
 #include <cstring>
 #include <string>
+#include <utility>
 
 #include "support/driver_support.hpp"
 
@@ -17,6 +18,24 @@ TEST(DriverSupport, ErrorCodesMapToAbiStatuses) {
   EXPECT_EQ(statusOf(ErrorCode::kParse), PROCAM_EINVAL);
   EXPECT_EQ(statusOf(ErrorCode::kIo), PROCAM_EIO);
   EXPECT_EQ(statusOf(ErrorCode::kNoConvergence), PROCAM_EINTERNAL);
+}
+
+TEST(DriverSupport, DeviceCodesAndAbiStatusesRoundTrip) {
+  // A driver that relays another driver's status (the ir_camera tracker relays its
+  // camera's) keeps it: status -> code -> status is the identity on every PROCAM_E*.
+  const std::pair<ErrorCode, int> pairs[] = {{ErrorCode::kInvalidInput, PROCAM_EINVAL},
+                                             {ErrorCode::kNoDevice, PROCAM_ENODEV},
+                                             {ErrorCode::kIo, PROCAM_EIO},
+                                             {ErrorCode::kTimeout, PROCAM_ETIMEDOUT},
+                                             {ErrorCode::kAgain, PROCAM_EAGAIN},
+                                             {ErrorCode::kNotSupported, PROCAM_ENOTSUP},
+                                             {ErrorCode::kInternal, PROCAM_EINTERNAL},
+                                             {ErrorCode::kEnded, PROCAM_EEND}};
+  for (const auto& [code, status] : pairs) {
+    EXPECT_EQ(statusOf(code), status) << toString(code);
+    EXPECT_EQ(codeOf(status), code) << status;
+  }
+  EXPECT_EQ(codeOf(-99), ErrorCode::kInternal);  // not a status of this ABI
 }
 
 TEST(DriverSupport, ReportTruncatesIntoTheCallersBufferAndReturnsTheStatus) {

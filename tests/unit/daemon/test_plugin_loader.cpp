@@ -37,6 +37,9 @@ TEST(PluginLoader, LoadsSharedObjectAndCreatesDevice) {
   char err[64] = {};
   ASSERT_EQ(device->raw().ops.tilt->read(device->raw().self, &sample, err, sizeof err), PROCAM_OK);
   EXPECT_EQ(sample.specific_force[2], -9.5);  // the configured value, exactly
+  // Its tilt table is version 1: no counts, and nothing read past the table's end.
+  EXPECT_EQ(device->raw().ops.tilt->version, 1u);
+  EXPECT_FALSE(tiltCounts(device->raw()));
 }
 
 TEST(PluginLoader, DeviceOutlivesDriverListAndKeepsLibraryLoaded) {

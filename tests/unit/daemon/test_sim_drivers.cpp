@@ -30,11 +30,8 @@ DeviceDescription simDevice(procam_family family, const char* name,
   return d;
 }
 
-// handheld.toml with a display-to-capture latency on its camera, and the hand
-// held still: captures taken at different times see the wall from the same
-// pose, so their black levels differ by noise only (the tilting hand changes
-// the camera's view by more than that within a second).
-std::string handheldWithLatency(double latency_s) {
+// handheld.toml with the hand held still and level the whole time.
+std::string handheldHeldStill() {
   std::string text;
   for (std::size_t i = 0; i < sim::detail::kEmbeddedSceneCount; ++i) {
     if (sim::detail::kEmbeddedScenes[i].name == "handheld") {
@@ -52,12 +49,29 @@ std::string handheldWithLatency(double latency_s) {
                  "  { t = 8.0, position = [0.0, 0.0, 1.2] },\n"
                  "]\n");
   }
+  return text;
+}
+
+// handheld.toml with a display-to-capture latency on its camera, and the hand
+// held still: captures taken at different times see the wall from the same
+// pose, so their black levels differ by noise only (the tilting hand changes
+// the camera's view by more than that within a second).
+std::string handheldWithLatency(double latency_s) {
+  std::string text = handheldHeldStill();
   const std::string camera = "[[cameras]]\n";
   const std::size_t at = text.find(camera);
   EXPECT_NE(at, std::string::npos);
   if (at != std::string::npos) {
     text.insert(at + camera.size(), "latency_s = " + std::to_string(latency_s) + "\n");
   }
+  return text;
+}
+
+// `text` with `from` replaced by `to` (which must be there).
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const std::size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
   return text;
 }
 
@@ -89,6 +103,40 @@ TEST(SimDrivers, TiltReportsGravityMagnitude) {
   // handheld.toml: 50 mg bias per axis (<= 0.087 g in norm) and 400 ug/sqrt(Hz)
   // noise; 0.1 g covers both with margin.
   EXPECT_NEAR(norm, 9.80665, 0.1 * 9.80665);
+}
+
+TEST(SimDrivers, TiltGarbageIsDroppedAndCountedByTheDriver) {
+  // A broken accelerometer on a projector at a fixed pose: no noise and 2.5 g of bias on
+  // the chip's z (up), clamped to its 2 g full scale. It reports the same vector, 2 g
+  // long, every time (a trajectory, even a still one, varies it by rounding).
+  std::string text = replaced(handheldHeldStill(), "trajectory = \"hand\"",
+                              "pose = { position = [0.0, 0.0, 1.2] }");
+  text = replaced(text, "noise_density_ug = 400.0", "noise_density_ug = 0.0");
+  text = replaced(text, "bias_mg = [50.0, -50.0, 50.0]", "bias_mg = [0.0, 0.0, 2500.0]");
+  const auto file = std::filesystem::temp_directory_path() /
+                    ("procam_broken_tilt_" + std::to_string(::getpid()) + ".toml");
+  {
+    std::ofstream out(file);
+    out << text;
+  }
+  auto r = simRegistry();
+  Device tilt = open(r, simDevice(PROCAM_FAMILY_TILT, "accel", file.string()));
+  for (int i = 0; i < 100; ++i) {
+    procam_tilt_sample s{};
+    char err[256] = {};
+    EXPECT_EQ(tilt.raw().ops.tilt->read(tilt.raw().self, &s, err, sizeof err), PROCAM_EAGAIN)
+        << i << ": " << err;
+  }
+  std::filesystem::remove(file);
+  auto c = tiltCounts(tilt.raw());
+  ASSERT_TRUE(c);
+  // The tilt drivers' gate (SampleGateOptions' defaults): |f| outside [0.5, 1.5] g until
+  // the 64th identical vector in a row, stuck from then on.
+  EXPECT_EQ(c->accepted, 0u);
+  EXPECT_EQ(c->bad_norm, 63u);
+  EXPECT_EQ(c->stuck, 37u);
+  EXPECT_EQ(c->not_finite + c->out_of_range, 0u);
+  EXPECT_EQ(rejectedSamples(*c), 100u);
 }
 
 TEST(SimDrivers, CameraSeesWhiteBrighterThanBlack) {

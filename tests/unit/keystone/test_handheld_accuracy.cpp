@@ -43,8 +43,8 @@ struct Pose {
   double yaw, pitch, roll;
 };
 // The keyframe poses of tests/scenes/handheld.toml.
-const Pose kHandPoses[] = {{0, 0, 0},  {0, 45, 0},  {0, -45, 0},   {30, 0, 0}, {-30, 0, 0},
-                           {0, 0, 20}, {0, 0, -20}, {20, 25, -10}, {0, 0, 0}};
+const Pose kHandPoses[] = {{0, 0, 0},  {0, 45, 0},  {0, -45, 0},    {-30, 0, 0}, {30, 0, 0},
+                           {0, 0, 20}, {0, 0, -20}, {-20, 25, -10}, {0, 0, 0}};
 constexpr double kHold = 10.0;  // s per pose: 0.5 s to move, 9.5 s still
 
 std::string sceneText() {

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <string>
 
-#include "sim/orientation.hpp"
+#include "core/units.hpp"
 #include "sim/renderer.hpp"
 #include "sim/scene_library.hpp"
 #include "sim/truth_json.hpp"
@@ -184,10 +184,10 @@ TEST(SimSceneFile, ShippedScenesMatchTheIssue) {
   ASSERT_EQ(ws.projectors.size(), 1u);
   EXPECT_EQ(ws.projectors[0].model.width, 1920);
   EXPECT_EQ(ws.projectors[0].model.height, 1080);
-  // Optical axis against the wall normal (-Y toward the wall is +Y): 30 deg yaw,
-  // 15 deg pitch.
+  // Optical axis against the wall normal (-Y toward the wall is +Y): turned 30 deg to
+  // the left (towards -X: yaw -30), tilted up by 15 deg.
   const Vec3 axis = ws.projectors[0].model.pose.R.row(2).transpose();
-  EXPECT_NEAR(radToDeg(std::atan2(-axis.x(), axis.y())), 30.0, 1e-9);
+  EXPECT_NEAR(radToDeg(std::atan2(axis.x(), axis.y())), -30.0, 1e-9);
   EXPECT_NEAR(radToDeg(std::asin(axis.z())), 15.0, 1e-9);
   ASSERT_EQ(ws.cameras.size(), 1u);
   EXPECT_EQ(ws.cameras[0].model.width, 1280);

@@ -60,20 +60,28 @@ struct Options {
   Kv text_;
 };
 
-// One read through the ABI.
+// The driver's counts through the ABI (procam_tilt_ops::get_counts).
+procam_tilt_counts counts(const plugins::Device& d) {
+  auto c = plugins::tiltCounts(d.raw());
+  EXPECT_TRUE(c) << "the tilt drivers report their counts";
+  return c.value_or(procam_tilt_counts{});
+}
+
+// One read through the ABI, and whether the driver counted it as rejected.
 struct Read {
   int status = PROCAM_EINTERNAL;
   std::string reason;
   procam_tilt_sample sample{};
-  bool rejected() const {
-    return status == PROCAM_EAGAIN && reason.rfind(PROCAM_TILT_REJECTED_PREFIX, 0) == 0;
-  }
+  uint64_t newly_rejected = 0;
+  bool rejected() const { return status == PROCAM_EAGAIN && newly_rejected == 1; }
 };
 Read readOnce(const plugins::Device& d) {
   Read r;
   char err[256] = {};
+  const uint64_t before = plugins::rejectedSamples(counts(d));
   r.status = d.raw().ops.tilt->read(d.raw().self, &r.sample, err, sizeof err);
   r.reason = err;
+  r.newly_rejected = plugins::rejectedSamples(counts(d)) - before;
   return r;
 }
 Vec3 force(const Read& r) {
@@ -237,10 +245,10 @@ TEST(TiltPlugin, I2cReadsRegistersAndRejectsGarbage) {
   r = readOnce(dev);
   EXPECT_TRUE(r.rejected()) << r.reason;
   EXPECT_NE(r.reason.find("stuck"), std::string::npos);
-  const SampleCounts& counts = plugin::tiltDeviceCounts(dev.raw());
-  EXPECT_EQ(counts.accepted, 3u);
-  EXPECT_EQ(counts.bad_norm, 1u);
-  EXPECT_EQ(counts.stuck, 1u);
+  const procam_tilt_counts c = counts(dev);
+  EXPECT_EQ(c.accepted, 3u);
+  EXPECT_EQ(c.bad_norm, 1u);
+  EXPECT_EQ(c.stuck, 1u);
 
   bus->stuck = true;  // SDA held low
   EXPECT_EQ(readOnce(dev).status, PROCAM_EIO);
@@ -294,12 +302,12 @@ TEST(TiltPlugin, IioThroughSysfsRootCountsGarbage) {
   r = readOnce(*dev);
   EXPECT_TRUE(r.rejected());
   EXPECT_NE(r.reason.find("far from 1 g"), std::string::npos) << r.reason;
-  const SampleCounts& counts = plugin::tiltDeviceCounts(dev->raw());
-  EXPECT_EQ(counts.accepted, 1u);
-  EXPECT_EQ(counts.not_finite, 1u);
-  EXPECT_EQ(counts.out_of_range, 1u);
-  EXPECT_EQ(counts.bad_norm, 1u);
-  EXPECT_EQ(counts.rejected(), 3u);
+  const procam_tilt_counts c = counts(*dev);
+  EXPECT_EQ(c.accepted, 1u);
+  EXPECT_EQ(c.not_finite, 1u);
+  EXPECT_EQ(c.out_of_range, 1u);
+  EXPECT_EQ(c.bad_norm, 1u);
+  EXPECT_EQ(plugins::rejectedSamples(c), 3u);
 }
 
 TEST(TiltPlugin, HidStoredReportsAndLogicalRange) {
@@ -318,7 +326,7 @@ TEST(TiltPlugin, HidStoredReportsAndLogicalRange) {
   EXPECT_NEAR((force(r) - Vec3(0, 0, -kG)).norm(), 0, 1e-12);
   EXPECT_TRUE(readOnce(dev).rejected());
   EXPECT_EQ(readOnce(dev).status, PROCAM_EAGAIN);  // nothing queued
-  EXPECT_EQ(plugin::tiltDeviceCounts(dev.raw()).out_of_range, 1u);
+  EXPECT_EQ(counts(dev).out_of_range, 1u);
 
   auto foreign = std::make_unique<ScriptedHid>();
   foreign->descriptor = {0x05, 0x01, 0x09, 0x02, 0xA1, 0x01, 0xC0};  // a mouse, empty

@@ -1,0 +1,28 @@
+#include "sim_tilt.hpp"
+
+#include "sim/sensors.hpp"
+#include "sim_unplug.hpp"
+
+namespace procam::sim::mock {
+
+Result<tilt::TiltSample> SimTiltSensor::read() {
+  auto gone = unpluggedNow(name_);
+  // A malformed variable was refused when the device was created; it changed since.
+  if (!gone) return fail(ErrorCode::kInternal, gone.error().message);
+  if (*gone)
+    return fail(ErrorCode::kNoDevice,
+                "'" + name_ + "' is unplugged (" + std::string(kUnplugVariable) + ")");
+  const double t = world_->now();
+  auto s = sampleTilt(world_->scene(), name_, t);
+  if (!s) return fail(ErrorCode::kIo, s.error().message);
+  double unit = 1.0;
+  for (const auto& spec : world_->scene().tiltSensors()) {
+    if (spec.name == name_ && spec.report_in_g) unit = kStandardGravity;
+  }
+  tilt::TiltSample out;
+  out.specific_force = s->value * unit;
+  out.timestamp_ns = static_cast<uint64_t>(t * 1e9);
+  return out;
+}
+
+}  // namespace procam::sim::mock
