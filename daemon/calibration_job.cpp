@@ -1,6 +1,8 @@
 #include "calibration_job.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <thread>
 
@@ -82,7 +84,7 @@ tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const json& requ
   a.settle_frames = defaults.settle_frames;
   a.auto_settle = defaults.auto_settle;
   static const char* const kKeys[] = {"mode",          "step",   "phase_steps", "grid",
-                                      "settle_frames", "output", "cameras"};
+                                      "settle_frames", "output", "cameras",     "plane"};
   for (const auto& [key, value] : request.items()) {
     if (key == "cmd" || key == "id") continue;
     bool known = false;
@@ -119,12 +121,35 @@ tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const json& requ
     a.output = it->get<std::string>();
   }
   if (auto it = request.find("cameras"); it != request.end()) {
-    const bool pair = it->is_array() && it->size() == 2 && (*it)[0].is_string() &&
-                      (*it)[1].is_string() && (*it)[0] != (*it)[1];
-    if (!pair) {
-      return tl::unexpected(std::string("\"cameras\" must name two different cameras"));
+    const bool names = it->is_array() && (it->size() == 1 || it->size() == 2) &&
+                       std::all_of(it->begin(), it->end(), [](const json& n) {
+                         return n.is_string() && !n.get<std::string>().empty();
+                       });
+    if (!names || (it->size() == 2 && (*it)[0] == (*it)[1])) {
+      return tl::unexpected(
+          std::string("\"cameras\" must name one camera (route b′) or two different ones"));
     }
-    a.cameras = {(*it)[0].get<std::string>(), (*it)[1].get<std::string>()};
+    for (const auto& n : *it) a.cameras.push_back(n.get<std::string>());
+  }
+  if (auto it = request.find("plane"); it != request.end()) {
+    // a x + b y + c z + d = 0 in the world frame, as rig.json's surface.plane.
+    const bool numbers =
+        it->is_array() && it->size() == 4 && std::all_of(it->begin(), it->end(), [](const json& v) {
+          return v.is_number() && std::isfinite(v.get<double>());
+        });
+    const Vec3 n =
+        numbers ? Vec3((*it)[0].get<double>(), (*it)[1].get<double>(), (*it)[2].get<double>())
+                : Vec3::Zero();
+    if (!numbers || !(n.norm() > 1e-9)) {
+      return tl::unexpected(std::string(
+          "\"plane\" must be 4 finite numbers [a, b, c, d] (a x + b y + c z + d = 0, world "
+          "metres) with a non-zero normal"));
+    }
+    if (a.cameras.size() == 2) {
+      return tl::unexpected(
+          std::string("\"plane\" is for route (b′) with one camera; \"cameras\" names two"));
+    }
+    a.plane = geom::Plane{n / n.norm(), (*it)[3].get<double>() / n.norm()};
   }
   return a;
 }
@@ -212,6 +237,15 @@ tl::expected<CalibrationOutcome, CalibrationFailure> runCalibration(const Calibr
     if (hooks.cancelled()) return tl::unexpected(cancelled);
   }
   hooks.progress({0.95, "solving", total});
+  if (plan.plane) {
+    auto planar =
+        calib::solvePlaneHomographyRoute(plan.set, views[0], *plan.plane, {.step = plan.grid});
+    if (!planar) {
+      return tl::unexpected(CalibrationFailure{code::kFailed, planar.error().message});
+    }
+    outcome.planar = std::move(*planar);
+    return outcome;
+  }
   auto route = calib::solveStereoRoute(plan.set, views[0], views[1], plan.grid);
   if (!route) return tl::unexpected(CalibrationFailure{code::kFailed, route.error().message});
   outcome.route = std::move(*route);

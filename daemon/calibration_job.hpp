@@ -1,15 +1,18 @@
 #pragma once
 // The calibrate operation's work, apart from the daemon: its arguments, and the
 // run on a worker thread that shows every structured-light frame on the output,
-// waits for it to settle, captures it with both cameras, decodes and solves route
-// (a) ([Raskar02] §4.1.1) through calib::solveStereoRoute, the pipeline procam-calibrate
-// uses on files.
+// waits for it to settle, captures it with its cameras, decodes and solves route
+// (a) ([Raskar02] §4.1.1, two cameras) through calib::solveStereoRoute, the pipeline
+// procam-calibrate uses on files, or route (b′) ([Raskar02] §4.2.4, one camera and
+// the display plane) through calib::solvePlaneHomographyRoute.
 #include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "calibration/plane_homography_route.hpp"
 #include "calibration/stereo_route.hpp"
 #include "config.hpp"
 #include "driver.hpp"
@@ -28,7 +31,8 @@ struct CalibrationArgs {
   int settle_frames = 2;             // output frames to wait after showing a pattern
   bool auto_settle = false;          // settle_frames "auto": measure the latency first
   std::string output;                // empty: the first usable output
-  std::vector<std::string> cameras;  // empty: the first two usable cameras
+  std::vector<std::string> cameras;  // empty: the first usable ones; one name: route (b′)
+  std::optional<geom::Plane> plane;  // the display plane (world): route (b′)
 };
 
 // The message names the offending key; `defaults` ([calibration] of procamd.toml)
@@ -56,7 +60,9 @@ struct CalibrationPlan {
   CalibrationConfig latency;  // margin_frames, latency_repeats, latency_timeout_s
   double refresh_hz = 60;
   CalibrationDevice output;
-  std::vector<CalibrationCamera> cameras;  // two: route (a)
+  std::vector<CalibrationCamera> cameras;  // two: route (a); one: route (b′)
+  std::optional<geom::Plane> plane;        // set: route (b′) on this display plane (world)
+  bool plane_from_rig = false;             // the rig model's surface plane, not an argument
 
   int captures() const { return static_cast<int>(set.frames.size() * cameras.size()); }
 };
@@ -80,10 +86,11 @@ struct CalibrationFailure {
 };
 
 struct CalibrationOutcome {
-  calib::StereoRouteResult route;
-  std::vector<int> decoded;  // camera pixels decoded, per camera
-  int settle_frames = 0;     // waited after every pattern
-  nlohmann::json latency;    // the measured latency (auto_settle; latencyJson), else null
+  calib::StereoRouteResult route;                      // route (a)
+  std::optional<calib::PlaneHomographyResult> planar;  // route (b′)
+  std::vector<int> decoded;                            // camera pixels decoded, per camera
+  int settle_frames = 0;                               // waited after every pattern
+  nlohmann::json latency;  // the measured latency (auto_settle; latencyJson), else null
 };
 
 // Shared with the latency probe (latency_probe.hpp).

@@ -1,7 +1,7 @@
-// The calibrate operation (PROTOCOL.md): chooses the devices, runs the
-// structured-light capture and route (a) on the compute worker, and writes
-// what it learnt into the rig model (rig_store.hpp): the projector bound to the
-// output, and its surface (a plane, or a mesh file for a non-planar surface).
+// The calibrate operation (PROTOCOL.md): chooses the devices and the route, runs
+// the structured-light capture and route (a) or (b′) on the compute worker, and
+// writes what it learnt into the rig model (rig_store.hpp): the projector bound to
+// the output, and its surface (a plane, or a mesh file for a non-planar surface).
 #include <algorithm>
 
 #include "calibration_job.hpp"
@@ -53,20 +53,42 @@ tl::expected<CalibrationPlan, Failure> makePlan(DeviceSet& devices, const Calibr
         code::kUnavailable, args.output.empty() ? "calibration needs a projector output"
                                                 : "no usable output named '" + args.output + "'"});
   }
+  // Route (b′) when asked for (a plane, or one camera named), or when one camera is
+  // all there is and the rig model knows the display plane; route (a) otherwise.
+  int usable = 0;
+  for (const auto& e : devices.entries()) {
+    usable += e.description.family == PROCAM_FAMILY_CAMERA && e.usable();
+  }
+  const bool planar = args.plane || args.cameras.size() == 1 ||
+                      (args.cameras.empty() && usable == 1 && rig.surface.plane);
+  const std::size_t wanted = planar ? 1 : 2;
   std::vector<const DeviceEntry*> cams;
-  for (int i = 0; i < 2; ++i) {
+  for (std::size_t i = 0; i < wanted; ++i) {
     const std::string name = args.cameras.empty() ? "" : args.cameras[i];
     const DeviceEntry* c = pick(PROCAM_FAMILY_CAMERA, name, cams);
     if (!c) {
-      return tl::unexpected(Failure{code::kUnavailable,
-                                    name.empty()
-                                        ? "calibration (route a) needs two calibrated cameras; " +
-                                              std::to_string(cams.size()) + " usable camera(s) open"
-                                        : "no usable camera named '" + name + "'"});
+      return tl::unexpected(
+          Failure{code::kUnavailable,
+                  !name.empty() ? "no usable camera named '" + name + "'"
+                  : planar      ? std::string("calibration needs a calibrated camera; none is open")
+                           : "calibration needs two calibrated cameras (route a), or one and the "
+                             "display plane (route b′: the argument \"plane\" or the rig "
+                             "model's surface plane); " +
+                                 std::to_string(cams.size()) + " usable camera(s) open"});
     }
     cams.push_back(c);
   }
   CalibrationPlan plan;
+  if (planar) {
+    plan.plane = args.plane ? args.plane : rig.surface.plane;
+    plan.plane_from_rig = !args.plane;
+    if (!plan.plane) {
+      return tl::unexpected(
+          Failure{code::kUnavailable,
+                  "route (b′) with one camera needs the display plane: give \"plane\" [a, b, c, d] "
+                  "(world, metres) or put surface.plane in the rig model"});
+    }
+  }
   uint32_t w = 0, h = 0;
   const auto& raw = out->device.raw();
   if (raw.ops.output->get_mode(raw.self, &w, &h, &plan.refresh_hz) != PROCAM_OK || w < 2 || h < 2) {
@@ -98,6 +120,93 @@ tl::expected<CalibrationPlan, Failure> makePlan(DeviceSet& devices, const Calibr
 json positionJson(const geom::Pose& pose) {
   const Vec3 c = pose.center();
   return {c.x(), c.y(), c.z()};
+}
+
+// What a run learnt, to merge into the rig model, and the reply that shows it in
+// rig.json's own form.
+struct Learnt {
+  rig::RigModel update;
+  std::map<std::string, std::string> meshes;  // file name -> PLY text
+  json reply;
+};
+
+rig::RigProjector projectorEntry(const CalibrationPlan& plan) {
+  rig::RigProjector p;
+  p.name = p.output = plan.output.name;
+  p.width = plan.set.options.width;
+  p.height = plan.set.options.height;
+  return p;
+}
+
+// Route (a): the projector bound to the output gets K, pose and its surface; the
+// cameras keep their models.
+Learnt learntByStereoRoute(const CalibrationPlan& plan, const CalibrationOutcome& result) {
+  const calib::StereoRouteResult& route = result.route;
+  Learnt out;
+  rig::RigProjector projector = projectorEntry(plan);
+  projector.K = route.projector.K;
+  projector.pose = route.projector.pose;
+  projector.scale_known = route.projector.scale_known;
+  projector.rms_px = route.projector.rms_px;
+  projector.points = route.projector.points;
+  std::string how = "structured light, route (a): cameras";
+  for (const auto& c : plan.cameras) how += " " + c.device.name;
+  projector.calibrated = {how, utcNow()};
+  out.update.projectors.push_back(projector);
+  if (route.surface.planar) {
+    out.update.surface.plane = route.surface.plane;
+    out.update.surface.plane_rms_m = route.surface.plane_rms;
+  } else {
+    const std::string file = meshFileName(projector.name);
+    out.update.surface.meshes[projector.name] = file;
+    out.meshes[file] = surface::toPly(route.surface.mesh);
+  }
+  const json learnt = rig::rigToJson(out.update);
+  out.reply = {{"route", "a"},
+               {"projector", learnt["projectors"][0]},
+               {"position", positionJson(route.projector.pose)},
+               {"reprojection_rms_px", route.projector.rms_px},
+               {"surface", learnt["surface"]},
+               {"surface_type", route.surface.planar ? "plane" : "mesh"},
+               {"triangulated", route.triangulated}};
+  return out;
+}
+
+// Route (b′): the projector bound to the output gets its collineation with the
+// display plane (no K, no pose); a plane given as an argument becomes the rig's
+// surface, one read from the rig stays as it was.
+Learnt learntByPlaneRoute(const CalibrationPlan& plan, const CalibrationOutcome& result) {
+  const calib::PlaneHomographyResult& route = *result.planar;
+  Learnt out;
+  rig::RigProjector projector = projectorEntry(plan);
+  projector.intrinsics_known = false;
+  projector.pose_known = false;
+  projector.plane_homography = route.projector_to_plane;
+  projector.rms_px = route.rms_projector_px;
+  projector.points = static_cast<long>(route.inliers);
+  projector.calibrated = {"structured light, route (b′): camera " + plan.cameras.at(0).device.name +
+                              ", plane from the " +
+                              (plan.plane_from_rig ? "rig model" : "calibrate request"),
+                          utcNow()};
+  out.update.projectors.push_back(projector);
+  if (!plan.plane_from_rig) out.update.surface.plane = plan.plane;
+  rig::RigModel shown = out.update;
+  shown.surface.plane = plan.plane;
+  const json learnt = rig::rigToJson(shown);
+  out.reply = {{"route", "b'"},
+               {"projector", learnt["projectors"][0]},
+               {"reprojection_rms_px", route.rms_projector_px},
+               {"surface", learnt["surface"]},
+               {"surface_type", "plane"},
+               {"plane_source", plan.plane_from_rig ? "rig" : "request"},
+               {"homography",
+                {{"rms_camera_px", route.rms_camera_px},
+                 {"rms_projector_px", route.rms_projector_px},
+                 {"condition", route.condition},
+                 {"coverage", route.coverage},
+                 {"samples", route.samples},
+                 {"inliers", route.inliers}}}};
+  return out;
 }
 
 }  // namespace
@@ -164,6 +273,7 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
            {"state", "started"},
            {"output", plan->output.name},
            {"cameras", cameras},
+           {"route", plan->plane ? "b'" : "a"},
            {"mode", sl::toString(plan->set.options.mode)},
            {"frames", plan->set.frames.size()},
            {"captures", captures},
@@ -210,48 +320,18 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
       // From here on the result is written: a cancel no longer finds the operation.
       operations_.erase(op_id);
       operationEvent(client, "progress", progress({0.98, "writing", plan->captures()}));
-      const calib::StereoRouteResult& route = result->route;
-      // What this run learnt, merged into the rig model: the cameras keep their
-      // models, the projector bound to the output gets K, pose and its surface.
-      rig::RigModel update;
-      rig::RigProjector projector;
-      projector.name = projector.output = plan->output.name;
-      projector.width = plan->set.options.width;
-      projector.height = plan->set.options.height;
-      projector.K = route.projector.K;
-      projector.pose = route.projector.pose;
-      projector.scale_known = route.projector.scale_known;
-      projector.rms_px = route.projector.rms_px;
-      projector.points = route.projector.points;
-      std::string how = "structured light, route (a): cameras";
-      for (const auto& c : plan->cameras) how += " " + c.device.name;
-      projector.calibrated = {how, utcNow()};
-      update.projectors.push_back(projector);
-      std::map<std::string, std::string> meshes;
-      if (route.surface.planar) {
-        update.surface.plane = route.surface.plane;
-        update.surface.plane_rms_m = route.surface.plane_rms;
-      } else {
-        const std::string file = meshFileName(projector.name);
-        update.surface.meshes[projector.name] = file;
-        meshes[file] = surface::toPly(route.surface.mesh);
-      }
-      // The reply shows what is merged, in rig.json's own form.
-      const json learnt = rig::rigToJson(update);
-      json reply = {{"operation", op_id},
-                    {"state", "done"},
-                    {"projector", learnt["projectors"][0]},
-                    {"position", positionJson(route.projector.pose)},
-                    {"reprojection_rms_px", route.projector.rms_px},
-                    {"surface", learnt["surface"]},
-                    {"surface_type", route.surface.planar ? "plane" : "mesh"},
-                    {"triangulated", route.triangulated},
-                    {"decoded", result->decoded},
-                    {"settle_frames", result->settle_frames}};
+      Learnt learnt =
+          result->planar ? learntByPlaneRoute(*plan, *result) : learntByStereoRoute(*plan, *result);
+      json reply = std::move(learnt.reply);
+      reply["operation"] = op_id;
+      reply["state"] = "done";
+      reply["decoded"] = result->decoded;
+      reply["settle_frames"] = result->settle_frames;
       if (!result->latency.is_null()) reply["latency"] = result->latency;
       // fsync may block: the I/O worker writes the mesh first, then rig.json
       // (the previous versions stay as .bak; a failure leaves rig.json as it was).
-      io_worker_->submit([this, dir = options_.state_dir, update, meshes, reply, finish] {
+      io_worker_->submit([this, dir = options_.state_dir, update = std::move(learnt.update),
+                          meshes = std::move(learnt.meshes), reply, finish] {
         auto merged = mergeIntoRig(dir, update, meshes);
         return [this, merged, reply, finish, path = rigStateFile(dir).path()]() mutable {
           if (!merged) {

@@ -19,6 +19,7 @@
 #include "device_set.hpp"
 #include "event_loop.hpp"
 #include "geometry/intersect.hpp"
+#include "keystone/keystone_solver.hpp"
 #include "keystone_runtime.hpp"
 #include "registry.hpp"
 #include "render/projective_mesh.hpp"
@@ -118,6 +119,11 @@ class Daemon {
   void accelCalibrationStep(ClientId client, const proto::Request& req, const std::string& action);
   void requestSolve();
   std::optional<Mat3> currentWarp(cv::Size content_size) const;
+  // keystone_rig.cpp: keystone from the rig model's plane mapping.
+  Result<keystone::KeystoneSolution> solveRigKeystone(cv::Size content) const;
+  std::optional<Mat3> rigKeystoneWarp(cv::Size content) const;  // when on and solvable
+  Result<void> setRigKeystone(bool enable);
+  nlohmann::json rigKeystoneJson(cv::Size content) const;
   cv::Size currentSourceSize() const;
   void refreshOutputs(std::function<void(bool shown)> done = {});
   // What render::choosePath needs about an output, from the rig model and the viewer.

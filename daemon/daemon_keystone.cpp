@@ -87,7 +87,7 @@ void Daemon::probeKeystoneInputs() {
   if (!k.hooked) watchTiltSensor();
   k.hooked = true;
   const rig::RigProjector* proj = rig_.projectorForOutput(out->name);
-  if (!proj) {
+  if (!proj || !proj->intrinsics_known) {
     k.unavailable = "automatic keystone needs the intrinsics of the projector on output '" +
                     out->name + "': the rig model has none (calibrate writes it)";
     if (settings_.auto_keystone) warn(k.unavailable + "; it stays off");
@@ -251,6 +251,7 @@ std::optional<Mat3> Daemon::currentWarp(cv::Size content_size) const {
       k.estimate->content_height == content_size.height) {
     return k.estimate->H;
   }
+  if (auto H = rigKeystoneWarp(content_size)) return H;
   if (settings_.keystone) {
     std::array<Vec2, 4> corners;
     for (int i = 0; i < 4; ++i) {
@@ -266,8 +267,13 @@ std::optional<Mat3> Daemon::currentWarp(cv::Size content_size) const {
 json Daemon::keystoneJson() const {
   const KeystoneRuntime& k = keystone_rt_;
   const bool auto_active = settings_.auto_keystone && k.estimate.has_value();
+  const cv::Size content = currentSourceSize();
+  const json rig = rigKeystoneJson(content);
+  const bool rig_active = !auto_active && settings_.rig_keystone && !rig.contains("unavailable");
   json j = {{"auto", settings_.auto_keystone},
+            {"rig", settings_.rig_keystone},
             {"mode", auto_active          ? "auto"
+                     : rig_active         ? "rig"
                      : settings_.keystone ? "manual"
                                           : "none"},
             {"corners", nullptr},
@@ -275,7 +281,12 @@ json Daemon::keystoneJson() const {
             {"output_size", nullptr},
             {"content_size", nullptr}};
   if (!k.unavailable.empty()) j["auto_unavailable"] = k.unavailable;
-  if (settings_.keystone && !auto_active) {
+  if (rig.contains("unavailable")) {
+    j["rig_unavailable"] = rig["unavailable"];
+  } else if (rig_active) {
+    j["wall"] = rig;
+  }
+  if (settings_.keystone && !auto_active && !rig_active) {
     json c = json::array();
     for (const auto& p : *settings_.keystone) c.push_back({p[0], p[1]});
     j["corners"] = c;
@@ -322,12 +333,11 @@ json Daemon::keystoneJson() const {
   if (DeviceEntry* out = self->devices_.firstUsable(PROCAM_FAMILY_OUTPUT)) {
     if (auto mode = outputMode(*out)) j["output_size"] = {mode->width, mode->height};
   }
-  const cv::Size content = currentSourceSize();
   if (content.width > 0 && content.height > 0) {
     j["content_size"] = {content.width, content.height};
     if (auto H = currentWarp(content)) {
       j["homography"] = matJson(*H);
-      if (auto_active) {
+      if (auto_active || rig_active) {
         std::array<Vec2, 4> c = contentCorners(content);
         for (auto& p : c) p = (*H * p.homogeneous()).hnormalized();
         j["corners"] = quadJson(c);
@@ -400,8 +410,9 @@ void Daemon::cmdKeystone(ClientId client, const proto::Request& req) {
     } else {
       settings_.keystone.reset();
     }
-    // A manual correction replaces the automatic one.
+    // A manual correction replaces the automatic one and the rig's.
     if (settings_.auto_keystone) (void)setAutoKeystone(false);
+    settings_.rig_keystone = false;
     broadcast("keystone", keystoneJson());
     refreshOutputs();
   } else if (action == "auto") {
@@ -410,6 +421,17 @@ void Daemon::cmdKeystone(ClientId client, const proto::Request& req) {
       return errorTo(client, req, code::kBadArgument, "keystone auto needs \"enable\": true|false");
     }
     if (auto ok = setAutoKeystone(*enable); !ok) {
+      return errorTo(client, req, code::kUnavailable, ok.error().message);
+    }
+    if (*enable) settings_.rig_keystone = false;
+    broadcast("keystone", keystoneJson());
+    refreshOutputs();
+  } else if (action == "rig") {
+    auto enable = args.boolean("enable");
+    if (!args.ok() || !enable || corners || homography) {
+      return errorTo(client, req, code::kBadArgument, "keystone rig needs \"enable\": true|false");
+    }
+    if (auto ok = setRigKeystone(*enable); !ok) {
       return errorTo(client, req, code::kUnavailable, ok.error().message);
     }
     broadcast("keystone", keystoneJson());
@@ -422,7 +444,7 @@ void Daemon::cmdKeystone(ClientId client, const proto::Request& req) {
   } else {
     return errorTo(client, req, code::kBadArgument,
                    "unknown keystone action '" + action +
-                       "' (get, set, auto, accel-sample, accel-solve, accel-reset)");
+                       "' (get, set, auto, rig, accel-sample, accel-solve, accel-reset)");
   }
   replyTo(client, req, "KEYSTONE", keystoneJson());
 }
@@ -707,10 +729,11 @@ void Daemon::onRigChanged() {
   // Auto keystone keeps its tilt state and takes the new intrinsics; when it had
   // none, `keystone auto on` reads the rig again.
   KeystoneRuntime& k = keystone_rt_;
+  if (settings_.rig_keystone) broadcast("keystone", keystoneJson());  // a new plane mapping
   if (!k.projector) return;
   const DeviceEntry* out = devices_.firstUsable(PROCAM_FAMILY_OUTPUT);
   const rig::RigProjector* p = out ? rig_.projectorForOutput(out->name) : nullptr;
-  if (!p) return;
+  if (!p || !p->intrinsics_known) return;
   k.projector = projectorModel(*p);
 }
 

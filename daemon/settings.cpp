@@ -49,6 +49,7 @@ std::string settingsToJson(const Settings& s) {
   nlohmann::json j;
   j["schema"] = kSettingsSchema;
   j["auto_keystone"] = s.auto_keystone;
+  j["rig_keystone"] = s.rig_keystone;
   if (s.keystone) {
     nlohmann::json corners = nlohmann::json::array();
     for (const auto& p : *s.keystone) corners.push_back({p[0], p[1]});
@@ -79,6 +80,11 @@ Result<Settings> settingsFromJson(std::string_view text) {
   if (!autok || !autok->is_boolean())
     return fail(ErrorCode::kParse, "\"auto_keystone\" must be a boolean");
   s.auto_keystone = autok->get<bool>();
+  // Absent in files written before keystone from the rig model existed: off.
+  if (const auto* rigk = field("rig_keystone")) {
+    if (!rigk->is_boolean()) return fail(ErrorCode::kParse, "\"rig_keystone\" must be a boolean");
+    s.rig_keystone = rigk->get<bool>();
+  }
   const auto* ks = field("keystone");
   if (!ks) return fail(ErrorCode::kParse, "missing \"keystone\"");
   if (!ks->is_null()) {

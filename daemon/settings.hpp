@@ -1,6 +1,7 @@
 #pragma once
 // The settings the daemon persists in its state directory (settings.json):
-// manual keystone corners, auto keystone, test pattern, content image.
+// manual keystone corners, auto keystone, keystone from the rig model, test
+// pattern, content image.
 #include <array>
 #include <optional>
 #include <string>
@@ -16,6 +17,7 @@ using Quad = std::array<std::array<double, 2>, 4>;
 
 struct Settings {
   bool auto_keystone = false;
+  bool rig_keystone = false;     // keystone from the rig model's plane mapping
   std::optional<Quad> keystone;  // none: no manual correction
   std::string pattern = "off";   // off, grid, crosshair, white, black
   std::string content;           // image path; empty: none

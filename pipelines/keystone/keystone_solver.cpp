@@ -1,5 +1,6 @@
 #include "keystone/keystone_solver.hpp"
 
+#include <Eigen/SVD>
 #include <cmath>
 #include <string>
 
@@ -28,27 +29,39 @@ Result<KeystoneSolution> solveKeystone(const KeystoneProblem& p) {
   if (!K.allFinite() || p.K.fx <= 0 || p.K.fy <= 0)
     return fail(ErrorCode::kInvalidInput, "intrinsics must be finite with fx, fy > 0");
   if (!validRotation(p.R)) return fail(ErrorCode::kInvalidInput, "R is not a rotation");
+  // With M = [r1 r3 r2] orthonormal, the wall point of a corner is M^T K^-1 x: its
+  // w is the corner ray's Y in the wall frame, and |(x, y, w)| the ray's length.
+  return solveOnWall(wallToFramebuffer(p.K, p.R), p.width, p.height, p.content_width,
+                     p.content_height, p.inscribe);
+}
 
+Result<KeystoneSolution> solveOnWall(const Mat3& wall_to_framebuffer, int width, int height,
+                                     int content_width, int content_height,
+                                     const InscribeOptions& inscribe) {
+  if (width <= 0 || height <= 0 || content_width <= 0 || content_height <= 0)
+    return fail(ErrorCode::kInvalidInput, "framebuffer and content sizes must be positive");
+  const Eigen::JacobiSVD<Mat3> svd(wall_to_framebuffer);
+  if (!wall_to_framebuffer.allFinite() ||
+      !(svd.singularValues()(2) > 1e-12 * svd.singularValues()(0)))
+    return fail(ErrorCode::kInvalidInput, "the wall's collineation is not finite or singular");
   KeystoneSolution s;
-  s.wall_to_framebuffer = wallToFramebuffer(p.K, p.R);
+  s.wall_to_framebuffer = wall_to_framebuffer;
   const Mat3 fb_to_wall = s.wall_to_framebuffer.inverse();
-  const double W = p.width, Hh = p.height;
+  const double W = width, Hh = height;
   const std::array<Vec2, 4> fb = {Vec2(-0.5, -0.5), Vec2(W - 0.5, -0.5), Vec2(W - 0.5, Hh - 0.5),
                                   Vec2(-0.5, Hh - 0.5)};
-  const Mat3 Kinv = K.inverse();
   for (int i = 0; i < 4; ++i) {
-    // Ray of the corner in the wall frame; it must head into the wall (Y > 0) with
-    // some margin, else the quadrilateral is unbounded.
-    const Vec3 ray = p.R.transpose() * (Kinv * fb[i].homogeneous());
-    if (ray.y() <= 1e-6 * ray.norm())
+    // The corner must land on the wall, with some margin, else the quadrilateral is
+    // unbounded.
+    const Vec3 w = fb_to_wall * fb[i].homogeneous();
+    if (w.z() <= 1e-6 * w.norm())
       return fail(ErrorCode::kDegenerate,
                   "framebuffer corner " + std::to_string(i) + " does not reach the wall");
-    const Vec3 w = fb_to_wall * fb[i].homogeneous();
     s.wall_quad[i] = w.hnormalized();
   }
 
-  const double aspect = double(p.content_width) / double(p.content_height);
-  auto rect = largestInscribedRect(s.wall_quad, aspect, p.inscribe);
+  const double aspect = double(content_width) / double(content_height);
+  auto rect = largestInscribedRect(s.wall_quad, aspect, inscribe);
   if (!rect) return tl::unexpected(rect.error());
   s.rect = *rect;
 
@@ -56,8 +69,8 @@ Result<KeystoneSolution> solveKeystone(const KeystoneProblem& p) {
   // v in [-0.5, Hc - 0.5] -> Z from top to bottom (content y is down, wall Z is up).
   const double left = rect->centre.x() - rect->half_width;
   const double top = rect->centre.y() + rect->half_height;
-  const double sx = 2 * rect->half_width / p.content_width;
-  const double sz = 2 * rect->half_height / p.content_height;
+  const double sx = 2 * rect->half_width / content_width;
+  const double sz = 2 * rect->half_height / content_height;
   Mat3 content_to_wall;
   content_to_wall << sx, 0, left + 0.5 * sx, 0, -sz, top - 0.5 * sz, 0, 0, 1;
   s.H = s.wall_to_framebuffer * content_to_wall;
@@ -65,7 +78,7 @@ Result<KeystoneSolution> solveKeystone(const KeystoneProblem& p) {
     return fail(ErrorCode::kDegenerate, "pre-warp maps the content origin to infinity");
   s.H /= s.H(2, 2);
 
-  const double cw = p.content_width, ch = p.content_height;
+  const double cw = content_width, ch = content_height;
   const std::array<Vec2, 4> content = {Vec2(-0.5, -0.5), Vec2(cw - 0.5, -0.5),
                                        Vec2(cw - 0.5, ch - 0.5), Vec2(-0.5, ch - 0.5)};
   for (int i = 0; i < 4; ++i) s.corners[i] = (s.H * content[i].homogeneous()).hnormalized();

@@ -40,6 +40,16 @@ struct KeystoneSolution {
 // framebuffer does not reach the wall (a corner ray is parallel to it or points away).
 Result<KeystoneSolution> solveKeystone(const KeystoneProblem& problem);
 
+// The same from the wall's collineation with the framebuffer, however it was found
+// (wall coordinates X right, Y up, any unit; [Raskar02] §4.2.1): the largest upright
+// rectangle of the content's aspect inside the framebuffer's image on the wall.
+// kInvalidInput for bad sizes or a non-finite or singular collineation; kDegenerate
+// when a framebuffer corner maps to or beyond the wall's horizon (its homogeneous
+// wall coordinate w <= 1e-6 |(x, y, w)|).
+Result<KeystoneSolution> solveOnWall(const Mat3& wall_to_framebuffer, int width, int height,
+                                     int content_width, int content_height,
+                                     const InscribeOptions& inscribe = {});
+
 // Wall coordinates (X, Z) -> framebuffer pixels: K [r1 r3 r2] (wall plane Y = 1).
 Mat3 wallToFramebuffer(const geom::Intrinsics& K, const Mat3& R);
 

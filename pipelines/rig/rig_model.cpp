@@ -1,5 +1,6 @@
 #include "rig/rig_model.hpp"
 
+#include <Eigen/SVD>
 #include <cmath>
 
 namespace procam::rig {
@@ -167,20 +168,52 @@ Result<TiltMountModel> tiltFrom(const json& j, const std::string& where) {
   return m;
 }
 
+// "plane_homography": {"H": 9 numbers (rows), "origin", "u", "v": 3 each}.
+Result<geom::PlaneHomography> planeHomographyFrom(const json& j, const std::string& where) {
+  const std::string at = where + " plane_homography";
+  if (!j.is_object()) return fail(ErrorCode::kParse, at + ": must be an object");
+  auto H = matrix(j, "H", at);
+  if (!H) return tl::unexpected(H.error());
+  auto origin = vector3(j, "origin", at);
+  if (!origin) return tl::unexpected(origin.error());
+  auto u = vector3(j, "u", at);
+  if (!u) return tl::unexpected(u.error());
+  auto v = vector3(j, "v", at);
+  if (!v) return tl::unexpected(v.error());
+  if (std::abs(u->norm() - 1) > 1e-6 || std::abs(v->norm() - 1) > 1e-6 ||
+      std::abs(u->dot(*v)) > 1e-6) {
+    return fail(ErrorCode::kParse, at + ": 'u' and 'v' must be orthonormal");
+  }
+  const Eigen::JacobiSVD<Mat3> svd(*H);
+  if (!(svd.singularValues()(2) > 1e-12 * svd.singularValues()(0))) {
+    return fail(ErrorCode::kParse, at + ": 'H' is singular");
+  }
+  return geom::PlaneHomography{{*origin, *u, *v}, *H};
+}
+
 Result<RigProjector> projectorFrom(const json& p, const std::string& where, size_t index) {
   if (!p.is_object()) return fail(ErrorCode::kParse, where + ": not an object");
   RigProjector out;
   out.name = stringField(p, "name", "projector" + std::to_string(index));
   out.output = stringField(p, "output", "");
   if (auto ok = size(p, out.width, out.height, where); !ok) return tl::unexpected(ok.error());
-  auto K = intrinsics(p, where);
-  if (!K) return tl::unexpected(K.error());
-  out.K = *K;
-  auto d = distortion(p, where);
-  if (!d) return tl::unexpected(d.error());
-  out.dist = *d;
-  out.pose_known = p.contains("R") || p.contains("t");
-  if (p.contains("pose_known") && p["pose_known"].is_boolean()) {
+  if (p.contains("plane_homography")) {
+    auto ph = planeHomographyFrom(p["plane_homography"], where);
+    if (!ph) return tl::unexpected(ph.error());
+    out.plane_homography = *ph;
+  }
+  // Without K a projector needs its plane mapping (route (b′)); otherwise K is required.
+  out.intrinsics_known = p.contains("K") || !out.plane_homography;
+  if (out.intrinsics_known) {
+    auto K = intrinsics(p, where);
+    if (!K) return tl::unexpected(K.error());
+    out.K = *K;
+    auto d = distortion(p, where);
+    if (!d) return tl::unexpected(d.error());
+    out.dist = *d;
+  }
+  out.pose_known = out.intrinsics_known && (p.contains("R") || p.contains("t"));
+  if (out.intrinsics_known && p.contains("pose_known") && p["pose_known"].is_boolean()) {
     out.pose_known = p["pose_known"].get<bool>();
   }
   if (out.pose_known) {
@@ -355,15 +388,21 @@ json rigToJson(const RigModel& rig) {
   }
   j["projectors"] = json::array();
   for (const auto& p : rig.projectors) {
-    json pj = {{"name", p.name},
-               {"width", p.width},
-               {"height", p.height},
-               {"K", matrixJson(p.K.matrix())},
-               {"dist", {p.dist.k1, p.dist.k2, p.dist.p1, p.dist.p2, p.dist.k3}},
-               {"pose_known", p.pose_known},
-               {"points", p.points},
-               {"calibrated", provenanceJson(p.calibrated)}};
-    if (p.pose_known) {
+    json pj = {{"name", p.name},     {"width", p.width},
+               {"height", p.height}, {"pose_known", p.pose_known && p.intrinsics_known},
+               {"points", p.points}, {"calibrated", provenanceJson(p.calibrated)}};
+    if (p.intrinsics_known || !p.plane_homography) {
+      pj["K"] = matrixJson(p.K.matrix());
+      pj["dist"] = {p.dist.k1, p.dist.k2, p.dist.p1, p.dist.p2, p.dist.k3};
+    }
+    if (p.plane_homography) {
+      const geom::PlaneHomography& ph = *p.plane_homography;
+      pj["plane_homography"] = {{"H", matrixJson(ph.H)},
+                                {"origin", vecJson(ph.basis.origin)},
+                                {"u", vecJson(ph.basis.u)},
+                                {"v", vecJson(ph.basis.v)}};
+    }
+    if (p.pose_known && p.intrinsics_known) {
       pj["R"] = matrixJson(p.pose.R);
       pj["t"] = vecJson(p.pose.t);
     }

@@ -18,6 +18,7 @@
 #include "core/types.hpp"
 #include "geometry/camera_model.hpp"
 #include "geometry/plane_fit.hpp"
+#include "geometry/plane_homography.hpp"
 #include "keystone/accel_calibration.hpp"
 
 namespace procam::rig {
@@ -52,12 +53,17 @@ struct RigProjector {
   int width = 0, height = 0;
   geom::Intrinsics K;
   geom::Distortion dist;
-  geom::Pose pose;          // world -> projector
-  bool pose_known = true;   // false: only K is known (e.g. from a keystone-only set-up)
-  bool scale_known = true;  // false: t is up to scale (route (b) without a distance)
-  double rms_px = -1;       // reprojection RMS; < 0 when unknown
-  long points = 0;          // correspondences of the fit
+  bool intrinsics_known = true;  // false: K and dist unknown (only plane_homography is)
+  geom::Pose pose;               // world -> projector
+  bool pose_known = true;        // false: only K is known (e.g. from a keystone-only set-up)
+  bool scale_known = true;       // false: t is up to scale (route (b) without a distance)
+  double rms_px = -1;            // reprojection RMS; < 0 when unknown
+  long points = 0;               // correspondences of the fit
   Provenance calibrated;
+  // Framebuffer pixels -> the planar display surface, in a basis of that plane
+  // ([Raskar02] §4.2.1 collineation; route (b′) writes it). Enough for keystone on
+  // the plane without K or pose.
+  std::optional<geom::PlaneHomography> plane_homography;
   std::optional<TiltMountModel> tilt;
   nlohmann::json photometric = nullptr;  // per-projector response and brightness (reserved)
 

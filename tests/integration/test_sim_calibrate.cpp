@@ -377,8 +377,13 @@ TEST(SimCalibrate, MalformedArgumentsAreRefused) {
       {{"settle_frames", 100000}},
       {{"phase_steps", 2}},
       {{"mode", "gray"}, {"phase_steps", 4}},
-      {{"cameras", {"cam_left"}}},
       {{"cameras", {"cam_left", "cam_left"}}},
+      {{"cameras", {"a", "b", "c"}}},
+      {{"cameras", {""}}},
+      {{"plane", {0, 0, 0, 1}}},
+      {{"plane", {0, 1, 0}}},
+      {{"plane", "wall"}},
+      {{"cameras", {"cam_left", "cam_right"}}, {"plane", {0, 1, 0, -3}}},
       {{"cameras", "cam_left"}},
       {{"output", ""}},
       {{"speed", "fast"}},
@@ -401,6 +406,12 @@ TEST(SimCalibrate, MalformedArgumentsAreRefused) {
   r = c.call({{"cmd", "calibrate"}, {"output", "beamer"}});
   ASSERT_TRUE(r);
   EXPECT_EQ((*r)["code"], "unavailable");
+  // One camera named is route (b′), which needs the display plane: the rig model
+  // has none and the request gives none.
+  r = c.call({{"cmd", "calibrate"}, {"cameras", {"cam_left"}}});
+  ASSERT_TRUE(r);
+  EXPECT_EQ((*r)["code"], "unavailable");
+  EXPECT_NE((*r)["message"].get<std::string>().find("plane"), std::string::npos) << r->dump();
   auto status = c.call({{"cmd", "status"}});
   ASSERT_TRUE(status);
   EXPECT_EQ((*status)["operations"], json::array());

@@ -13,8 +13,7 @@
 
 #include "daemon_harness.hpp"
 #include "geometry/homography.hpp"
-#include "keystone/display_error.hpp"
-#include "keystone/keystone_solver.hpp"
+#include "keystone_truth.hpp"
 #include "sim/embedded_scenes.hpp"
 #include "sim/scene.hpp"
 #include "truth_rig_file.hpp"
@@ -67,54 +66,16 @@ std::string levelScene() {
          text.substr(end + 2);
 }
 
-Mat3 matrixOf(const json& rows) {
-  Mat3 H;
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) H(r, c) = rows[r][c].get<double>();
-  }
-  return H;
-}
-
-// The content's outer corners (pixel edges) through H: what solveKeystone reports.
-std::array<Vec2, 4> outerCorners(const Mat3& H, int w, int h) {
-  const std::array<Vec2, 4> c = {Vec2(-0.5, -0.5), Vec2(w - 0.5, -0.5), Vec2(w - 0.5, h - 0.5),
-                                 Vec2(-0.5, h - 0.5)};
-  std::array<Vec2, 4> out;
-  for (int i = 0; i < 4; ++i) out[i] = (H * c[i].homogeneous()).hnormalized();
-  return out;
-}
-
-struct Measured {
-  double corner_px = 0, aspect_rel = 0, area_rel = 0;
-};
-
 // The daemon's keystone event against the truth at its sample time.
 Measured compareWithTruth(const sim::Scene& scene, const json& event) {
   const double t = event["estimate"]["sample_time"].get<double>();
   const sim::SceneState state = scene.at(t);
   const sim::ProjectorState* proj = state.projector("proj");
-  const int cw = event["content_size"][0].get<int>(), ch = event["content_size"][1].get<int>();
-  keystone::KeystoneProblem p;
-  p.K = proj->spec.K;
-  p.width = proj->spec.width;
-  p.height = proj->spec.height;
   // The handheld wall is the plane y = 2.5 facing -y: the world frame is the
   // wall frame of keystone/orientation.hpp, so the pose's rotation is R.
-  p.R = proj->model.pose.R;
-  p.content_width = cw;
-  p.content_height = ch;
-  auto truth = keystone::solveKeystone(p);
-  EXPECT_TRUE(truth) << truth.error().message;
-  if (!truth) return {1e9, 1e9, 1e9};
-  const auto got = outerCorners(matrixOf(event["homography"]), cw, ch);
-  Measured m;
-  for (int i = 0; i < 4; ++i)
-    m.corner_px = std::max(m.corner_px, (got[i] - truth->corners[i]).norm());
-  const auto err = keystone::displayError(p.K, p.R, got);
-  m.corner_px = std::max(m.corner_px, err.max_corner_px);
-  m.aspect_rel = std::abs(err.aspect / (double(cw) / ch) - 1);
-  m.area_rel = std::abs(err.area / truth->rect.area() - 1);
-  return m;
+  return measureAgainstTruth(proj->spec.K, proj->model.pose.R, proj->spec.width, proj->spec.height,
+                             matrixOf(event["homography"]), event["content_size"][0].get<int>(),
+                             event["content_size"][1].get<int>());
 }
 
 TEST(SimKeystone, AutoKeystoneFollowsTheHeldPosesOfTheHandheldProjector) {

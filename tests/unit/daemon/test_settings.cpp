@@ -9,12 +9,14 @@ namespace {
 TEST(Settings, RoundTrip) {
   Settings s;
   s.auto_keystone = true;
+  s.rig_keystone = true;
   s.keystone = Quad{{{10.5, 20}, {1900, 15}, {1910, 1070}, {5, 1075.25}}};
   s.pattern = "crosshair";
   s.content = "/srv/slide.png";
   auto back = settingsFromJson(settingsToJson(s));
   ASSERT_TRUE(back) << back.error().message;
   EXPECT_TRUE(back->auto_keystone);
+  EXPECT_TRUE(back->rig_keystone);
   ASSERT_TRUE(back->keystone);
   EXPECT_EQ(*back->keystone, *s.keystone);  // doubles survive JSON exactly
   EXPECT_EQ(back->pattern, "crosshair");
@@ -22,7 +24,17 @@ TEST(Settings, RoundTrip) {
   auto defaults = settingsFromJson(settingsToJson(Settings{}));
   ASSERT_TRUE(defaults);
   EXPECT_FALSE(defaults->keystone);
+  EXPECT_FALSE(defaults->rig_keystone);
   EXPECT_TRUE(defaults->content.empty());
+}
+
+// A settings file written before keystone from the rig model existed is still read.
+TEST(Settings, FileWithoutRigKeystoneIsRead) {
+  auto old = settingsFromJson(
+      R"({"schema":1,"auto_keystone":true,"keystone":null,"pattern":"off","content":null})");
+  ASSERT_TRUE(old) << old.error().message;
+  EXPECT_TRUE(old->auto_keystone);
+  EXPECT_FALSE(old->rig_keystone);
 }
 
 TEST(Settings, RejectsCorruptOrForeignFiles) {
@@ -33,6 +45,7 @@ TEST(Settings, RejectsCorruptOrForeignFiles) {
           "[]",
           R"({"schema":2,"auto_keystone":false,"keystone":null,"pattern":"off","content":null})",
           R"({"schema":1,"auto_keystone":0,"keystone":null,"pattern":"off","content":null})",
+          R"({"schema":1,"auto_keystone":false,"rig_keystone":1,"keystone":null,"pattern":"off","content":null})",
           R"({"schema":1,"auto_keystone":false,"keystone":{"corners":[[0,0]]},"pattern":"off","content":null})",
           R"({"schema":1,"auto_keystone":false,"keystone":null,"pattern":"plaid","content":null})",
           R"({"schema":1,"auto_keystone":false,"keystone":null,"pattern":"off","content":5})",

@@ -143,6 +143,18 @@ TEST(RigModel, MalformedDocumentsAreTypedErrors) {
       {R"({"projectors": [{"name": "p", "width": 10, "height": 10, "K": [5,0,5,0,5,5,0,0,1],
           "tilt": {"mount": [1,0,0,0,1,0,0,0,1], "scale": [0, 1, 1]}}]})",
        ErrorCode::kParse},
+      // Neither K nor a plane mapping.
+      {R"({"projectors": [{"name": "p", "width": 10, "height": 10}]})", ErrorCode::kParse},
+      // A plane mapping with a basis that is not orthonormal, or a singular H.
+      {R"({"projectors": [{"name": "p", "width": 10, "height": 10, "plane_homography":
+          {"H": [1,0,0,0,1,0,0,0,1], "origin": [0,3,0], "u": [1,0,0], "v": [1,0,1]}}]})",
+       ErrorCode::kParse},
+      {R"({"projectors": [{"name": "p", "width": 10, "height": 10, "plane_homography":
+          {"H": [1,0,0,2,0,0,0,0,1], "origin": [0,3,0], "u": [1,0,0], "v": [0,0,1]}}]})",
+       ErrorCode::kParse},
+      {R"({"projectors": [{"name": "p", "width": 10, "height": 10, "plane_homography":
+          {"H": [1,0,0,0,1,0,0,0,1], "origin": [0,3], "u": [1,0,0], "v": [0,0,1]}}]})",
+       ErrorCode::kParse},
   };
   for (const auto& [text, code] : cases) {
     auto r = rigFromText(text, "test");
@@ -163,6 +175,76 @@ TEST(RigModel, ProjectorWithoutPoseKeepsOnlyItsIntrinsics) {
   EXPECT_FALSE(rig->projectors[0].pose_known);
   EXPECT_EQ(rig->projectorForOutput("hdmi")->K.fx, 2000);
   EXPECT_FALSE(rigToJson(*rig)["projectors"][0].contains("R"));
+}
+
+// Route (b′): a projector known only by its collineation with the display plane.
+// It round-trips at full precision, has no K, no pose and no dist in the file, and
+// merging it replaces the projector's earlier entry (keeping its tilt mount).
+TEST(RigModel, PlaneHomographyRoundTripWithoutIntrinsics) {
+  RigModel rig;
+  RigProjector p;
+  p.name = p.output = "proj";
+  p.width = 1920;
+  p.height = 1080;
+  p.intrinsics_known = false;
+  p.pose_known = false;
+  p.rms_px = 0.04;
+  p.points = 12345;
+  geom::PlaneHomography ph;
+  ph.basis.origin = Vec3(-0.4, 3.0, 1.0 + 1.0 / 3.0);
+  ph.basis.u = Vec3(1, 0, 0);
+  ph.basis.v = Vec3(0, 0, 1);
+  ph.H << 1.1e-3, 2e-5, -1.05, -3e-5, -9e-4, 0.41, 1e-5, 2e-6, 0.7;
+  p.plane_homography = ph;
+  rig.projectors = {p};
+  rig.surface.plane = geom::Plane{Vec3(0, -1, 0), 3.0};
+
+  const json j = rigToJson(rig);
+  const json& pj = j["projectors"][0];
+  EXPECT_FALSE(pj.contains("K"));
+  EXPECT_FALSE(pj.contains("dist"));
+  EXPECT_FALSE(pj.contains("R"));
+  EXPECT_EQ(pj["pose_known"], false);
+  auto back = rigFromText(j.dump(2), "rig.json");
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_EQ(rigToJson(*back), j);  // a fixed point
+  const RigProjector& b = back->projectors.at(0);
+  EXPECT_FALSE(b.intrinsics_known);
+  EXPECT_FALSE(b.pose_known);
+  ASSERT_TRUE(b.plane_homography);
+  EXPECT_EQ(b.plane_homography->H, ph.H);
+  EXPECT_EQ(b.plane_homography->basis.origin, ph.basis.origin);
+  EXPECT_EQ(b.plane_homography->basis.u, ph.basis.u);
+  EXPECT_EQ(b.plane_homography->basis.v, ph.basis.v);
+
+  // Merged over a route (a) entry with a tilt mount: the mapping replaces K and pose.
+  RigModel base;
+  base.projectors = {projector("proj", 1500)};
+  base.projectors[0].tilt = TiltMountModel{};
+  const RigModel merged = mergeRig(base, *back);
+  ASSERT_EQ(merged.projectors.size(), 1u);
+  EXPECT_FALSE(merged.projectors[0].intrinsics_known);
+  EXPECT_TRUE(merged.projectors[0].plane_homography);
+  EXPECT_TRUE(merged.projectors[0].tilt);
+}
+
+// A projector may have K and a plane mapping; files written before plane mappings
+// existed have K alone and are read as before.
+TEST(RigModel, ProjectorWithKAndPlaneHomographyKeepsBoth) {
+  auto rig = rigFromText(R"({"version": 2, "projectors": [{"name": "p", "width": 1920,
+      "height": 1080, "K": [2000,0,959.5,0,2000,539.5,0,0,1], "plane_homography":
+      {"H": [1,0,0,0,1,0,0,0,1], "origin": [0,3,0], "u": [1,0,0], "v": [0,0,1]}}]})",
+                         "both");
+  ASSERT_TRUE(rig) << rig.error().message;
+  EXPECT_TRUE(rig->projectors[0].intrinsics_known);
+  EXPECT_EQ(rig->projectors[0].K.fx, 2000);
+  EXPECT_TRUE(rig->projectors[0].plane_homography);
+  auto old = rigFromText(R"({"version": 2, "projectors": [{"name": "p", "width": 1920,
+      "height": 1080, "K": [2000,0,959.5,0,2000,539.5,0,0,1]}]})",
+                         "old");
+  ASSERT_TRUE(old) << old.error().message;
+  EXPECT_TRUE(old->projectors[0].intrinsics_known);
+  EXPECT_FALSE(old->projectors[0].plane_homography);
 }
 
 }  // namespace

@@ -1,0 +1,146 @@
+#include "calibration/plane_homography_route.hpp"
+
+#include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
+
+#include "geometry/homography.hpp"
+#include "surface/projector_samples.hpp"
+
+namespace procam::calib {
+
+namespace {
+
+std::vector<cv::Point2d> cvPoints(const Points2& p) {
+  std::vector<cv::Point2d> out;
+  out.reserve(p.size());
+  for (const Vec2& q : p) out.emplace_back(q.x(), q.y());
+  return out;
+}
+
+// Convex hull area of `points` over the w x h frame.
+double coverage(const Points2& points, int w, int h) {
+  std::vector<cv::Point2f> pts;
+  pts.reserve(points.size());
+  for (const Vec2& p : points)
+    pts.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()));
+  std::vector<cv::Point2f> hull;
+  cv::convexHull(pts, hull);
+  return hull.size() < 3 ? 0.0 : cv::contourArea(hull) / (double(w) * double(h));
+}
+
+}  // namespace
+
+Result<PlaneHomographyResult> solvePlaneHomographyRoute(const sl::PatternSet& set,
+                                                        const DecodedView& view,
+                                                        const geom::Plane& plane_in,
+                                                        const PlaneHomographyOptions& o) {
+  const geom::CameraModel& camera = view.camera;
+  if (view.decoded.u.cols != camera.width || view.decoded.u.rows != camera.height)
+    return fail(ErrorCode::kInvalidInput,
+                "captures of camera '" + view.name + "' are " +
+                    std::to_string(view.decoded.u.cols) + "x" +
+                    std::to_string(view.decoded.u.rows) + " but its calibration is " +
+                    std::to_string(camera.width) + "x" + std::to_string(camera.height));
+  const double n_norm = plane_in.n.norm();
+  if (!plane_in.n.allFinite() || !std::isfinite(plane_in.d) || !(n_norm > 1e-9))
+    return fail(ErrorCode::kInvalidInput, "the display plane must be finite with a normal");
+  const geom::Plane plane{plane_in.n / n_norm, plane_in.d / n_norm};
+  const int pw = set.options.width, ph = set.options.height;
+
+  // Projector nodes and the camera pixels that see them ([Raskar02] §4.1.1), the
+  // camera's lens distortion removed: collineations hold between pinhole images.
+  auto samples = surface::sampleProjectorGrid(view.decoded, pw, ph,
+                                              {.step = o.step, .radius = sampleRadius(set)});
+  if (!samples) return tl::unexpected(samples.error());
+  Points2 proj, cam;
+  for (std::size_t i = 0; i < samples->camera.size(); ++i) {
+    auto ideal = camera.undistortPixel(samples->camera[i]);
+    if (!ideal) continue;
+    proj.push_back(samples->projector[i]);
+    cam.push_back(*ideal);
+  }
+  PlaneHomographyResult out;
+  out.samples = proj.size();
+  if (proj.size() < o.min_points)
+    return fail(ErrorCode::kTooFewPoints,
+                "camera '" + view.name + "' saw only " + std::to_string(proj.size()) +
+                    " projector nodes (need " + std::to_string(o.min_points) + ")");
+
+  // Robust support (RANSAC), then the Hartley-normalised DLT and the ML refinement
+  // of the camera-side error on the inliers alone.
+  std::vector<unsigned char> mask;
+  const cv::Mat H0 = cv::findHomography(cvPoints(proj), cvPoints(cam), cv::RANSAC,
+                                        o.ransac_threshold_px, mask, 2000, 0.999);
+  if (H0.empty())
+    return fail(ErrorCode::kDegenerate,
+                "camera '" + view.name + "': no collineation fits the projector nodes it saw");
+  Points2 proj_in, cam_in;
+  for (std::size_t i = 0; i < proj.size(); ++i) {
+    if (!mask[i]) continue;
+    proj_in.push_back(proj[i]);
+    cam_in.push_back(cam[i]);
+  }
+  out.inliers = proj_in.size();
+  if (out.inliers < o.min_points)
+    return fail(ErrorCode::kTooFewPoints,
+                "only " + std::to_string(out.inliers) + " of " + std::to_string(proj.size()) +
+                    " projector nodes fit one collineation (need " + std::to_string(o.min_points) +
+                    "): is the surface planar?");
+  out.coverage = coverage(proj_in, pw, ph);
+  if (out.coverage < o.min_coverage)
+    return fail(ErrorCode::kDegenerate,
+                "camera '" + view.name + "' sees " + std::to_string(100 * out.coverage) +
+                    " % of the projector's image; the collineation would be extrapolated "
+                    "(aim the camera at the projection)");
+  auto fit = geom::fitHomography(proj_in, cam_in);
+  if (!fit) return tl::unexpected(fit.error());
+  out.projector_to_camera = fit->H;
+  out.rms_camera_px = fit->rms;
+  out.condition = fit->condition;
+  const Mat3 cam_to_proj = fit->H.inverse();
+  double sum = 0;
+  for (std::size_t i = 0; i < proj_in.size(); ++i) {
+    const auto back = geom::applyHomography(cam_to_proj, cam_in[i]);
+    if (!back) return fail(ErrorCode::kDegenerate, "the collineation is singular on its inliers");
+    sum += (*back - proj_in[i]).squaredNorm();
+  }
+  out.rms_projector_px = std::sqrt(sum / double(proj_in.size()));
+
+  // The plane in the upright basis seen from the camera, centred where the camera
+  // saw the projection; the camera's rays through the inliers must reach it in front.
+  const Vec3 centre = camera.pose.center();
+  auto basis = geom::uprightBasis(plane, centre, centre);
+  if (!basis) return tl::unexpected(basis.error());
+  auto plane_to_camera = geom::planeToImage(camera.K, camera.pose, *basis);
+  if (!plane_to_camera) return tl::unexpected(plane_to_camera.error());
+  const Mat3 camera_to_plane = plane_to_camera->inverse();
+  Vec2 mean = Vec2::Zero();
+  const Mat3 Kinv = camera.K.matrix().inverse();
+  for (const Vec2& c : cam_in) {
+    const Vec3 dir = camera.pose.R.transpose() * (Kinv * c.homogeneous());
+    const double along = plane.n.dot(dir);
+    const double t = std::abs(along) > 1e-12 ? -plane.signedDistance(centre) / along : -1.0;
+    if (!(t > 0))
+      return fail(ErrorCode::kDegenerate,
+                  "camera '" + view.name +
+                      "' sees the projection where the given plane is not in front of it: "
+                      "the plane is not the lit surface");
+    mean += (camera_to_plane * c.homogeneous()).hnormalized();
+  }
+  mean /= double(cam_in.size());
+  basis->origin = basis->toWorld(mean);
+  Mat3 shift = Mat3::Identity();
+  shift.topRightCorner<2, 1>() = -mean;
+  Mat3 H = shift * camera_to_plane * fit->H;  // [Raskar02] §4.2.4: A_wp = A_wc^-1 A_cp
+  H /= H.norm();
+  if (H(2, 2) < 0) H = -H;
+  if (!H.allFinite())
+    return fail(ErrorCode::kIllConditioned, "the projector-to-plane collineation is not finite");
+  out.projector_to_plane = {*basis, H};
+  return out;
+}
+
+}  // namespace procam::calib

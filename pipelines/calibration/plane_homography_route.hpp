@@ -1,0 +1,57 @@
+#pragma once
+// Route (b′): a projector on a planar display surface from one calibrated camera and
+// the plane's position in the world ([Raskar02] §4.2.1, §4.2.4: on a plane every
+// pair of images is related by a collineation, and collineations chain). The
+// decoded structured light gives projector pixel <-> camera pixel; their
+// collineation A_cp is fitted robustly; the camera's model and the plane give the
+// camera's collineation with the plane A_wc; their chain A_wc^-1 A_cp maps projector
+// pixels to the plane. Neither the projector's intrinsics nor its pose are needed.
+//
+// The plane is what an installer gives (measured, or from fiducials of known size):
+// one camera cannot measure the depth of a plane it sees, only its collineation.
+#include <cstddef>
+
+#include "calibration/stereo_route.hpp"
+#include "core/error.hpp"
+#include "core/types.hpp"
+#include "geometry/plane_fit.hpp"
+#include "geometry/plane_homography.hpp"
+#include "structured_light/pattern_set.hpp"
+
+namespace procam::calib {
+
+struct PlaneHomographyOptions {
+  int step = 8;  // projector pixels between sampled nodes
+  // RANSAC inlier distance in camera pixels. A sampled node's camera position
+  // averages a neighbourhood of decoded pixels and scatters by well under 0.2 px
+  // under the reference capture conditions; a node this far off the collineation
+  // is not on the plane (or was mis-decoded).
+  double ransac_threshold_px = 1.0;
+  std::size_t min_points = 20;  // inlier nodes
+  // Convex hull of the inlier nodes over the projector frame. Below this the
+  // collineation is extrapolated far beyond what the camera saw.
+  double min_coverage = 0.05;
+};
+
+struct PlaneHomographyResult {
+  geom::PlaneHomography projector_to_plane;     // upright basis (geom::uprightBasis), lit side
+  Mat3 projector_to_camera = Mat3::Identity();  // to ideal (undistorted) camera pixels
+  double rms_camera_px = 0;                     // of the collineation fit, inliers, camera pixels
+  double rms_projector_px = 0;                  // the same residuals transferred into the projector
+  double condition = 0;     // of the Hartley-normalised DLT (geom::HomographyFit)
+  double coverage = 0;      // inlier nodes' convex hull / projector frame area
+  std::size_t samples = 0;  // projector nodes the camera saw
+  std::size_t inliers = 0;
+};
+
+// kInvalidInput for a decoded map whose size is not its camera's, a non-finite or
+// zero-normal plane; kTooFewPoints below min_points inliers; kDegenerate when the
+// camera lies on the plane, sees the lit points behind it (the plane given is not
+// the one lit), the nodes cover less than min_coverage of the projector, or the
+// plane is horizontal; the errors of geom::fitHomography (kIllConditioned...).
+Result<PlaneHomographyResult> solvePlaneHomographyRoute(const sl::PatternSet& set,
+                                                        const DecodedView& view,
+                                                        const geom::Plane& plane,
+                                                        const PlaneHomographyOptions& options = {});
+
+}  // namespace procam::calib
