@@ -35,7 +35,9 @@ void Daemon::cmdPattern(ClientId client, const proto::Request& req) {
 
 json Daemon::contentJson() const {
   if (live_content_) return liveContentJson();
-  if (!keystone_rt_.meshes.empty()) return keystone_rt_.mesh_info;
+  if (!keystone_rt_.meshes.empty() || !keystone_rt_.mesh_images.empty()) {
+    return keystone_rt_.mesh_info;
+  }
   if (settings_.content.empty()) return nullptr;
   json j = {{"path", settings_.content}};
   if (content_info_.width > 0) j["size"] = {content_info_.width, content_info_.height};
@@ -59,6 +61,7 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
       content_info_ = {};
       keystone_rt_.content.reset();
       keystone_rt_.meshes.clear();
+      keystone_rt_.mesh_images.clear();
       broadcast("content", {{"content", nullptr}});
       refreshOutputs();
     }
@@ -78,9 +81,17 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
     std::vector<MeshOutput> outputs;
     for (const auto& e : devices_.entries()) {
       if (e.description.family != PROCAM_FAMILY_OUTPUT || !e.usable()) continue;
-      MeshOutput o{e.name, std::nullopt, rig_.surface.plane, !rig_.surface.empty()};
+      MeshOutput o{e.name, std::nullopt, rig_.surface.plane, !rig_.surface.empty(), nullptr};
       const rig::RigProjector* p = rig_.projectorForOutput(e.name);
       if (p && p->pose_known && p->scale_known) o.projector = p->model();
+      if (p && !o.plane) {
+        auto s = rig_surfaces_.find(p->name);
+        if (s == rig_surfaces_.end()) s = rig_surfaces_.find("");
+        if (s != rig_surfaces_.end()) {
+          o.surface =
+              std::shared_ptr<const geom::MeshIntersector>(s->second, &s->second->intersector);
+        }
+      }
       outputs.push_back(std::move(o));
     }
     // The viewer: a tracker's (status `viewer`), else [content] viewer, else the rig's.
@@ -110,6 +121,7 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
           content_info_ = {};
           keystone_rt_.content.reset();
           keystone_rt_.meshes = std::move((*prepared)->meshes);
+          keystone_rt_.mesh_images = std::move((*prepared)->images);
           keystone_rt_.mesh_info = std::move((*prepared)->info);
           followMeshViewer(**prepared);
           broadcast("content", {{"content", contentJson()}});
@@ -160,6 +172,7 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
         content_info_ = {image->cols, image->rows};
         keystone_rt_.content = image;
         keystone_rt_.meshes.clear();
+        keystone_rt_.mesh_images.clear();
         broadcast("content", {{"content", contentJson()}});
         refreshOutputs();
         replyTo(client, req, "CONTENT", {{"content", contentJson()}, {"operation", op_id}});

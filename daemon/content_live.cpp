@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <filesystem>
 
 #include "content/raw_source.hpp"
@@ -14,6 +15,9 @@
 #include "content_mesh.hpp"
 #include "daemon.hpp"
 #include "geometry/intersect.hpp"
+#include "render/cpu_renderer.hpp"
+#include "render/projective_mesh.hpp"
+#include "render/viewer_view.hpp"
 #include "request_args.hpp"
 #if PROCAM_HAVE_GSTREAMER
 #include "content/gst_source.hpp"
@@ -158,6 +162,7 @@ Result<void> Daemon::startLiveContent(std::unique_ptr<content::ContentSource> so
   keystone_rt_.content.reset();
   content_info_ = {source->size().width, source->size().height};
   keystone_rt_.meshes.clear();
+  keystone_rt_.mesh_images.clear();
   live_content_ = LiveContent{std::move(source), timer, fd, std::move(info), 0, false};
   pollLiveContent();  // a frame already there shows at once
   broadcast("content", {{"content", contentJson()}});
@@ -220,6 +225,66 @@ bool isMeshFile(const std::string& path) {
   return ext == ".obj" || ext == ".ply";
 }
 
+namespace {
+
+nlohmann::json vec3Json(const Vec3& v) {
+  return {v.x(), v.y(), v.z()};
+}
+
+struct ViewerImage {
+  std::shared_ptr<const cv::Mat> image;
+  content::PlanarView view;  // the placement plane
+};
+
+// A mesh on a non-planar surface: the content image that render::viewerContentMatrix
+// places on the surface for the eye (the output's size) plays the projector's part in the
+// rules of content/mesh_placement.hpp: the mesh stands on the plane through the surface
+// point at the projector's centre, facing the viewer, inside that image's rectangle on the
+// plane, and is drawn from the eye into it ([Raskar02] §3.2.3: the first pass of two).
+Result<ViewerImage> drawForViewer(const content::MeshContent& mesh, const geom::CameraModel& model,
+                                  const geom::MeshIntersector& surface, const Vec3& eye) {
+  const cv::Size size(model.width, model.height);
+  const Mat34 P = model.projectionMatrix();
+  auto ray = model.backproject(Vec2((model.width - 1) / 2.0, (model.height - 1) / 2.0));
+  if (!ray) return tl::unexpected(ray.error());
+  const auto hit = surface.intersect(*ray);
+  if (!hit) return fail(ErrorCode::kDegenerate, "the projector's central ray misses the surface");
+  auto V = render::viewerContentMatrix(surface, P, size, eye, size);
+  if (!V) return tl::unexpected(V.error());
+  // Placed for the content image as the viewer sees it (its rectangle on the plane is
+  // S), so that the whole mesh lies where the surface can show it.
+  ViewerImage out;
+  out.view.projector = *V;
+  out.view.size = size;
+  out.view.plane_point = hit->point;
+  out.view.plane_normal = (eye - hit->point).normalized();
+  out.view.eye = eye;
+  auto placed = content::placeMeshContent(mesh, out.view);
+  if (!placed) return tl::unexpected(placed.error());
+  double near = INFINITY, far = 0;
+  for (const Vec3& x : placed->mesh.vertices) {
+    const double w = V->row(2).dot(x.homogeneous());
+    if (w <= 0) return fail(ErrorCode::kDegenerate, "the placed mesh reaches behind the viewer");
+    near = std::min(near, w);
+    far = std::max(far, w);
+  }
+  auto depth = render::pixelProjectionWithDepth(*V, 0.5 * near, 2.0 * far);
+  if (!depth) return tl::unexpected(depth.error());
+  render::RenderSetup setup;
+  setup.output_size = size;
+  setup.path = render::RenderPath::kPlanar3d;
+  setup.planar3d = *depth;
+  render::CpuRenderer renderer;
+  if (auto ok = renderer.configure(setup); !ok) return tl::unexpected(ok.error());
+  if (auto ok = renderer.render({nullptr, &placed->mesh, 1}); !ok) {
+    return tl::unexpected(ok.error());
+  }
+  out.image = std::make_shared<const cv::Mat>(renderer.frame().clone());
+  return out;
+}
+
+}  // namespace
+
 tl::expected<PreparedMesh, MeshFailure> prepareMeshContent(const std::string& file,
                                                            const std::vector<MeshOutput>& outputs,
                                                            const std::optional<Vec3>& eye,
@@ -238,8 +303,8 @@ tl::expected<PreparedMesh, MeshFailure> prepareMeshContent(const std::string& fi
     if (!o.surface_known) {
       return unavailable("the rig model has no display surface (run calibrate)");
     }
-    if (!o.plane) {
-      return unavailable("the display surface is not planar; 3D content needs the planar 3D path");
+    if (!o.plane && !o.surface) {
+      return unavailable("the display surface is not planar and its mesh is not loaded");
     }
   }
   if (!eye) {
@@ -263,6 +328,20 @@ tl::expected<PreparedMesh, MeshFailure> prepareMeshContent(const std::string& fi
     // The display surface is where the projector's central ray meets the plane.
     auto ray = model.backproject(Vec2((model.width - 1) / 2.0, (model.height - 1) / 2.0));
     if (!ray) return unavailable(ray.error().message);
+    if (!o.plane) {
+      auto drawn = drawForViewer(*loaded, model, *o.surface, *eye);
+      if (!drawn) return unavailable(drawn.error().message);
+      out.images[o.name] = drawn->image;
+      json matrix = json::array();
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 4; ++c) matrix.push_back(drawn->view.projector(r, c));
+      out.placement[o.name] = {{"plane_point", vec3Json(drawn->view.plane_point)},
+                               {"plane_normal", vec3Json(drawn->view.plane_normal)},
+                               {"viewer_matrix", matrix},
+                               {"size", {drawn->view.size.width, drawn->view.size.height}}};
+      out.eye = *eye;
+      continue;
+    }
     const auto hit = geom::intersectPlane(*ray, *o.plane);
     if (!hit) return unavailable("the projector's central ray does not meet the display plane");
     content::PlanarView view;
@@ -286,6 +365,7 @@ tl::expected<PreparedMesh, MeshFailure> prepareMeshContent(const std::string& fi
                 {"vertices", loaded->mesh.vertices.size()},
                 {"shading", "lambert"},
                 {"viewer", viewer}}}};
+  if (!out.placement.empty()) out.info["mesh"]["placement"] = out.placement;
   return out;
 }
 

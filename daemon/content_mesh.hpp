@@ -6,6 +6,7 @@
 // (content_follow.cpp).
 #include <chrono>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -15,6 +16,7 @@
 #include "core/error.hpp"
 #include "core/types.hpp"
 #include "geometry/camera_model.hpp"
+#include "geometry/intersect.hpp"
 #include "geometry/plane_fit.hpp"
 #include "keystone/head_tracked.hpp"
 #include "output_frames.hpp"
@@ -29,6 +31,9 @@ struct MeshOutput {
   std::optional<geom::CameraModel> projector;
   std::optional<geom::Plane> plane;
   bool surface_known = false;  // the rig has a surface (a plane or a mesh)
+  // A non-planar surface's mesh (rig.json meshes), when loaded: the mesh is then drawn
+  // for the viewer first and that image shown through the lookup warp.
+  std::shared_ptr<const geom::MeshIntersector> surface;
 };
 
 // What an output's view-dependent matrix needs: the view it was placed for (its eye is
@@ -39,10 +44,14 @@ struct MeshView {
 };
 
 struct PreparedMesh {
-  std::map<std::string, Mesh3d> meshes;   // output name -> what it draws
-  std::map<std::string, MeshView> views;  // output name -> its view
-  Vec3 eye = Vec3::Zero();                // the viewer it was placed for
-  nlohmann::json info;                    // the `content` object of replies
+  std::map<std::string, Mesh3d> meshes;  // output name -> what it draws (planar surface)
+  // Non-planar surface: output name -> the mesh as the viewer sees it (RGBA, the output's
+  // size), drawn through the lookup warp like image content ([Raskar02] §3.2.3 first pass).
+  std::map<std::string, std::shared_ptr<const cv::Mat>> images;
+  nlohmann::json placement = nlohmann::json::object();  // output name -> placement plane
+  std::map<std::string, MeshView> views;                // output name -> its view
+  Vec3 eye = Vec3::Zero();                              // the viewer it was placed for
+  nlohmann::json info;                                  // the `content` object of replies
 };
 
 // The shown mesh following its tracker (loop thread only; content_follow.cpp).
@@ -72,9 +81,14 @@ bool isMeshFile(const std::string& path);
 
 // Reads the mesh and places it for each output. The viewer is `eye` (world: a
 // tracker's, the configuration's or the rig model's, described by `eye_source`, an
-// object with "source"). `unavailable` when there is no viewer, or an output's
-// projector pose or display surface is unknown or the surface is not planar;
-// `io-error` / `bad-argument` when the file cannot be read or parsed.
+// object with "source"). On a planar surface the mesh stands on the wall and is drawn by
+// the planar 3D path; on a non-planar one it stands on the plane through the surface point
+// at the projector's centre, facing the viewer, sized for the content image the viewer
+// sees on the surface, and is drawn once from the viewer into that image (the output's
+// size; `images`; the plane and the viewer's matrix reported per output in info "placement").
+// `unavailable` when there is no viewer, or an output's projector pose or display surface
+// is unknown (or a non-planar surface's mesh is not loaded); `io-error` / `bad-argument`
+// when the file cannot be read or parsed.
 tl::expected<PreparedMesh, MeshFailure> prepareMeshContent(const std::string& file,
                                                            const std::vector<MeshOutput>& outputs,
                                                            const std::optional<Vec3>& eye,

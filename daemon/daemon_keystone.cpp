@@ -563,6 +563,7 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done) {
     }
     r.content = k.content;
     if (auto m = k.meshes.find(e.name); m != k.meshes.end()) r.mesh3d = m->second;
+    if (auto m = k.mesh_images.find(e.name); m != k.mesh_images.end()) r.content = m->second;
     r.homography = currentWarp(sourceSize(r));
     if (!first_source) first_source = sourceSize(r);
     auto plan = planFrame(r);

@@ -64,7 +64,9 @@ struct KeystoneRuntime {
   int stats_timer = -1;                    // one-shot: statistics of frames drawn without them
   std::shared_ptr<const cv::Mat> content;  // RGBA, decoded on a worker
   std::map<std::string, Mesh3d> meshes;    // 3D content: output name -> what it draws
-  nlohmann::json mesh_info;                // `content` in replies while meshes are shown
+  // 3D content on a non-planar surface: output name -> the mesh drawn for the viewer.
+  std::map<std::string, std::shared_ptr<const cv::Mat>> mesh_images;
+  nlohmann::json mesh_info;  // `content` in replies while meshes are shown
   bool rendering = false;
   bool render_again = false;
   std::vector<std::function<void(bool shown)>> frame_waiters;
