@@ -331,7 +331,7 @@ tl::expected<PreparedMesh, MeshFailure> prepareMeshContent(const std::string& fi
     if (!o.plane) {
       auto drawn = drawForViewer(*loaded, model, *o.surface, *eye);
       if (!drawn) return unavailable(drawn.error().message);
-      out.images[o.name] = drawn->image;
+      out.images[o.name] = MeshImage{drawn->image, drawn->view.projector};
       json matrix = json::array();
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 4; ++c) matrix.push_back(drawn->view.projector(r, c));

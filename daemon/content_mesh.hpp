@@ -43,11 +43,18 @@ struct MeshView {
   keystone::DisplayRect S;
 };
 
+// 3D content drawn for the viewer on a non-planar surface, and the world -> image matrix it
+// was drawn with (the lookup warp shows it with the same one).
+struct MeshImage {
+  std::shared_ptr<const cv::Mat> image;
+  Mat34 viewer = Mat34::Zero();
+};
+
 struct PreparedMesh {
   std::map<std::string, Mesh3d> meshes;  // output name -> what it draws (planar surface)
   // Non-planar surface: output name -> the mesh as the viewer sees it (RGBA, the output's
   // size), drawn through the lookup warp like image content ([Raskar02] §3.2.3 first pass).
-  std::map<std::string, std::shared_ptr<const cv::Mat>> images;
+  std::map<std::string, MeshImage> images;
   nlohmann::json placement = nlohmann::json::object();  // output name -> placement plane
   std::map<std::string, MeshView> views;                // output name -> its view
   Vec3 eye = Vec3::Zero();                              // the viewer it was placed for

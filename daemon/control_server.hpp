@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
+#include "core/unique_fd.hpp"
 #include "event_loop.hpp"
 #include "protocol.hpp"
-#include "core/unique_fd.hpp"
 
 namespace procam::daemon {
 

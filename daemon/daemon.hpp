@@ -133,9 +133,11 @@ class Daemon {
   // rig or the viewer do not allow it).
   void loadRigSurfaces();
   std::optional<Vec3> viewerEye() const;
-  Result<std::shared_ptr<const render::RenderSetup>> nonPlanarSetup(const std::string& output,
-                                                                    cv::Size mode,
-                                                                    cv::Size content);
+  // `fixed_viewer`: content drawn for that world -> image matrix (3D content), shown by
+  // the lookup warp with it whatever the viewer does since.
+  Result<std::shared_ptr<const render::RenderSetup>> nonPlanarSetup(
+      const std::string& output, cv::Size mode, cv::Size content,
+      const Mat34* fixed_viewer = nullptr);
   bool calibrating() const;
   // Marks `op_id` as the calibration operation using `devices` (commands_calibrate.cpp).
   void beginCalibrationOp(const std::string& op_id, std::vector<std::string> devices);

@@ -517,7 +517,8 @@ render::SceneTraits Daemon::sceneTraits(const std::string& output, bool mesh_con
       (p && rig_.surface.meshes.count(p->name)) || !rig_.surface.unified_mesh.empty();
   t.surface = !rig_.surface.plane && meshed ? render::SurfaceKind::kNonPlanar
                                             : render::SurfaceKind::kPlanar;
-  if (!mesh_follow_.tracker.empty() || !rig_.viewer.tracker.empty()) {
+  // Tracked: a tracker reports the viewer (the eye viewerEye() gives) or the rig names one.
+  if (!viewerJson().is_null() || !rig_.viewer.tracker.empty()) {
     t.viewer = render::ViewerKind::kTracked;
   } else if (config_.content_viewer || rig_.viewer.position) {
     t.viewer = render::ViewerKind::kStatic;
@@ -563,7 +564,11 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done) {
     }
     r.content = k.content;
     if (auto m = k.meshes.find(e.name); m != k.meshes.end()) r.mesh3d = m->second;
-    if (auto m = k.mesh_images.find(e.name); m != k.mesh_images.end()) r.content = m->second;
+    const MeshImage* mesh_image = nullptr;
+    if (auto m = k.mesh_images.find(e.name); m != k.mesh_images.end()) {
+      mesh_image = &m->second;
+      r.content = m->second.image;
+    }
     r.homography = currentWarp(sourceSize(r));
     if (!first_source) first_source = sourceSize(r);
     auto plan = planFrame(r);
@@ -576,7 +581,8 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done) {
     if (plan->source == "content" && !plan->mesh) {
       // Image content on a non-planar surface: what the viewer should see, drawn by the
       // two-pass path or the lookup warp; a keystone homography otherwise.
-      auto np = nonPlanarSetup(e.name, *mode, plan->image->size());
+      auto np = nonPlanarSetup(e.name, *mode, plan->image->size(),
+                               mesh_image ? &mesh_image->viewer : nullptr);
       if (np) {
         plan->setup = **np;
         viewer = (*np)->viewer;
@@ -610,6 +616,8 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done) {
     if (!plugins::outputRenders(device->raw())) {
       if (!st.fallback) st.fallback = std::make_shared<render::CpuRenderer>();
       job.fallback = st.fallback;
+    } else {
+      st.fallback.reset();
     }
     // A client waiting for this frame, or new still content, gets its numbers at once.
     const bool live = live_content_ && !live_content_->ended;

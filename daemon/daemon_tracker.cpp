@@ -124,6 +124,14 @@ void Daemon::onTrackerSample(const std::string& name, const procam_pose_sample& 
   p.timestamp_ns = s.timestamp_ns;
   p.received = std::chrono::steady_clock::now();
   if (name == mesh_follow_.tracker) onMeshViewerSample();
+  // Image content on a non-planar surface drawn by the two-pass path follows the viewer:
+  // a new frame for the new eye (one at a time; refreshOutputs coalesces).
+  for (const auto& [output, st] : keystone_rt_.output_state) {
+    if (st.np_tracked && st.path == "two-pass-mesh") {
+      refreshOutputs();
+      break;
+    }
+  }
 }
 
 json Daemon::viewerJson() const {

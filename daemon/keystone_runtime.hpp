@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "auto_keystone.hpp"
+#include "content_mesh.hpp"
 #include "driver.hpp"
 #include "output_frames.hpp"
 #include "render/cpu_renderer.hpp"
@@ -57,6 +58,7 @@ struct KeystoneRuntime {
     cv::Size np_content;
     Mat34 np_projector = Mat34::Zero();
     bool np_tracked = false;
+    std::optional<Mat34> np_fixed;
     std::optional<Mat34> viewer;  // world -> content pixels of the frame drawn
   };
   std::map<std::string, OutputState> output_state;
@@ -65,7 +67,7 @@ struct KeystoneRuntime {
   std::shared_ptr<const cv::Mat> content;  // RGBA, decoded on a worker
   std::map<std::string, Mesh3d> meshes;    // 3D content: output name -> what it draws
   // 3D content on a non-planar surface: output name -> the mesh drawn for the viewer.
-  std::map<std::string, std::shared_ptr<const cv::Mat>> mesh_images;
+  std::map<std::string, MeshImage> mesh_images;
   nlohmann::json mesh_info;  // `content` in replies while meshes are shown
   bool rendering = false;
   bool render_again = false;

@@ -44,7 +44,8 @@ void drawFallback(const OutputDraw& j, OutputDrawn& r) {
     r.error = reason(err, r.rc);
     return;
   }
-  r.ok = r.drawn = true;
+  r.ok = true;
+  r.drawn = *drawn;
   if (j.want_stats) {
     if (auto st = render::frameStats(cpu.frame())) r.stats = *st;
   }

@@ -70,9 +70,8 @@ std::optional<Vec3> Daemon::viewerEye() const {
   return rig_.viewer.position;
 }
 
-Result<std::shared_ptr<const render::RenderSetup>> Daemon::nonPlanarSetup(const std::string& output,
-                                                                          cv::Size mode,
-                                                                          cv::Size content) {
+Result<std::shared_ptr<const render::RenderSetup>> Daemon::nonPlanarSetup(
+    const std::string& output, cv::Size mode, cv::Size content, const Mat34* fixed_viewer) {
   const render::SceneTraits traits = sceneTraits(output, false);
   if (traits.surface != render::SurfaceKind::kNonPlanar) {
     return fail(ErrorCode::kNotFound, "the surface is planar");
@@ -87,19 +86,35 @@ Result<std::shared_ptr<const render::RenderSetup>> Daemon::nonPlanarSetup(const 
   if (surface == rig_surfaces_.end()) {
     return fail(ErrorCode::kNotFound, "the surface mesh is not loaded");
   }
-  const auto eye = viewerEye();
+  // The eye of the viewer kind the path is chosen for: a tracker's when tracked, else the
+  // configured or the rig's sweet spot. Content drawn for a fixed matrix needs none.
+  const bool tracked = traits.viewer == render::ViewerKind::kTracked && !fixed_viewer;
+  std::optional<Vec3> eye;
+  if (fixed_viewer) {
+    eye = Vec3::Zero();
+  } else if (tracked) {
+    eye = viewerEye();
+  } else if (const auto& c = config_.content_viewer) {
+    eye = Vec3((*c)[0], (*c)[1], (*c)[2]);
+  } else {
+    eye = rig_.viewer.position;
+  }
   if (!eye) {
     return fail(ErrorCode::kNotFound,
                 "no viewer ([content] viewer, a tracker or the rig model's viewer)");
   }
   const Mat34 P = p->model().projectionMatrix();
   auto& st = keystone_rt_.output_state[output];
-  const bool tracked = traits.viewer == render::ViewerKind::kTracked;
+  const std::optional<Mat34> fixed =
+      fixed_viewer ? std::optional<Mat34>(*fixed_viewer) : std::nullopt;
   if (st.np_setup && st.np_surface == surface->second && st.np_eye == *eye &&
-      st.np_content == content && st.np_projector == P && st.np_tracked == tracked) {
+      st.np_content == content && st.np_projector == P && st.np_tracked == tracked &&
+      st.np_fixed == fixed) {
     return st.np_setup;
   }
-  auto V = render::viewerContentMatrix(surface->second->intersector, P, mode, *eye, content);
+  auto V = fixed
+               ? Result<Mat34>(*fixed)
+               : render::viewerContentMatrix(surface->second->intersector, P, mode, *eye, content);
   if (!V) return tl::unexpected(V.error());
   render::RenderSetup setup;
   setup.output_size = mode;
@@ -122,6 +137,7 @@ Result<std::shared_ptr<const render::RenderSetup>> Daemon::nonPlanarSetup(const 
   st.np_content = content;
   st.np_projector = P;
   st.np_tracked = tracked;
+  st.np_fixed = fixed;
   return st.np_setup;
 }
 

@@ -2,9 +2,8 @@
 // A projector output: renders content through its renderer and presents the frame
 // (scan-out on a real display, memory for the headless output, the virtual rig for the
 // mock). Plain C++ interface; every implementation owns its handles (RAII).
-// Threads: an output is driven by one thread at a time. A GLES output leaves its context
-// free after creation and keeps it current on the thread that draws (a context switch per
-// frame would wait for the GPU); it can be destroyed on any thread.
+// Threads: an output is driven by one thread at a time, any thread, and may be destroyed on
+// any thread. A GLES output runs its GL calls on a thread of its own (egl/gl_thread.hpp).
 #include <cstdint>
 #include <functional>
 #include <opencv2/core.hpp>

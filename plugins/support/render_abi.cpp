@@ -46,12 +46,14 @@ tl::unexpected<Error> bad(const std::string& what) {
   return fail(ErrorCode::kInvalidInput, "render setup: " + what);
 }
 
-Result<render::WarpGrid> gridFromAbi(const procam_warp_grid& v, const char* name) {
-  // A grid finer than one node per output pixel gains nothing.
+Result<render::WarpGrid> gridFromAbi(const procam_warp_grid& v, cv::Size output, const char* name) {
+  // A grid finer than one node per output pixel gains nothing: at most one node more
+  // than the output has pixels along each side.
   const uint64_t nodes = uint64_t(v.cols) * v.rows;
-  if (v.cols < 2 || v.rows < 2 || v.cols > kMaxOutputSide + 1 || v.rows > kMaxOutputSide + 1 ||
-      !v.source) {
-    return bad(std::string(name) + " needs 2..16385 node columns and rows and their coordinates");
+  if (v.cols < 2 || v.rows < 2 || v.cols > uint32_t(output.width) + 1 ||
+      v.rows > uint32_t(output.height) + 1 || !v.source) {
+    return bad(std::string(name) +
+               " needs 2 to (output size + 1) node columns and rows and their coordinates");
   }
   render::WarpGrid g;
   g.cols = static_cast<int>(v.cols);
@@ -160,7 +162,7 @@ Result<render::RenderSetup> setupFromAbi(const procam_render_setup& v) {
     }
     case PROCAM_RENDER_LOOKUP_WARP: {
       s.path = render::RenderPath::kLookupWarp;
-      auto g = gridFromAbi(v.lookup, "lookup warp");
+      auto g = gridFromAbi(v.lookup, s.output_size, "lookup warp");
       if (!g) return tl::unexpected(g.error());
       s.lookup = std::move(*g);
       break;
@@ -173,7 +175,7 @@ Result<render::RenderSetup> setupFromAbi(const procam_render_setup& v) {
     s.content_size = cv::Size(int(v.content_width), int(v.content_height));
   }
   if (v.post_warp.cols != 0) {
-    auto g = gridFromAbi(v.post_warp, "post-render warp");
+    auto g = gridFromAbi(v.post_warp, s.output_size, "post-render warp");
     if (!g) return tl::unexpected(g.error());
     s.post_warp = std::move(*g);
   }
@@ -192,6 +194,8 @@ Result<render::RenderSetup> setupFromAbi(const procam_render_setup& v) {
 }
 
 ContentView::ContentView(const cv::Mat* rgba, const render::ColoredMesh* mesh, uint64_t version) {
+  // One colour per vertex is the renderers' invariant; a broken mesh is handed over empty.
+  if (mesh && mesh->colors.size() != mesh->vertices.size()) mesh = nullptr;
   view_.version = version;
   if (rgba && !rgba->empty()) {
     image_ = procam_image{static_cast<uint32_t>(rgba->cols),

@@ -192,12 +192,6 @@ EglContext::~EglContext() {
   releaseDisplay(display_);
 }
 
-void EglContext::release() {
-  if (display_ != EGL_NO_DISPLAY && eglGetCurrentContext() == context_) {
-    eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-  }
-}
-
 Result<void> EglContext::makeCurrent() {
   if (eglGetCurrentContext() == context_) return {};
   if (!eglMakeCurrent(display_, surface_, surface_, context_)) {

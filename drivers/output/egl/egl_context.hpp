@@ -27,9 +27,6 @@ class EglContext {
   EglContext& operator=(const EglContext&) = delete;
 
   Result<void> makeCurrent();
-  // Makes no context current on this thread if this one is: a context can be current on
-  // one thread at a time, so a context made on one thread is freed for the one that draws.
-  void release();
   Result<void> swapBuffers();    // window surfaces only
   std::string renderer() const;  // GL_RENDERER string, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
 
@@ -38,19 +35,6 @@ class EglContext {
   EGLDisplay display_ = EGL_NO_DISPLAY;
   EGLContext context_ = EGL_NO_CONTEXT;
   EGLSurface surface_ = EGL_NO_SURFACE;
-};
-
-// Current on this thread for the scope's life, released at its end.
-class CurrentScope {
- public:
-  explicit CurrentScope(EglContext& context) : context_(context) {}
-  CurrentScope(const CurrentScope&) = delete;
-  CurrentScope& operator=(const CurrentScope&) = delete;
-  ~CurrentScope() { context_.release(); }
-  Result<void> bind() { return context_.makeCurrent(); }
-
- private:
-  EglContext& context_;
 };
 
 // Human-readable name of an EGL error code.

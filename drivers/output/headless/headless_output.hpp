@@ -1,12 +1,13 @@
 #pragma once
 // Output without a display: GLES 3 on the surfaceless EGL platform, frames rendered
-// into a framebuffer object. With a sink (the virtual rig) every frame is read back to
-// memory and handed to it; without one a frame is read back only on request (readFrame,
-// lastFrame, writePng), so a frame costs the GPU's time alone.
+// into a framebuffer object on the output's own GL thread (egl/gl_thread.hpp). With a sink (the
+// virtual rig) every frame is read back to memory and handed to it; without one a frame is read
+// back only on request (readFrame, lastFrame, writePng), so a frame costs the GPU's time alone.
 #include <memory>
 #include <string>
 
 #include "egl/egl_context.hpp"
+#include "egl/gl_thread.hpp"
 #include "gl/gl_renderer.hpp"
 #include "output.hpp"
 
@@ -23,7 +24,7 @@ class HeadlessOutput final : public ProjectorOutput {
   Result<void> configure(const render::RenderSetup& setup) override;
   Result<bool> show(const render::Content& content) override;
   Result<void> readFrame(cv::Mat& rgba) override;
-  void redraw() override { renderer_->redraw(); }
+  void redraw() override;
 
   void setSink(FrameSink sink) { sink_ = std::move(sink); }
   // RGBA, empty before the first frame (read back when needed).
@@ -31,11 +32,13 @@ class HeadlessOutput final : public ProjectorOutput {
   uint64_t frameCount() const { return frames_; }
   // Writes the last frame as an RGBA PNG; kInvalidInput before the first frame, kIo on failure.
   Result<void> writePng(const std::string& path);
-  std::string glRenderer() const { return context_->renderer(); }
+  std::string glRenderer() const;
 
  private:
   HeadlessOutput() = default;
-  // Declaration order = reverse destruction order: the renderer's GL objects go first.
+  // Every GL call runs on thread_, where the context is current for its whole life; the
+  // destructor releases renderer and context there before the thread ends.
+  std::unique_ptr<egl::GlThread> thread_;
   std::unique_ptr<egl::EglContext> context_;
   std::unique_ptr<gl::GlRenderer> renderer_;
   cv::Size size_;

@@ -54,27 +54,33 @@ Result<std::unique_ptr<KmsOutput>> KmsOutput::create(const KmsConfig& config) {
       gbm_surface_create(out->gbm_, out->mode_.hdisplay, out->mode_.vdisplay, GBM_FORMAT_XRGB8888,
                          GBM_BO_USE_SCANOUT | GBM_BO_USE_RENDERING);
   if (!out->surface_) return tl::unexpected(drmError("gbm_surface_create"));
-  auto ctx = egl::EglContext::forGbm(out->gbm_, out->surface_, GBM_FORMAT_XRGB8888);
-  if (!ctx) return tl::unexpected(ctx.error());
-  out->context_ = std::move(*ctx);
-  egl::CurrentScope current(*out->context_);
-  if (auto ok = current.bind(); !ok) return tl::unexpected(ok.error());
-  // Rendered offscreen and blitted to the scan-out buffer, so that the frame shown can be
-  // read back (status, snapshots) after the swap made the window's buffer undefined.
-  auto r = gl::GlRenderer::create(gl::GlTarget{true, 0});
-  if (!r) return tl::unexpected(r.error());
-  out->renderer_ = std::move(*r);
+  out->thread_ = std::make_unique<egl::GlThread>();
+  auto made = out->thread_->run([&]() -> Result<void> {
+    auto ctx = egl::EglContext::forGbm(out->gbm_, out->surface_, GBM_FORMAT_XRGB8888);
+    if (!ctx) return tl::unexpected(ctx.error());
+    out->context_ = std::move(*ctx);
+    if (auto ok = out->context_->makeCurrent(); !ok) return ok;
+    // Rendered offscreen and blitted to the scan-out buffer, so that the frame shown can
+    // be read back (status, snapshots) after the swap made the window's buffer undefined.
+    auto r = gl::GlRenderer::create(gl::GlTarget{true, 0});
+    if (!r) return tl::unexpected(r.error());
+    out->renderer_ = std::move(*r);
+    return {};
+  });
+  if (!made) return tl::unexpected(made.error());
   return out;
 }
 
 KmsOutput::~KmsOutput() {
   if (flip_pending_) (void)waitForFlip();
-  if (context_ && renderer_) {
-    egl::CurrentScope current(*context_);
-    (void)current.bind();
-    renderer_.reset();
+  // GL objects, surface and context go on the thread where the context is current,
+  // before GBM and the DRM device below.
+  if (thread_) {
+    thread_->run([this] {
+      renderer_.reset();
+      context_.reset();
+    });
   }
-  context_.reset();
   if (saved_crtc_) {
     // Give the display back as it was found.
     drmModeSetCrtc(dev_.fd(), saved_crtc_->crtc_id, saved_crtc_->buffer_id, saved_crtc_->x,
@@ -91,22 +97,27 @@ Result<void> KmsOutput::configure(const render::RenderSetup& setup) {
   if (setup.output_size != size()) {
     return fail(ErrorCode::kInvalidInput, "kms output: setup size differs from the display mode");
   }
-  if (auto ok = context_->makeCurrent(); !ok) return ok;
-  return renderer_->configure(setup);
+  return thread_->run([&] { return renderer_->configure(setup); });
 }
 
 Result<bool> KmsOutput::show(const render::Content& content) {
-  if (auto ok = context_->makeCurrent(); !ok) return tl::unexpected(ok.error());
-  auto rendered = renderer_->render(content);
-  if (!rendered || !*rendered) return rendered;
-  if (auto ok = renderer_->blitTo(0); !ok) return tl::unexpected(ok.error());
-  if (auto ok = present(); !ok) return tl::unexpected(ok.error());
-  return true;
+  return thread_->run([&]() -> Result<bool> {
+    auto rendered = renderer_->render(content);
+    if (!rendered || !*rendered) return rendered;
+    if (auto ok = renderer_->blitTo(0); !ok) return tl::unexpected(ok.error());
+    if (auto ok = present(); !ok) return tl::unexpected(ok.error());
+    shown_ = true;
+    return true;
+  });
 }
 
 Result<void> KmsOutput::readFrame(cv::Mat& rgba) {
-  if (auto ok = context_->makeCurrent(); !ok) return ok;
-  return renderer_->readFrame(rgba);
+  if (!shown_) return fail(ErrorCode::kInvalidInput, "kms output: no frame yet");
+  return thread_->run([&] { return renderer_->readFrame(rgba); });
+}
+
+void KmsOutput::redraw() {
+  thread_->run([this] { renderer_->redraw(); });
 }
 
 Result<uint32_t> KmsOutput::framebufferFor(gbm_bo* bo) {

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "egl/egl_context.hpp"
+#include "egl/gl_thread.hpp"
 #include "gl/gl_renderer.hpp"
 #include "kms/kms_device.hpp"
 #include "kms/kms_select.hpp"
@@ -34,7 +35,7 @@ class KmsOutput final : public ProjectorOutput {
   Result<void> configure(const render::RenderSetup& setup) override;
   Result<bool> show(const render::Content& content) override;
   Result<void> readFrame(cv::Mat& rgba) override;
-  void redraw() override { renderer_->redraw(); }
+  void redraw() override;
 
   const FrameStats& stats() const { return stats_; }
   const std::string& connectorName() const { return connector_name_; }
@@ -57,7 +58,11 @@ class KmsOutput final : public ProjectorOutput {
   drmModeCrtc* saved_crtc_ = nullptr;
   gbm_device* gbm_ = nullptr;
   gbm_surface* surface_ = nullptr;
+  // Every GL call (and the page flip after it) runs on thread_, where the context is
+  // current for its whole life (egl/gl_thread.hpp).
+  std::unique_ptr<egl::GlThread> thread_;
   std::unique_ptr<egl::EglContext> context_;
+  bool shown_ = false;
   std::unique_ptr<gl::GlRenderer> renderer_;
   gbm_bo* front_ = nullptr;
   bool mode_set_ = false, flip_pending_ = false;

@@ -96,9 +96,10 @@ int configure(void* self, const procam_render_setup* setup, char* err, size_t er
       return plugins::report(err, err_len, "render setup size differs from the output mode",
                              PROCAM_EINVAL);
     }
+    d->showing = false;  // whatever the outcome, the 1:1 setup is gone
+    d->setup.reset();
     if (auto ok = d->out->configure(*s); !ok) return plugins::report(err, err_len, ok.error());
     d->setup = std::move(*s);
-    d->showing = false;
     return PROCAM_OK;
   } catch (const std::exception& e) {
     return plugins::report(err, err_len, e.what(), PROCAM_EINTERNAL);
@@ -114,10 +115,11 @@ int render(void* self, const procam_content* content, int* out_drawn, procam_fra
     if (!content) return plugins::report(err, err_len, "no content", PROCAM_EINVAL);
     if (d->showing) {
       // A 1:1 frame was shown meanwhile: back to the daemon's setup, drawn again.
+      d->showing = false;
       if (auto ok = d->out->configure(*d->setup); !ok) {
+        d->setup.reset();
         return plugins::report(err, err_len, ok.error());
       }
-      d->showing = false;
     }
     cv::Mat header;
     auto c = plugins::contentFromAbi(*content, *d->setup, header, d->mesh);

@@ -83,6 +83,8 @@ TEST(RenderAbi, BrokenSetupsAreRefused) {
   EXPECT_TRUE(
       refused([](procam_render_setup& s, auto&, auto&) { s.n_surface_vertices = 1ull << 40; }));
   EXPECT_TRUE(refused([](procam_render_setup& s, auto&, auto&) { s.post_warp.rows = 1; }));
+  // Finer than one node per output pixel (64 wide): refused before anything is read.
+  EXPECT_TRUE(refused([](procam_render_setup& s, auto&, auto&) { s.post_warp.cols = 66; }));
   EXPECT_TRUE(refused([](procam_render_setup& s, auto&, auto&) { s.post_warp.step[0] = 0; }));
   EXPECT_TRUE(refused([](procam_render_setup& s, auto&, auto&) { s.alpha_stride = 10; }));
   EXPECT_TRUE(refused([](procam_render_setup& s, auto&, auto&) { s.projector[3] = INFINITY; }));
