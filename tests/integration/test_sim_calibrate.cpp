@@ -474,7 +474,7 @@ TEST(SimCalibrate, ImageContentOnTheCalibratedCornerMatchesTheTrueRig) {
   bgr(cv::Rect(kW / 2, 0, kW / 2, kH)).setTo(cv::Scalar(255, 0, 0));
   const std::string png = dir.file("halves.png");
   ASSERT_TRUE(cv::imwrite(png, bgr));
-  auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", png}});
+  auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", png}}, 30s);
   ASSERT_TRUE(load);
   ASSERT_EQ((*load)["class"], "CONTENT") << load->dump();
   json shown;
@@ -495,7 +495,8 @@ TEST(SimCalibrate, ImageContentOnTheCalibratedCornerMatchesTheTrueRig) {
   // The true rig: the scene's projector and surfaces.
   auto truth = sim::Scene::load(scene);
   ASSERT_TRUE(truth) << truth.error().message;
-  const auto& proj = truth->at(0).projectors.at(0);
+  const sim::SceneState state = truth->at(0);
+  const auto& proj = state.projectors.at(0);
   const cv::Size size(proj.spec.width, proj.spec.height);
   const Mat34 P = proj.model.projectionMatrix();
   const Mat3 Minv = P.leftCols<3>().inverse();
@@ -610,7 +611,8 @@ TEST(SimCalibrate, MeshContentOnTheCalibratedCornerMatchesTheTrueRig) {
   // nearest cube face.
   auto truth = sim::Scene::load(scene);
   ASSERT_TRUE(truth) << truth.error().message;
-  const auto& proj = truth->at(0).projectors.at(0);
+  const sim::SceneState state = truth->at(0);
+  const auto& proj = state.projectors.at(0);
   const cv::Size size(proj.spec.width, proj.spec.height);
   const Mat34 P = proj.model.projectionMatrix();
   const Mat3 Minv = P.leftCols<3>().inverse();
