@@ -85,29 +85,15 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
       const rig::RigProjector* p = rig_.projectorForOutput(e.name);
       if (p && p->pose_known && p->scale_known) o.projector = p->model();
       if (p && !o.plane) {
-        auto s = rig_surfaces_.find(p->name);
-        if (s == rig_surfaces_.end()) s = rig_surfaces_.find("");
-        if (s != rig_surfaces_.end()) {
-          o.surface =
-              std::shared_ptr<const geom::MeshIntersector>(s->second, &s->second->intersector);
+        if (auto surface = rigSurfaceFor(p->name)) {
+          o.surface = std::shared_ptr<const geom::MeshIntersector>(surface, &surface->intersector);
         }
       }
       outputs.push_back(std::move(o));
     }
-    // The viewer: a tracker's (status `viewer`), else [content] viewer, else the rig's.
-    std::optional<Vec3> eye;
-    json eye_source;
-    if (const json v = viewerJson(); v.is_object() && v["position"].is_array()) {
-      eye = Vec3(v["position"][0].get<double>(), v["position"][1].get<double>(),
-                 v["position"][2].get<double>());
-      eye_source = {{"source", "tracker"}, {"tracker", v.value("tracker", "")}};
-    } else if (const auto& c = config_.content_viewer) {
-      eye = Vec3((*c)[0], (*c)[1], (*c)[2]);
-      eye_source = {{"source", "config"}};
-    } else if (rig_.viewer.position) {
-      eye = *rig_.viewer.position;
-      eye_source = {{"source", "rig"}};
-    }
+    const auto viewer = viewerEye();
+    const std::optional<Vec3> eye = viewer ? std::optional<Vec3>(viewer->position) : std::nullopt;
+    const json eye_source = viewer ? viewer->source : json();
     server_->hold(client);
     compute_worker_->submit([this, client, req, file, outputs, eye, eye_source] {
       auto prepared = std::make_shared<tl::expected<PreparedMesh, MeshFailure>>(

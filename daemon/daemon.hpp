@@ -21,6 +21,7 @@
 #include "geometry/intersect.hpp"
 #include "keystone/keystone_solver.hpp"
 #include "keystone_runtime.hpp"
+#include "output_draw.hpp"
 #include "registry.hpp"
 #include "render/projective_mesh.hpp"
 #include "render/render_path.hpp"
@@ -128,15 +129,34 @@ class Daemon {
   void refreshOutputs(std::function<void(bool shown)> done = {});
   // What render::choosePath needs about an output, from the rig model and the viewer.
   render::SceneTraits sceneTraits(const std::string& output, bool mesh_content) const;
+  // daemon_outputs.cpp: one output's frame planned on the loop (nullopt: nothing to draw).
+  struct OutputDrawPolicy {
+    std::chrono::steady_clock::time_point now;
+    bool waited_for = false;  // a client waits for this frame
+    bool live = false;        // streamed content: statistics throttled
+  };
+  std::optional<OutputDraw> planOutput(DeviceEntry& e, const OutputDrawPolicy& policy);
   // rig_surfaces.cpp: the rig's surface meshes (read on the I/O worker), the viewer's
   // eye, and image content on a non-planar surface (kNotFound with the reason when the
   // rig or the viewer do not allow it).
+  struct RigSurfaceMesh {
+    geom::MeshIntersector intersector;
+    render::SurfaceMesh mesh;
+  };
+  struct ViewerEye {
+    Vec3 position = Vec3::Zero();
+    nlohmann::json source;  // {"source": "tracker" (with "tracker"), "config" or "rig"}
+  };
   void loadRigSurfaces();
-  std::optional<Vec3> viewerEye() const;
+  std::shared_ptr<const RigSurfaceMesh> rigSurfaceFor(const std::string& projector) const;
+  // A tracker's (status `viewer`), else the static one.
+  std::optional<ViewerEye> viewerEye() const;
+  // [content] viewer, else the rig model's.
+  std::optional<ViewerEye> staticEye() const;
   // `fixed_viewer`: content drawn for that world -> image matrix (3D content), shown by
   // the lookup warp with it whatever the viewer does since.
   Result<std::shared_ptr<const render::RenderSetup>> nonPlanarSetup(
-      const std::string& output, cv::Size mode, cv::Size content,
+      const std::string& output, const render::SceneTraits& traits, cv::Size mode, cv::Size content,
       const Mat34* fixed_viewer = nullptr);
   bool calibrating() const;
   // Marks `op_id` as the calibration operation using `devices` (commands_calibrate.cpp).
@@ -173,10 +193,6 @@ class Daemon {
   Settings settings_;
   std::unique_ptr<StateFile> settings_file_;
   rig::RigModel rig_;  // the state directory's rig.json: the only source of geometry
-  struct RigSurfaceMesh {
-    geom::MeshIntersector intersector;
-    render::SurfaceMesh mesh;
-  };
   // rig_'s surface meshes by projector name ("" for the unified mesh).
   std::map<std::string, std::shared_ptr<const RigSurfaceMesh>> rig_surfaces_;
   uint64_t rig_generation_ = 0;

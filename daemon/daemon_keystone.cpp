@@ -1,7 +1,6 @@
-// Auto keystone and what the outputs show (PROTOCOL.md: keystone, pattern,
-// content). Everything here runs on the loop thread; the keystone solve, the
-// six-position calibration of the virtual rig and frame rendering run on
-// compute_worker_ and post their results back.
+// Auto keystone (PROTOCOL.md: keystone). Everything here runs on the loop thread; the
+// keystone solve and the six-position calibration of the virtual rig run on
+// compute_worker_ and post their results back. What the outputs show: daemon_outputs.cpp.
 #include <cmath>
 #include <numbers>
 #include <sstream>
@@ -12,7 +11,6 @@
 #include "log.hpp"
 #include "output_draw.hpp"
 #include "request_args.hpp"
-#include "support/render_abi.hpp"
 
 namespace procam::daemon {
 
@@ -48,16 +46,6 @@ ProjectorModel projectorModel(const rig::RigProjector& p) {
   m.source = "rig model (" +
              (p.calibrated.method.empty() ? std::string("rig.json") : p.calibrated.method) + ")";
   return m;
-}
-
-std::optional<cv::Size> outputMode(const DeviceEntry& e) {
-  uint32_t w = 0, h = 0;
-  double hz = 0;
-  const auto& raw = e.device.raw();
-  if (raw.ops.output->get_mode(raw.self, &w, &h, &hz) != PROCAM_OK || w < 2 || h < 2) {
-    return std::nullopt;
-  }
-  return cv::Size(static_cast<int>(w), static_cast<int>(h));
 }
 
 }  // namespace
@@ -240,7 +228,7 @@ cv::Size Daemon::currentSourceSize() const {
   r.pattern = settings_.pattern;
   r.content = keystone_rt_.content;
   if (DeviceEntry* out = self->devices_.firstUsable(PROCAM_FAMILY_OUTPUT)) {
-    if (auto mode = outputMode(*out)) r.output_size = *mode;
+    if (auto mode = outputMode(out->device.raw())) r.output_size = *mode;
   }
   return sourceSize(r);
 }
@@ -331,7 +319,7 @@ json Daemon::keystoneJson() const {
     }
   }
   if (DeviceEntry* out = self->devices_.firstUsable(PROCAM_FAMILY_OUTPUT)) {
-    if (auto mode = outputMode(*out)) j["output_size"] = {mode->width, mode->height};
+    if (auto mode = outputMode(out->device.raw())) j["output_size"] = {mode->width, mode->height};
   }
   if (content.width > 0 && content.height > 0) {
     j["content_size"] = {content.width, content.height};
@@ -500,237 +488,6 @@ void Daemon::accelCalibrationStep(ClientId client, const proto::Request& req,
   json body = keystoneJson();
   body["accel_calibration"] = cal;
   replyTo(client, req, "KEYSTONE", body);
-}
-
-bool Daemon::calibrating() const {
-  // The calibrate operation shows its own pattern frames on the outputs.
-  for (const auto& [id, op] : operations_) {
-    if (op.kind == "calibrate") return true;
-  }
-  return false;
-}
-
-render::SceneTraits Daemon::sceneTraits(const std::string& output, bool mesh_content) const {
-  render::SceneTraits t;
-  const rig::RigProjector* p = rig_.projectorForOutput(output);
-  const bool meshed =
-      (p && rig_.surface.meshes.count(p->name)) || !rig_.surface.unified_mesh.empty();
-  t.surface = !rig_.surface.plane && meshed ? render::SurfaceKind::kNonPlanar
-                                            : render::SurfaceKind::kPlanar;
-  // Tracked: a tracker reports the viewer (the eye viewerEye() gives) or the rig names one.
-  if (!viewerJson().is_null() || !rig_.viewer.tracker.empty()) {
-    t.viewer = render::ViewerKind::kTracked;
-  } else if (config_.content_viewer || rig_.viewer.position) {
-    t.viewer = render::ViewerKind::kStatic;
-  }
-  t.content = mesh_content ? render::ContentKind::kMesh3d : render::ContentKind::kImage;
-  t.projectors = std::max<int>(1, static_cast<int>(devices_.count(PROCAM_FAMILY_OUTPUT)));
-  return t;
-}
-
-void Daemon::refreshOutputs(std::function<void(bool shown)> done) {
-  KeystoneRuntime& k = keystone_rt_;
-  if (done) k.frame_waiters.push_back(std::move(done));
-  if (k.rendering) {
-    k.render_again = true;  // after the frame in flight: the state changed since
-    return;
-  }
-  auto waiters = std::move(k.frame_waiters);
-  k.frame_waiters.clear();
-  if (calibrating()) {
-    for (auto& w : waiters) w(false);
-    return;
-  }
-  const auto now = std::chrono::steady_clock::now();
-  // Statistics cost a GPU read-back on GLES outputs: asked for at most every 200 ms, and
-  // once more after a burst of frames drawn without them.
-  constexpr auto kStatsPeriod = std::chrono::milliseconds(200);
-  bool stats_pending = false;
-  std::vector<OutputDraw> jobs;
-  std::optional<cv::Size> first_source;
-  for (auto& e : devices_.entries()) {
-    if (e.description.family != PROCAM_FAMILY_OUTPUT || !e.usable()) continue;
-    auto mode = outputMode(e);
-    if (!mode) continue;
-    FrameRequest r;
-    r.output_size = *mode;
-    r.pattern = settings_.pattern;
-    if (r.pattern != "off") {
-      const std::string key =
-          r.pattern + " " + std::to_string(mode->width) + "x" + std::to_string(mode->height);
-      auto& image = k.patterns[key];
-      if (!image) image = patternImage(r.pattern, *mode);
-      r.pattern_image = image;
-    }
-    r.content = k.content;
-    if (auto m = k.meshes.find(e.name); m != k.meshes.end()) r.mesh3d = m->second;
-    const MeshImage* mesh_image = nullptr;
-    if (auto m = k.mesh_images.find(e.name); m != k.mesh_images.end()) {
-      mesh_image = &m->second;
-      r.content = m->second.image;
-    }
-    r.homography = currentWarp(sourceSize(r));
-    if (!first_source) first_source = sourceSize(r);
-    auto plan = planFrame(r);
-    if (!plan) {
-      warn("output '" + e.name + "': " + plan.error().message);
-      continue;
-    }
-    std::string np_note;
-    std::optional<Mat34> viewer;
-    if (plan->source == "content" && !plan->mesh) {
-      // Image content on a non-planar surface: what the viewer should see, drawn by the
-      // two-pass path or the lookup warp; a keystone homography otherwise.
-      auto np = nonPlanarSetup(e.name, *mode, plan->image->size(),
-                               mesh_image ? &mesh_image->viewer : nullptr);
-      if (np) {
-        plan->setup = **np;
-        viewer = (*np)->viewer;
-      } else if (np.error().code != ErrorCode::kNotFound) {
-        np_note = "non-planar surface: " + np.error().message;
-      } else if (sceneTraits(e.name, false).surface == render::SurfaceKind::kNonPlanar) {
-        np_note = "non-planar surface, drawn by homography: " + np.error().message;
-      }
-    }
-    auto& st = k.output_state[e.name];
-    st.viewer = viewer;
-    const auto device = e.device.share();
-    OutputDraw job;
-    job.name = e.name;
-    job.device = device;
-    job.configure =
-        !st.setup || st.device.lock() != device || !render::sameSetup(*st.setup, plan->setup);
-    if (job.configure) st.setup = std::make_shared<const render::RenderSetup>(plan->setup);
-    st.device = device;
-    job.setup = st.setup;
-    std::shared_ptr<const void> content =
-        plan->image ? std::shared_ptr<const void>(plan->image) : plan->mesh;
-    const bool new_content = content != st.content;
-    if (new_content) {
-      st.content = content;  // held, so that a new content never reuses its address
-      ++st.version;
-    }
-    job.image = plan->image;
-    job.mesh = plan->mesh;
-    job.version = st.version;
-    if (!plugins::outputRenders(device->raw())) {
-      if (!st.fallback) st.fallback = std::make_shared<render::CpuRenderer>();
-      job.fallback = st.fallback;
-    } else {
-      st.fallback.reset();
-    }
-    // A client waiting for this frame, or new still content, gets its numbers at once.
-    const bool live = live_content_ && !live_content_->ended;
-    job.want_stats =
-        !waiters.empty() || (new_content && !live) || now - st.stats_time >= kStatsPeriod;
-    if (job.want_stats) {
-      st.stats_time = now;
-    } else {
-      stats_pending = true;
-    }
-    st.path = render::toString(plan->setup.path);
-    const auto chosen = render::choosePath(sceneTraits(e.name, plan->mesh != nullptr));
-    st.chosen = chosen ? render::toString(chosen->path) : std::string("none");
-    st.path_note.clear();
-    if (!chosen) {
-      st.path_note = chosen.error().message;
-    } else if (!np_note.empty()) {
-      st.path_note = np_note;
-    } else if (chosen->path != plan->setup.path && plan->source != "content") {
-      st.path_note = "patterns and blank frames are drawn 2D, by homography";
-    }
-    job.source = plan->source;
-    jobs.push_back(std::move(job));
-  }
-  if (stats_pending && k.stats_timer < 0) {
-    auto timer = loop_->addTimer(std::chrono::milliseconds(250), false, [this] {
-      keystone_rt_.stats_timer = -1;
-      refreshOutputs();
-    });
-    if (timer) k.stats_timer = *timer;
-  }
-  if (jobs.empty()) {
-    for (auto& w : waiters) w(false);
-    return;
-  }
-  // A changed source size changes the auto solution's content: solve again.
-  if (settings_.auto_keystone && k.estimate && first_source) {
-    if (first_source->width != k.estimate->content_width ||
-        first_source->height != k.estimate->content_height) {
-      requestSolve();
-    }
-  }
-  k.rendering = true;
-  compute_worker_->submit([this, jobs = std::move(jobs), waiters = std::move(waiters)]() mutable {
-    auto results = std::make_shared<std::vector<OutputDrawn>>();
-    for (const auto& job : jobs) results->push_back(drawOutput(job));
-    return [this, results, waiters = std::move(waiters)] {
-      KeystoneRuntime& k = keystone_rt_;
-      k.rendering = false;
-      bool shown = false, drawn = false;
-      for (const OutputDrawn& r : *results) {
-        auto st = k.output_state.find(r.name);
-        if (!r.ok) {
-          warn("output '" + r.name + "': " + r.error);
-          // Hand the setup over again next time: the output may not hold it.
-          if (st != k.output_state.end()) st->second.setup.reset();
-          if (closesDevice(r.rc)) device_manager_->report(r.name, r.rc, r.error);
-          continue;
-        }
-        shown = true;
-        drawn = drawn || r.drawn;
-        if (r.stats) k.shown[r.name] = {r.source, r.stats->lit_fraction, r.stats->mean_rgb};
-      }
-      if (drawn) ++k.frames;  // frames drawn, not statistics read again
-      for (auto& w : waiters) w(shown);
-      if (k.render_again) {
-        k.render_again = false;
-        refreshOutputs();
-      }
-    };
-  });
-}
-
-void Daemon::loadContentAtStart() {
-  if (settings_.content.empty()) return;
-  compute_worker_->submit([this, file = settings_.content] {
-    auto image = decodeContent(file);
-    return [this, file, image = std::move(image)] {
-      if (settings_.content != file) return;  // replaced meanwhile
-      if (!image) {
-        warn("saved content not shown: " + image.error().message);
-        return;
-      }
-      keystone_rt_.content = *image;
-      content_info_ = {(*image)->cols, (*image)->rows};
-      refreshOutputs();
-    };
-  });
-}
-
-json Daemon::outputsJson() const {
-  json list = json::array();
-  for (const auto& [name, st] : keystone_rt_.shown) {
-    json o = {{"name", name},
-              {"source", st.source},
-              {"lit_fraction", st.lit_fraction},
-              {"mean_rgb", {st.mean_rgb[0], st.mean_rgb[1], st.mean_rgb[2]}}};
-    if (auto it = keystone_rt_.output_state.find(name); it != keystone_rt_.output_state.end()) {
-      const auto& os = it->second;
-      o["path"] = os.path;
-      o["chosen_path"] = os.chosen;
-      if (!os.path_note.empty()) o["path_note"] = os.path_note;
-      o["renderer"] = os.fallback ? "daemon-cpu" : "output";
-      if (os.viewer) {
-        json v = json::array();
-        for (int r = 0; r < 3; ++r)
-          for (int c = 0; c < 4; ++c) v.push_back((*os.viewer)(r, c));
-        o["viewer_matrix"] = v;
-      }
-    }
-    list.push_back(std::move(o));
-  }
-  return {{"frames", keystone_rt_.frames}, {"shown", list}};
 }
 
 void Daemon::onRigChanged() {

@@ -99,4 +99,13 @@ OutputDrawn drawOutput(const OutputDraw& j) {
   return r;
 }
 
+std::optional<cv::Size> outputMode(const procam_device& raw) {
+  uint32_t w = 0, h = 0;
+  double hz = 0;
+  if (raw.ops.output->get_mode(raw.self, &w, &h, &hz) != PROCAM_OK || w < 2 || h < 2) {
+    return std::nullopt;
+  }
+  return cv::Size(static_cast<int>(w), static_cast<int>(h));
+}
+
 }  // namespace procam::daemon

@@ -45,4 +45,7 @@ struct OutputDrawn {
 // Runs on a worker; never throws.
 OutputDrawn drawOutput(const OutputDraw& job);
 
+// The output's mode (framebuffer size); nullopt when it does not answer or is below 2x2.
+std::optional<cv::Size> outputMode(const procam_device& output);
+
 }  // namespace procam::daemon

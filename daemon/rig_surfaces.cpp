@@ -61,43 +61,48 @@ void Daemon::loadRigSurfaces() {
   });
 }
 
-std::optional<Vec3> Daemon::viewerEye() const {
-  if (const nlohmann::json v = viewerJson(); v.is_object() && v["position"].is_array()) {
-    return Vec3(v["position"][0].get<double>(), v["position"][1].get<double>(),
-                v["position"][2].get<double>());
+std::optional<Daemon::ViewerEye> Daemon::staticEye() const {
+  if (const auto& c = config_.content_viewer) {
+    return ViewerEye{Vec3((*c)[0], (*c)[1], (*c)[2]), {{"source", "config"}}};
   }
-  if (const auto& c = config_.content_viewer) return Vec3((*c)[0], (*c)[1], (*c)[2]);
-  return rig_.viewer.position;
+  if (rig_.viewer.position) return ViewerEye{*rig_.viewer.position, {{"source", "rig"}}};
+  return std::nullopt;
+}
+
+std::optional<Daemon::ViewerEye> Daemon::viewerEye() const {
+  if (const nlohmann::json v = viewerJson(); v.is_object() && v["position"].is_array()) {
+    return ViewerEye{Vec3(v["position"][0].get<double>(), v["position"][1].get<double>(),
+                          v["position"][2].get<double>()),
+                     {{"source", "tracker"}, {"tracker", v.value("tracker", "")}}};
+  }
+  return staticEye();
+}
+
+std::shared_ptr<const Daemon::RigSurfaceMesh> Daemon::rigSurfaceFor(
+    const std::string& projector) const {
+  auto s = rig_surfaces_.find(projector);
+  if (s == rig_surfaces_.end()) s = rig_surfaces_.find("");  // the unified mesh
+  return s == rig_surfaces_.end() ? nullptr : s->second;
 }
 
 Result<std::shared_ptr<const render::RenderSetup>> Daemon::nonPlanarSetup(
-    const std::string& output, cv::Size mode, cv::Size content, const Mat34* fixed_viewer) {
-  const render::SceneTraits traits = sceneTraits(output, false);
-  if (traits.surface != render::SurfaceKind::kNonPlanar) {
-    return fail(ErrorCode::kNotFound, "the surface is planar");
-  }
+    const std::string& output, const render::SceneTraits& traits, cv::Size mode, cv::Size content,
+    const Mat34* fixed_viewer) {
   const rig::RigProjector* p = rig_.projectorForOutput(output);
   if (!p || !p->pose_known) return fail(ErrorCode::kNotFound, "the projector has no pose");
   if (p->width != mode.width || p->height != mode.height) {
     return fail(ErrorCode::kNotFound, "the output's mode differs from the calibrated projector's");
   }
-  auto surface = rig_surfaces_.find(p->name);
-  if (surface == rig_surfaces_.end()) surface = rig_surfaces_.find("");
-  if (surface == rig_surfaces_.end()) {
-    return fail(ErrorCode::kNotFound, "the surface mesh is not loaded");
-  }
+  const auto surface = rigSurfaceFor(p->name);
+  if (!surface) return fail(ErrorCode::kNotFound, "the surface mesh is not loaded");
   // The eye of the viewer kind the path is chosen for: a tracker's when tracked, else the
   // configured or the rig's sweet spot. Content drawn for a fixed matrix needs none.
   const bool tracked = traits.viewer == render::ViewerKind::kTracked && !fixed_viewer;
   std::optional<Vec3> eye;
   if (fixed_viewer) {
     eye = Vec3::Zero();
-  } else if (tracked) {
-    eye = viewerEye();
-  } else if (const auto& c = config_.content_viewer) {
-    eye = Vec3((*c)[0], (*c)[1], (*c)[2]);
-  } else {
-    eye = rig_.viewer.position;
+  } else if (auto e = tracked ? viewerEye() : staticEye()) {
+    eye = e->position;
   }
   if (!eye) {
     return fail(ErrorCode::kNotFound,
@@ -107,32 +112,30 @@ Result<std::shared_ptr<const render::RenderSetup>> Daemon::nonPlanarSetup(
   auto& st = keystone_rt_.output_state[output];
   const std::optional<Mat34> fixed =
       fixed_viewer ? std::optional<Mat34>(*fixed_viewer) : std::nullopt;
-  if (st.np_setup && st.np_surface == surface->second && st.np_eye == *eye &&
-      st.np_content == content && st.np_projector == P && st.np_tracked == tracked &&
-      st.np_fixed == fixed) {
+  if (st.np_setup && st.np_surface == surface && st.np_eye == *eye && st.np_content == content &&
+      st.np_projector == P && st.np_tracked == tracked && st.np_fixed == fixed) {
     return st.np_setup;
   }
-  auto V = fixed
-               ? Result<Mat34>(*fixed)
-               : render::viewerContentMatrix(surface->second->intersector, P, mode, *eye, content);
+  auto V = fixed ? Result<Mat34>(*fixed)
+                 : render::viewerContentMatrix(surface->intersector, P, mode, *eye, content);
   if (!V) return tl::unexpected(V.error());
   render::RenderSetup setup;
   setup.output_size = mode;
   setup.content_size = content;
   if (tracked) {
     setup.path = render::RenderPath::kTwoPassMesh;
-    setup.surface = surface->second->mesh;
+    setup.surface = surface->mesh;
     setup.projector = P;
     setup.viewer = *V;
   } else {
     setup.path = render::RenderPath::kLookupWarp;
-    auto grid = render::lookupGridForViewer(surface->second->intersector, P, mode, *V);
+    auto grid = render::lookupGridForViewer(surface->intersector, P, mode, *V);
     if (!grid) return tl::unexpected(grid.error());
     setup.lookup = std::move(*grid);
     setup.viewer = *V;  // reported in status; the grid is what is drawn
   }
   st.np_setup = std::make_shared<const render::RenderSetup>(std::move(setup));
-  st.np_surface = surface->second;
+  st.np_surface = surface;
   st.np_eye = *eye;
   st.np_content = content;
   st.np_projector = P;

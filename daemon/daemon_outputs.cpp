@@ -1,0 +1,253 @@
+// What the outputs show (PROTOCOL.md: pattern, content, status `outputs`). Planned on the
+// loop thread: per output the render path (render::choosePath over the rig model), its
+// setup and the content with its version; drawn by the outputs on compute_worker_
+// (output_draw.hpp), results posted back.
+#include "daemon.hpp"
+#include "log.hpp"
+#include "output_draw.hpp"
+#include "support/render_abi.hpp"
+
+namespace procam::daemon {
+
+using nlohmann::json;
+
+namespace {
+
+// Statistics cost a GPU read-back on GLES outputs: asked for at most this often while
+// frames change quickly, and once more after such a burst.
+constexpr auto kStatsPeriod = std::chrono::milliseconds(200);
+constexpr auto kStatsCatchUp = std::chrono::milliseconds(250);
+
+json rowMajor(const Mat34& m) {
+  json v = json::array();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) v.push_back(m(r, c));
+  return v;
+}
+
+}  // namespace
+
+bool Daemon::calibrating() const {
+  // The calibrate operation shows its own pattern frames on the outputs.
+  for (const auto& [id, op] : operations_) {
+    if (op.kind == "calibrate") return true;
+  }
+  return false;
+}
+
+render::SceneTraits Daemon::sceneTraits(const std::string& output, bool mesh_content) const {
+  render::SceneTraits t;
+  const rig::RigProjector* p = rig_.projectorForOutput(output);
+  const bool meshed =
+      (p && rig_.surface.meshes.count(p->name)) || !rig_.surface.unified_mesh.empty();
+  t.surface = !rig_.surface.plane && meshed ? render::SurfaceKind::kNonPlanar
+                                            : render::SurfaceKind::kPlanar;
+  // Tracked: a tracker reports the viewer (the eye viewerEye() gives) or the rig names one.
+  if (!viewerJson().is_null() || !rig_.viewer.tracker.empty()) {
+    t.viewer = render::ViewerKind::kTracked;
+  } else if (staticEye()) {
+    t.viewer = render::ViewerKind::kStatic;
+  }
+  t.content = mesh_content ? render::ContentKind::kMesh3d : render::ContentKind::kImage;
+  t.projectors = std::max<int>(1, static_cast<int>(devices_.count(PROCAM_FAMILY_OUTPUT)));
+  return t;
+}
+
+std::optional<OutputDraw> Daemon::planOutput(DeviceEntry& e, const OutputDrawPolicy& policy) {
+  KeystoneRuntime& k = keystone_rt_;
+  auto mode = outputMode(e.device.raw());
+  if (!mode) return std::nullopt;
+  FrameRequest r;
+  r.output_size = *mode;
+  r.pattern = settings_.pattern;
+  if (r.pattern != "off") {
+    const std::string key =
+        r.pattern + " " + std::to_string(mode->width) + "x" + std::to_string(mode->height);
+    auto& image = k.patterns[key];
+    if (!image) image = patternImage(r.pattern, *mode);
+    r.pattern_image = image;
+  }
+  r.content = k.content;
+  if (auto m = k.meshes.find(e.name); m != k.meshes.end()) r.mesh3d = m->second;
+  const MeshImage* mesh_image = nullptr;
+  if (auto m = k.mesh_images.find(e.name); m != k.mesh_images.end()) {
+    mesh_image = &m->second;
+    r.content = m->second.image;
+  }
+  r.homography = currentWarp(sourceSize(r));
+  auto plan = planFrame(r);
+  if (!plan) {
+    warn("output '" + e.name + "': " + plan.error().message);
+    return std::nullopt;
+  }
+  const render::SceneTraits traits = sceneTraits(e.name, plan->mesh != nullptr);
+  auto& st = k.output_state[e.name];
+  st.viewer.reset();
+  std::string np_note;
+  if (plan->source == "content" && !plan->mesh &&
+      traits.surface == render::SurfaceKind::kNonPlanar) {
+    // Image content on a non-planar surface: what the viewer should see, drawn by the
+    // two-pass path or the lookup warp; a keystone homography when the rig or the viewer
+    // do not allow it.
+    auto np = nonPlanarSetup(e.name, traits, *mode, plan->image->size(),
+                             mesh_image ? &mesh_image->viewer : nullptr);
+    if (np) {
+      plan->setup = **np;
+      st.viewer = (*np)->viewer;
+    } else {
+      np_note = "non-planar surface, drawn by homography: " + np.error().message;
+    }
+  }
+  const auto device = e.device.share();
+  OutputDraw job;
+  job.name = e.name;
+  job.device = device;
+  job.configure =
+      !st.setup || st.device.lock() != device || !render::sameSetup(*st.setup, plan->setup);
+  if (job.configure) st.setup = std::make_shared<const render::RenderSetup>(plan->setup);
+  st.device = device;
+  job.setup = st.setup;
+  std::shared_ptr<const void> content =
+      plan->image ? std::shared_ptr<const void>(plan->image) : plan->mesh;
+  const bool new_content = content != st.content;
+  if (new_content) {
+    st.content = content;  // held, so that a new content never reuses its address
+    ++st.version;
+  }
+  job.image = plan->image;
+  job.mesh = plan->mesh;
+  job.version = st.version;
+  if (!plugins::outputRenders(device->raw())) {
+    if (!st.fallback) st.fallback = std::make_shared<render::CpuRenderer>();
+    job.fallback = st.fallback;
+  } else {
+    st.fallback.reset();
+  }
+  // A client waiting for this frame, or new still content, gets its numbers at once.
+  job.want_stats = policy.waited_for || (new_content && !policy.live) ||
+                   policy.now - st.stats_time >= kStatsPeriod;
+  if (job.want_stats) st.stats_time = policy.now;
+  st.path = render::toString(plan->setup.path);
+  const auto chosen = render::choosePath(traits);
+  st.chosen = chosen ? render::toString(chosen->path) : std::string("none");
+  st.path_note.clear();
+  if (!chosen) {
+    st.path_note = chosen.error().message;
+  } else if (!np_note.empty()) {
+    st.path_note = np_note;
+  } else if (chosen->path != plan->setup.path && plan->source != "content") {
+    st.path_note = "patterns and blank frames are drawn 2D, by homography";
+  }
+  job.source = plan->source;
+  return job;
+}
+
+void Daemon::refreshOutputs(std::function<void(bool shown)> done) {
+  KeystoneRuntime& k = keystone_rt_;
+  if (done) k.frame_waiters.push_back(std::move(done));
+  if (k.rendering) {
+    k.render_again = true;  // after the frame in flight: the state changed since
+    return;
+  }
+  auto waiters = std::move(k.frame_waiters);
+  k.frame_waiters.clear();
+  if (calibrating()) {
+    for (auto& w : waiters) w(false);
+    return;
+  }
+  const OutputDrawPolicy policy{std::chrono::steady_clock::now(), !waiters.empty(),
+                                live_content_ && !live_content_->ended};
+  std::vector<OutputDraw> jobs;
+  for (auto& e : devices_.entries()) {
+    if (e.description.family != PROCAM_FAMILY_OUTPUT || !e.usable()) continue;
+    if (auto job = planOutput(e, policy)) jobs.push_back(std::move(*job));
+  }
+  const bool stats_pending =
+      std::any_of(jobs.begin(), jobs.end(), [](const OutputDraw& j) { return !j.want_stats; });
+  if (stats_pending && k.stats_timer < 0) {
+    auto timer = loop_->addTimer(kStatsCatchUp, false, [this] {
+      keystone_rt_.stats_timer = -1;
+      refreshOutputs();
+    });
+    if (timer) k.stats_timer = *timer;
+  }
+  if (jobs.empty()) {
+    for (auto& w : waiters) w(false);
+    return;
+  }
+  // A changed source size changes the auto solution's content: solve again.
+  if (settings_.auto_keystone && k.estimate) {
+    const cv::Size s = currentSourceSize();
+    if (s.width != k.estimate->content_width || s.height != k.estimate->content_height) {
+      requestSolve();
+    }
+  }
+  k.rendering = true;
+  compute_worker_->submit([this, jobs = std::move(jobs), waiters = std::move(waiters)]() mutable {
+    auto results = std::make_shared<std::vector<OutputDrawn>>();
+    for (const auto& job : jobs) results->push_back(drawOutput(job));
+    return [this, results, waiters = std::move(waiters)] {
+      KeystoneRuntime& k = keystone_rt_;
+      k.rendering = false;
+      bool shown = false, drawn = false;
+      for (const OutputDrawn& r : *results) {
+        auto st = k.output_state.find(r.name);
+        if (!r.ok) {
+          warn("output '" + r.name + "': " + r.error);
+          // Hand the setup over again next time: the output may not hold it.
+          if (st != k.output_state.end()) st->second.setup.reset();
+          if (closesDevice(r.rc)) device_manager_->report(r.name, r.rc, r.error);
+          continue;
+        }
+        shown = true;
+        drawn = drawn || r.drawn;
+        if (r.stats) k.shown[r.name] = {r.source, r.stats->lit_fraction, r.stats->mean_rgb};
+      }
+      if (drawn) ++k.frames;  // frames drawn, not statistics read again
+      for (auto& w : waiters) w(shown);
+      if (k.render_again) {
+        k.render_again = false;
+        refreshOutputs();
+      }
+    };
+  });
+}
+
+void Daemon::loadContentAtStart() {
+  if (settings_.content.empty()) return;
+  compute_worker_->submit([this, file = settings_.content] {
+    auto image = decodeContent(file);
+    return [this, file, image = std::move(image)] {
+      if (settings_.content != file) return;  // replaced meanwhile
+      if (!image) {
+        warn("saved content not shown: " + image.error().message);
+        return;
+      }
+      keystone_rt_.content = *image;
+      content_info_ = {(*image)->cols, (*image)->rows};
+      refreshOutputs();
+    };
+  });
+}
+
+json Daemon::outputsJson() const {
+  json list = json::array();
+  for (const auto& [name, st] : keystone_rt_.shown) {
+    json o = {{"name", name},
+              {"source", st.source},
+              {"lit_fraction", st.lit_fraction},
+              {"mean_rgb", {st.mean_rgb[0], st.mean_rgb[1], st.mean_rgb[2]}}};
+    if (auto it = keystone_rt_.output_state.find(name); it != keystone_rt_.output_state.end()) {
+      const auto& os = it->second;
+      o["path"] = os.path;
+      o["chosen_path"] = os.chosen;
+      if (!os.path_note.empty()) o["path_note"] = os.path_note;
+      o["renderer"] = os.fallback ? "daemon-cpu" : "output";
+      if (os.viewer) o["viewer_matrix"] = rowMajor(*os.viewer);
+    }
+    list.push_back(std::move(o));
+  }
+  return {{"frames", keystone_rt_.frames}, {"shown", list}};
+}
+
+}  // namespace procam::daemon
