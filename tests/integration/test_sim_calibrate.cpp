@@ -15,6 +15,7 @@
 #include "content/mesh_content.hpp"
 #include "content/mesh_placement.hpp"
 #include "daemon_harness.hpp"
+#include "mesh_ray_cast.hpp"
 #include "rig/rig_model.hpp"
 #include "sim/truth_rig.hpp"
 #include "truth_rig_file.hpp"
@@ -439,6 +440,88 @@ TEST(SimCalibrate, OneCameraIsUnavailable) {
   EXPECT_NE((*r)["message"].get<std::string>().find("two"), std::string::npos);
 }
 
+// The calibrated-corner tests: corner_stereo at half resolution, the viewer configured
+// at kCornerEye, the cameras handed over (as an offline camera calibration gives them).
+const Vec3 kCornerEye(-1.6, 0.4, 1.6);
+
+DaemonProcess::Launch cornerWithViewer(const TempDir& dir, const std::string& scene) {
+  dir.write("procamd.toml",
+            "[sim]\nscene = \"" + scene + "\"\n[content]\nviewer = [-1.6, 0.4, 1.6]\n");
+  return DaemonProcess::Launch{{"--config", dir.file("procamd.toml"), "--rig",
+                                truthRigFile(dir, scene, TruthParts::kCamerasOnly)},
+                               {},
+                               -1,
+                               true};
+}
+
+// Runs calibrate to a successful final reply (fatal test failures otherwise).
+void calibrateToTheEnd(Connection& c, const DaemonProcess& d) {
+  auto started = c.call(calibrateRequest(1));
+  ASSERT_TRUE(started);
+  ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
+  CalibrateRun run;
+  follow(c, 1, run);
+  ASSERT_TRUE(run.reply) << d.log();
+  ASSERT_EQ((*run.reply)["class"], "CALIBRATE") << run.reply->dump();
+}
+
+// The first output's status entry once it shows content through the lookup warp.
+std::optional<json> shownByLookupWarp(Connection& c) {
+  json shown;
+  const bool ok = eventually(
+      [&] {
+        auto s = c.call({{"cmd", "status"}});
+        if (!s || (*s)["outputs"]["shown"].empty()) return false;
+        shown = (*s)["outputs"]["shown"][0];
+        return shown["source"] == "content" && shown.value("path", "") == "lookup-warp" &&
+               shown["lit_fraction"].get<double>() > 0;
+      },
+      20s);
+  if (!ok) {
+    ADD_FAILURE() << "no content through the lookup warp: " << shown.dump();
+    return std::nullopt;
+  }
+  return shown;
+}
+
+Mat34 rowMajor34(const json& j) {
+  Mat34 m;
+  for (int i = 0; i < 12; ++i) m(i / 4, i % 4) = j[i].get<double>();
+  return m;
+}
+
+// `label(surface point)` for every pixel of the scene's TRUE projector whose ray meets a
+// TRUE surface (0 elsewhere), as a CV_16S image of the projector's size.
+template <class Label>
+cv::Mat labelTrueSurface(const std::string& scene, Label label) {
+  auto truth = sim::Scene::load(scene);
+  EXPECT_TRUE(truth) << truth.error().message;
+  if (!truth) return {};
+  const sim::SceneState state = truth->at(0);
+  const auto& proj = state.projectors.at(0);
+  const Mat34 P = proj.model.projectionMatrix();
+  const Mat3 Minv = P.leftCols<3>().inverse();
+  const Vec3 C = -Minv * P.col(3);
+  cv::Mat labels(proj.spec.height, proj.spec.width, CV_16S, cv::Scalar(0));
+  for (int y = 0; y < labels.rows; ++y) {
+    for (int x = 0; x < labels.cols; ++x) {
+      const auto hit = truth->world().intersect({C, (Minv * Vec3(x, y, 1)).normalized()});
+      if (hit) labels.at<int16_t>(y, x) = static_cast<int16_t>(label(hit->hit.point));
+    }
+  }
+  return labels;
+}
+
+// Fraction of pixels within 2 px of a change of label: where two renderings of the same
+// geometry may legitimately differ.
+double edgeBand(const cv::Mat& labels) {
+  cv::Mat lo, hi;
+  const cv::Mat k = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(5, 5));
+  cv::erode(labels, lo, k);
+  cv::dilate(labels, hi, k);
+  return cv::countNonZero(lo != hi) / double(labels.total());
+}
+
 // End to end with nothing taken from truth but the cameras (calibrated beforehand, as
 // procam-calibrate gives them): calibrate finds the projector and the two walls, image
 // content is then drawn for the configured viewer by the lookup warp ([Raskar02] §4.1.5),
@@ -451,22 +534,10 @@ TEST(SimCalibrate, OneCameraIsUnavailable) {
 TEST(SimCalibrate, ImageContentOnTheCalibratedCornerMatchesTheTrueRig) {
   TempDir dir;
   const std::string scene = sceneFile(dir);
-  dir.write("procamd.toml",
-            "[sim]\nscene = \"" + scene + "\"\n[content]\nviewer = [-1.6, 0.4, 1.6]\n");
-  DaemonProcess d(dir, DaemonProcess::Launch{{"--config", dir.file("procamd.toml"), "--rig",
-                                              truthRigFile(dir, scene, TruthParts::kCamerasOnly)},
-                                             {},
-                                             -1,
-                                             true});
+  DaemonProcess d(dir, cornerWithViewer(dir, scene));
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
-  auto started = c.call(calibrateRequest(1));
-  ASSERT_TRUE(started);
-  ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
-  CalibrateRun run;
-  follow(c, 1, run);
-  ASSERT_TRUE(run.reply) << d.log();
-  ASSERT_EQ((*run.reply)["class"], "CALIBRATE") << run.reply->dump();
+  ASSERT_NO_FATAL_FAILURE(calibrateToTheEnd(c, d));
 
   // Content: left half red, right half blue.
   constexpr int kW = 320, kH = 200;
@@ -477,49 +548,25 @@ TEST(SimCalibrate, ImageContentOnTheCalibratedCornerMatchesTheTrueRig) {
   auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", png}}, 30s);
   ASSERT_TRUE(load);
   ASSERT_EQ((*load)["class"], "CONTENT") << load->dump();
-  json shown;
-  ASSERT_TRUE(eventually(
-      [&] {
-        auto s = c.call({{"cmd", "status"}});
-        if (!s || (*s)["outputs"]["shown"].empty()) return false;
-        shown = (*s)["outputs"]["shown"][0];
-        return shown["source"] == "content" && shown.value("path", "") == "lookup-warp";
-      },
-      10s))
-      << shown.dump();
+  const auto shown_now = shownByLookupWarp(c);
+  ASSERT_TRUE(shown_now);
+  const json shown = *shown_now;
   EXPECT_EQ(shown["chosen_path"], "lookup-warp");
   ASSERT_EQ(shown["viewer_matrix"].size(), 12u) << shown.dump();
-  Mat34 V;
-  for (int i = 0; i < 12; ++i) V(i / 4, i % 4) = shown["viewer_matrix"][i].get<double>();
+  const Mat34 V = rowMajor34(shown["viewer_matrix"]);
 
-  // The true rig: the scene's projector and surfaces.
-  auto truth = sim::Scene::load(scene);
-  ASSERT_TRUE(truth) << truth.error().message;
-  const sim::SceneState state = truth->at(0);
-  const auto& proj = state.projectors.at(0);
-  const cv::Size size(proj.spec.width, proj.spec.height);
-  const Mat34 P = proj.model.projectionMatrix();
-  const Mat3 Minv = P.leftCols<3>().inverse();
-  const Vec3 C = -Minv * P.col(3);
-  cv::Mat cls(size, CV_8U, cv::Scalar(0));  // 0 dark, 1 red, 2 blue
-  for (int y = 0; y < size.height; ++y) {
-    for (int x = 0; x < size.width; ++x) {
-      const auto hit = truth->world().intersect({C, (Minv * Vec3(x, y, 1)).normalized()});
-      if (!hit) continue;
-      const Vec3 q = V * hit->hit.point.homogeneous();
-      if (q.z() <= 0) continue;
-      const double u = q.x() / q.z(), v = q.y() / q.z();
-      if (u < -0.5 || u >= kW - 0.5 || v < -0.5 || v >= kH - 0.5) continue;
-      cls.at<uint8_t>(y, x) = u < kW / 2 - 0.5 ? 1 : 2;
-    }
-  }
-  const double n = double(size.area());
+  // The true rig: 1 red, 2 blue, 0 dark.
+  const cv::Mat cls = labelTrueSurface(scene, [&](const Vec3& point) {
+    const Vec3 q = V * point.homogeneous();
+    if (q.z() <= 0) return 0;
+    const double u = q.x() / q.z(), v = q.y() / q.z();
+    if (u < -0.5 || u >= kW - 0.5 || v < -0.5 || v >= kH - 0.5) return 0;
+    return u < kW / 2 - 0.5 ? 1 : 2;
+  });
+  ASSERT_FALSE(cls.empty());
+  const double n = double(cls.total());
   const double red = cv::countNonZero(cls == 1) / n, blue = cv::countNonZero(cls == 2) / n;
-  cv::Mat lo, hi;
-  const cv::Mat k = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(5, 5));
-  cv::erode(cls, lo, k);
-  cv::dilate(cls, hi, k);
-  const double band = cv::countNonZero(lo != hi) / n;
+  const double band = edgeBand(cls);
   const double lit = shown["lit_fraction"].get<double>();
   const double r = shown["mean_rgb"][0].get<double>(), b = shown["mean_rgb"][2].get<double>();
   std::printf(
@@ -546,27 +593,14 @@ TEST(SimCalibrate, ImageContentOnTheCalibratedCornerMatchesTheTrueRig) {
 TEST(SimCalibrate, MeshContentOnTheCalibratedCornerMatchesTheTrueRig) {
   TempDir dir;
   const std::string scene = sceneFile(dir);
-  const Vec3 eye(-1.6, 0.4, 1.6);
-  dir.write("procamd.toml",
-            "[sim]\nscene = \"" + scene + "\"\n[content]\nviewer = [-1.6, 0.4, 1.6]\n");
   dir.write("cube.obj",
             "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\n"
             "v -1 1 1\nf 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 4 7 3\n"
             "f 4 8 7\nf 1 5 8\nf 1 8 4\nf 2 3 7\nf 2 7 6\n");
-  DaemonProcess d(dir, DaemonProcess::Launch{{"--config", dir.file("procamd.toml"), "--rig",
-                                              truthRigFile(dir, scene, TruthParts::kCamerasOnly)},
-                                             {},
-                                             -1,
-                                             true});
+  DaemonProcess d(dir, cornerWithViewer(dir, scene));
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
-  auto started = c.call(calibrateRequest(1));
-  ASSERT_TRUE(started);
-  ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
-  CalibrateRun run;
-  follow(c, 1, run);
-  ASSERT_TRUE(run.reply) << d.log();
-  ASSERT_EQ((*run.reply)["class"], "CALIBRATE") << run.reply->dump();
+  ASSERT_NO_FATAL_FAILURE(calibrateToTheEnd(c, d));
   std::optional<json> load;
   ASSERT_TRUE(eventually(
       [&] {
@@ -578,17 +612,9 @@ TEST(SimCalibrate, MeshContentOnTheCalibratedCornerMatchesTheTrueRig) {
       << (load ? load->dump() : "no reply");
   const json placement = (*load)["content"]["mesh"]["placement"]["proj"];
   ASSERT_TRUE(placement.is_object()) << load->dump();
-  json shown;
-  ASSERT_TRUE(eventually(
-      [&] {
-        auto st = c.call({{"cmd", "status"}});
-        if (!st || (*st)["outputs"]["shown"].empty()) return false;
-        shown = (*st)["outputs"]["shown"][0];
-        return shown["source"] == "content" && shown.value("path", "") == "lookup-warp" &&
-               shown["lit_fraction"].get<double>() > 0;
-      },
-      20s))
-      << shown.dump();
+  const auto shown_now = shownByLookupWarp(c);
+  ASSERT_TRUE(shown_now);
+  const json shown = *shown_now;
 
   // The placement the daemon made, from what it reports (placement is the daemon's
   // choice, not a fact of the rig): the plane and the viewer's content image.
@@ -599,66 +625,31 @@ TEST(SimCalibrate, MeshContentOnTheCalibratedCornerMatchesTheTrueRig) {
   };
   ASSERT_EQ(placement["viewer_matrix"].size(), 12u) << placement.dump();
   content::PlanarView view;
-  for (int i = 0; i < 12; ++i) view.projector(i / 4, i % 4) = placement["viewer_matrix"][i];
+  view.projector = rowMajor34(placement["viewer_matrix"]);
   view.size = {placement["size"][0].get<int>(), placement["size"][1].get<int>()};
   view.plane_point = vec(placement["plane_point"]);
   view.plane_normal = vec(placement["plane_normal"]);
-  view.eye = eye;
+  view.eye = kCornerEye;
   auto placed = content::placeMeshContent(*cube, view);
   ASSERT_TRUE(placed) << placed.error().message;
 
   // The true rig: each projector pixel's wall point, the viewer's ray through it, the
-  // nearest cube face.
-  auto truth = sim::Scene::load(scene);
-  ASSERT_TRUE(truth) << truth.error().message;
-  const sim::SceneState state = truth->at(0);
-  const auto& proj = state.projectors.at(0);
-  const cv::Size size(proj.spec.width, proj.spec.height);
-  const Mat34 P = proj.model.projectionMatrix();
-  const Mat3 Minv = P.leftCols<3>().inverse();
-  const Vec3 C = -Minv * P.col(3);
-  const keystone::DisplayRect& S = placed->S;
-  const Vec3 light = (-0.3 * S.u + 0.5 * S.v + 0.8 * S.u.cross(S.v)).normalized();
-  const auto& m = placed->mesh;
-  cv::Mat face(size, CV_32S, cv::Scalar(-1));
+  // nearest cube face (label face + 1), Lambert grey.
+  const cv::Mat faces = labelTrueSurface(scene, [&](const Vec3& point) {
+    return nearestFace(placed->mesh, kCornerEye, point - kCornerEye) + 1;
+  });
+  ASSERT_FALSE(faces.empty());
+  const double n = double(faces.total());
   double lit_true = 0, grey_true = 0;
-  for (int y = 0; y < size.height; ++y) {
-    for (int x = 0; x < size.width; ++x) {
-      const auto hit = truth->world().intersect({C, (Minv * Vec3(x, y, 1)).normalized()});
-      if (!hit) continue;
-      const Vec3 D = hit->hit.point - eye;
-      double best = INFINITY;
-      for (size_t t = 0; t < m.triangles.size(); ++t) {
-        const Vec3 &a = m.vertices[m.triangles[t][0]], &b = m.vertices[m.triangles[t][1]],
-                   &cc = m.vertices[m.triangles[t][2]];
-        const Vec3 e1 = b - a, e2 = cc - a, p = D.cross(e2);
-        const double det = e1.dot(p);
-        if (std::abs(det) < 1e-15) continue;
-        const Vec3 s = eye - a, q = s.cross(e1);
-        const double beta = s.dot(p) / det, gamma = D.dot(q) / det, l = e2.dot(q) / det;
-        if (beta < 0 || gamma < 0 || beta + gamma > 1 || l <= 0 || l >= best) continue;
-        best = l;
-        face.at<int>(y, x) = static_cast<int>(t);
-      }
-      if (face.at<int>(y, x) < 0) continue;
-      const auto& tri = m.triangles[face.at<int>(y, x)];
-      const Vec3 normal = (m.vertices[tri[1]] - m.vertices[tri[0]])
-                              .cross(m.vertices[tri[2]] - m.vertices[tri[0]])
-                              .normalized();
-      lit_true += 1;
-      grey_true +=
-          255 * (content::kMeshAmbient + (1 - content::kMeshAmbient) * std::abs(normal.dot(light)));
+  for (int y = 0; y < faces.rows; ++y) {
+    for (int x = 0; x < faces.cols; ++x) {
+      const int face = faces.at<int16_t>(y, x) - 1;
+      if (face < 0) continue;
+      lit_true += 1 / n;
+      grey_true += lambertGrey(*placed, face) / n;
     }
   }
-  const double n = double(size.area());
-  lit_true /= n;
-  grey_true /= n;
-  cv::Mat ids, lo, hi;
-  face.convertTo(ids, CV_16S);
-  const cv::Mat k = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(5, 5));
-  cv::erode(ids, lo, k);
-  cv::dilate(ids, hi, k);
-  const double band = cv::countNonZero(lo != hi) / n;
+  const double band = edgeBand(faces);
   const double lit = shown["lit_fraction"].get<double>();
   std::printf(
       "[ figures  ] cube on the calibrated corner (lookup warp): lit %.5f (true rig %.5f), "

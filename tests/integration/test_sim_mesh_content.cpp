@@ -13,6 +13,7 @@
 
 #include "content/mesh_placement.hpp"
 #include "daemon_harness.hpp"
+#include "mesh_ray_cast.hpp"
 #include "sim/scene_library.hpp"
 #include "truth_rig_file.hpp"
 
@@ -61,36 +62,16 @@ Expected rayCast(const content::PlacedMesh& placed, const Mat34& P, cv::Size siz
   const Vec3 C = -Minv * P.col(3);
   const keystone::DisplayRect& S = placed.S;
   const Vec3 n = S.u.cross(S.v);
-  const Vec3 light = (-0.3 * S.u + 0.5 * S.v + 0.8 * n).normalized();
-  const auto& m = placed.mesh;
   cv::Mat face(size, CV_32S, cv::Scalar(-1));
   Expected e;
   for (int y = 0; y < size.height; ++y) {
     for (int x = 0; x < size.width; ++x) {
       const Vec3 d = Minv * Vec3(x, y, 1);
       const Vec3 wall = C + (n.dot(S.corner - C) / n.dot(d)) * d;
-      const Vec3 D = wall - eye;
-      double best = INFINITY;
-      for (size_t t = 0; t < m.triangles.size(); ++t) {
-        const Vec3 &a = m.vertices[m.triangles[t][0]], &b = m.vertices[m.triangles[t][1]],
-                   &c = m.vertices[m.triangles[t][2]];
-        const Vec3 e1 = b - a, e2 = c - a, p = D.cross(e2);
-        const double det = e1.dot(p);
-        if (std::abs(det) < 1e-15) continue;
-        const Vec3 s = eye - a, q = s.cross(e1);
-        const double beta = s.dot(p) / det, gamma = D.dot(q) / det, l = e2.dot(q) / det;
-        if (beta < 0 || gamma < 0 || beta + gamma > 1 || l <= 0 || l >= best) continue;
-        best = l;
-        face.at<int>(y, x) = static_cast<int>(t);
-      }
+      face.at<int>(y, x) = nearestFace(placed.mesh, eye, wall - eye);
       if (face.at<int>(y, x) < 0) continue;
-      const auto& tri = m.triangles[face.at<int>(y, x)];
-      const Vec3 normal = (m.vertices[tri[1]] - m.vertices[tri[0]])
-                              .cross(m.vertices[tri[2]] - m.vertices[tri[0]])
-                              .normalized();
       e.lit += 1;
-      e.mean +=
-          255 * (content::kMeshAmbient + (1 - content::kMeshAmbient) * std::abs(normal.dot(light)));
+      e.mean += lambertGrey(placed, face.at<int>(y, x));
     }
   }
   // Pixels whose right or lower neighbour shows another face (or none): where two
