@@ -123,11 +123,15 @@ std::optional<OutputDraw> Daemon::planOutput(DeviceEntry& e, const OutputDrawPol
   } else {
     st.fallback.reset();
   }
-  // A client waiting for this frame, or new still content, gets its numbers at once.
-  job.want_stats = policy.waited_for || (new_content && !policy.live) ||
+  // A client waiting for this frame, new still content or a new render path gets its
+  // numbers at once.
+  const std::string path = render::toString(plan->setup.path);
+  job.want_stats = policy.waited_for || (new_content && !policy.live) || path != st.path ||
                    policy.now - st.stats_time >= kStatsPeriod;
   if (job.want_stats) st.stats_time = policy.now;
-  st.path = render::toString(plan->setup.path);
+  st.path = path;
+  job.path = path;
+  job.viewer = st.viewer;
   const auto chosen = render::choosePath(traits);
   st.chosen = chosen ? render::toString(chosen->path) : std::string("none");
   st.path_note.clear();
@@ -201,7 +205,9 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done) {
         }
         shown = true;
         drawn = drawn || r.drawn;
-        if (r.stats) k.shown[r.name] = {r.source, r.stats->lit_fraction, r.stats->mean_rgb};
+        if (r.stats) {
+          k.shown[r.name] = {r.source, r.stats->lit_fraction, r.stats->mean_rgb, r.path, r.viewer};
+        }
       }
       if (drawn) ++k.frames;  // frames drawn, not statistics read again
       for (auto& w : waiters) w(shown);
@@ -237,13 +243,15 @@ json Daemon::outputsJson() const {
               {"source", st.source},
               {"lit_fraction", st.lit_fraction},
               {"mean_rgb", {st.mean_rgb[0], st.mean_rgb[1], st.mean_rgb[2]}}};
+    // The path and viewer of the frame the statistics describe; chosen path, note and
+    // renderer of the latest plan.
+    if (!st.path.empty()) o["path"] = st.path;
+    if (st.viewer) o["viewer_matrix"] = rowMajor(*st.viewer);
     if (auto it = keystone_rt_.output_state.find(name); it != keystone_rt_.output_state.end()) {
       const auto& os = it->second;
-      o["path"] = os.path;
       o["chosen_path"] = os.chosen;
       if (!os.path_note.empty()) o["path_note"] = os.path_note;
       o["renderer"] = os.fallback ? "daemon-cpu" : "output";
-      if (os.viewer) o["viewer_matrix"] = rowMajor(*os.viewer);
     }
     list.push_back(std::move(o));
   }

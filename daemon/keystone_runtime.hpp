@@ -47,7 +47,7 @@ struct KeystoneRuntime {
     std::shared_ptr<const void> content;               // what `version` numbers
     uint64_t version = 0;
     std::shared_ptr<render::CpuRenderer> fallback;     // outputs that do not render
-    std::string path;                                  // render path drawn
+    std::string path;                                  // render path of the latest plan
     std::string chosen;                                // render::choosePath's answer
     std::string path_note;                             // why they differ, if they do
     std::chrono::steady_clock::time_point stats_time;  // statistics last asked for

@@ -57,6 +57,8 @@ OutputDrawn drawOutput(const OutputDraw& j) {
   OutputDrawn r;
   r.name = j.name;
   r.source = j.source;
+  r.path = j.path;
+  r.viewer = j.viewer;
   try {
     if (!j.device || !j.device->valid() || !j.setup) {
       r.error = "no device or setup";

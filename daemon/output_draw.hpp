@@ -28,12 +28,16 @@ struct OutputDraw {
   uint64_t version = 0;                             // of the content
   bool want_stats = false;
   std::string source;                             // FrameStats::source of this frame
+  std::string path;                               // render::toString of setup->path
+  std::optional<Mat34> viewer;                    // world -> content pixels, if any
   std::shared_ptr<render::CpuRenderer> fallback;  // set: the output does not render itself
 };
 
 struct OutputDrawn {
   std::string name;
   std::string source;
+  std::string path;
+  std::optional<Mat34> viewer;
   bool ok = false;
   bool drawn = false;       // a new frame is shown
   bool configured = false;  // the setup was handed over and taken

@@ -112,7 +112,8 @@ Result<OutputFrame> renderOutputFrame(const FrameRequest& r) {
   out.rgba = renderer.frame().clone();
   auto st = render::frameStats(out.rgba);
   if (!st) return tl::unexpected(st.error());
-  out.stats = {plan->source, st->lit_fraction, st->mean_rgb};
+  out.stats = {
+      plan->source, st->lit_fraction, st->mean_rgb, render::toString(plan->setup.path), {}};
   return out;
 }
 

@@ -39,6 +39,10 @@ struct FrameStats {
   std::string source;                // "pattern:NAME", "content" or "none"
   double lit_fraction = 0;           // pixels with any channel above 0
   std::array<double, 3> mean_rgb{};  // 0..255
+  // The frame these numbers describe: its render path and, for content drawn for a
+  // viewer, the viewer's world -> content pixel matrix (status reports them together).
+  std::string path;
+  std::optional<Mat34> viewer;
 };
 
 // One output's frame as the output renders it: the geometry and the content.
