@@ -83,8 +83,8 @@ tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const json& requ
   CalibrationArgs a;
   a.settle_frames = defaults.settle_frames;
   a.auto_settle = defaults.auto_settle;
-  static const char* const kKeys[] = {"mode",          "step",   "phase_steps", "grid",
-                                      "settle_frames", "output", "cameras",     "plane"};
+  static const char* const kKeys[] = {"mode",   "step",    "phase_steps", "grid", "settle_frames",
+                                      "output", "cameras", "plane",       "board"};
   for (const auto& [key, value] : request.items()) {
     if (key == "cmd" || key == "id") continue;
     bool known = false;
@@ -151,8 +151,56 @@ tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const json& requ
     }
     a.plane = geom::Plane{n / n.norm(), (*it)[3].get<double>() / n.norm()};
   }
+  if (auto it = request.find("board"); it != request.end()) {
+    const std::string text = it->is_string() ? it->get<std::string>() : std::string();
+    auto spec =
+        !text.empty() && text.size() <= 64
+            ? calib::parseBoard(text)
+            : Result<calib::BoardSpec>(tl::unexpect, Error{ErrorCode::kParse, "not a board"});
+    if (!spec) {
+      return tl::unexpected(
+          "\"board\" must be a board on the display plane: aprilgrid:COLSxROWS:TAG_M[:GAP_M], "
+          "checker:COLSxROWS:SQUARE_M or charuco:COLSxROWS:SQUARE_M:MARKER_M (metres): " +
+          spec.error().message);
+    }
+    if (a.plane) {
+      return tl::unexpected(
+          std::string("give either \"plane\" or \"board\": both say where the display plane is"));
+    }
+    if (a.cameras.size() == 2) {
+      return tl::unexpected(
+          std::string("\"board\" is for route (b′) with one camera; \"cameras\" names two"));
+    }
+    a.board = *spec;
+    a.board_text = text;
+  }
   return a;
 }
+
+namespace {
+
+// The display plane from the board on it, as the camera saw it while the projector
+// showed white (the board is lit by the projector alone in a dark room).
+tl::expected<calib::BoardPlane, CalibrationFailure> planeOfBoard(const CalibrationPlan& plan,
+                                                                 const cv::Mat& white) {
+  const CalibrationCamera& cam = plan.cameras.at(0);
+  auto view = calib::detectBoard(*plan.board, white);
+  if (!view) {
+    return tl::unexpected(CalibrationFailure{
+        code::kFailed, "camera '" + cam.device.name + "' does not see the board " +
+                           plan.board_text +
+                           " on the display plane in the white frame: " + view.error().message});
+  }
+  auto plane = calib::boardPlane(cam.model, *view);
+  if (!plane) {
+    return tl::unexpected(CalibrationFailure{
+        code::kFailed, "the board " + plan.board_text + " seen by camera '" + cam.device.name +
+                           "' gives no display plane: " + plane.error().message});
+  }
+  return *plane;
+}
+
+}  // namespace
 
 tl::expected<CalibrationOutcome, CalibrationFailure> runCalibration(const CalibrationPlan& plan,
                                                                     const CalibrationHooks& hooks) {
@@ -218,6 +266,13 @@ tl::expected<CalibrationOutcome, CalibrationFailure> runCalibration(const Calibr
       hooks.progress({start + (0.9 - start) * done / total, "capturing", done});
       if (hooks.cancelled()) return tl::unexpected(cancelled);
     }
+    // The board is looked for as soon as it is lit: a board the camera does not see
+    // ends the run before the rest of the sequence is shown.
+    if (plan.board && plan.set.frames[f].kind == sl::FrameKind::kWhite && !outcome.board) {
+      auto found = planeOfBoard(plan, captures[0].back());
+      if (!found) return tl::unexpected(found.error());
+      outcome.board = *found;
+    }
   }
   std::vector<calib::DecodedView> views;
   for (std::size_t c = 0; c < plan.cameras.size(); ++c) {
@@ -237,9 +292,13 @@ tl::expected<CalibrationOutcome, CalibrationFailure> runCalibration(const Calibr
     if (hooks.cancelled()) return tl::unexpected(cancelled);
   }
   hooks.progress({0.95, "solving", total});
-  if (plan.plane) {
-    auto planar =
-        calib::solvePlaneHomographyRoute(plan.set, views[0], *plan.plane, {.step = plan.grid});
+  if (plan.planar()) {
+    if (plan.board && !outcome.board) {
+      return tl::unexpected(
+          CalibrationFailure{code::kFailed, "the pattern set has no white frame"});
+    }
+    const geom::Plane plane = plan.board ? outcome.board->plane : *plan.plane;
+    auto planar = calib::solvePlaneHomographyRoute(plan.set, views[0], plane, {.step = plan.grid});
     if (!planar) {
       return tl::unexpected(CalibrationFailure{code::kFailed, planar.error().message});
     }

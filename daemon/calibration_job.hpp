@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "calibration/board_plane.hpp"
 #include "calibration/plane_homography_route.hpp"
 #include "calibration/stereo_route.hpp"
 #include "config.hpp"
@@ -33,6 +34,10 @@ struct CalibrationArgs {
   std::string output;                // empty: the first usable output
   std::vector<std::string> cameras;  // empty: the first usable ones; one name: route (b′)
   std::optional<geom::Plane> plane;  // the display plane (world): route (b′)
+  // Route (b′) with the display plane found from this board fixed flat on it
+  // (calib::parseBoard form), seen by the camera in the white frame.
+  std::optional<calib::BoardSpec> board;
+  std::string board_text;
 };
 
 // The message names the offending key; `defaults` ([calibration] of procamd.toml)
@@ -63,6 +68,10 @@ struct CalibrationPlan {
   std::vector<CalibrationCamera> cameras;  // two: route (a); one: route (b′)
   std::optional<geom::Plane> plane;        // set: route (b′) on this display plane (world)
   bool plane_from_rig = false;             // the rig model's surface plane, not an argument
+  std::optional<calib::BoardSpec> board;   // set: route (b′), the plane from this board
+  std::string board_text;
+
+  bool planar() const { return plane || board; }
 
   int captures() const { return static_cast<int>(set.frames.size() * cameras.size()); }
 };
@@ -88,6 +97,7 @@ struct CalibrationFailure {
 struct CalibrationOutcome {
   calib::StereoRouteResult route;                      // route (a)
   std::optional<calib::PlaneHomographyResult> planar;  // route (b′)
+  std::optional<calib::BoardPlane> board;              // route (b′) on a board's plane
   std::vector<int> decoded;                            // camera pixels decoded, per camera
   int settle_frames = 0;                               // waited after every pattern
   nlohmann::json latency;  // the measured latency (auto_settle; latencyJson), else null

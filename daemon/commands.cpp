@@ -54,10 +54,16 @@ void Daemon::handle(ClientId client, const proto::Request& req) {
       {"tracker", &Daemon::cmdTracker},     {"latency", &Daemon::cmdLatency},
   };
   for (const auto& [name, fn] : kCommands) {
-    if (req.cmd == name) {
+    if (req.cmd != name) continue;
+    // A handler's defect must not take the daemon down with every client's state:
+    // the request is answered and the daemon keeps its last good state.
+    try {
       (this->*fn)(client, req);
-      return;
+    } catch (const std::exception& e) {
+      logError("'" + req.cmd + "' request failed: " + e.what());
+      errorTo(client, req, code::kInternal, std::string("internal error: ") + e.what());
     }
+    return;
   }
   std::string list;
   for (const auto& [name, fn] : kCommands) list += (list.empty() ? "" : ", ") + std::string(name);

@@ -59,7 +59,7 @@ tl::expected<CalibrationPlan, Failure> makePlan(DeviceSet& devices, const Calibr
   for (const auto& e : devices.entries()) {
     usable += e.description.family == PROCAM_FAMILY_CAMERA && e.usable();
   }
-  const bool planar = args.plane || args.cameras.size() == 1 ||
+  const bool planar = args.plane || args.board || args.cameras.size() == 1 ||
                       (args.cameras.empty() && usable == 1 && rig.surface.plane);
   const std::size_t wanted = planar ? 1 : 2;
   std::vector<const DeviceEntry*> cams;
@@ -79,14 +79,18 @@ tl::expected<CalibrationPlan, Failure> makePlan(DeviceSet& devices, const Calibr
     cams.push_back(c);
   }
   CalibrationPlan plan;
-  if (planar) {
+  if (planar && args.board) {
+    plan.board = args.board;
+    plan.board_text = args.board_text;
+  } else if (planar) {
     plan.plane = args.plane ? args.plane : rig.surface.plane;
     plan.plane_from_rig = !args.plane;
     if (!plan.plane) {
       return tl::unexpected(
           Failure{code::kUnavailable,
                   "route (b′) with one camera needs the display plane: give \"plane\" [a, b, c, d] "
-                  "(world, metres) or put surface.plane in the rig model"});
+                  "(world, metres), or \"board\" (a calibration board fixed flat on it, e.g. "
+                  "\"aprilgrid:6x4:0.15\"), or put surface.plane in the rig model"});
     }
   }
   uint32_t w = 0, h = 0;
@@ -173,10 +177,12 @@ Learnt learntByStereoRoute(const CalibrationPlan& plan, const CalibrationOutcome
 }
 
 // Route (b′): the projector bound to the output gets its collineation with the
-// display plane (no K, no pose); a plane given as an argument becomes the rig's
-// surface, one read from the rig stays as it was.
+// display plane (no K, no pose); a plane given as an argument or found from a board
+// becomes the rig's surface, one read from the rig stays as it was.
 Learnt learntByPlaneRoute(const CalibrationPlan& plan, const CalibrationOutcome& result) {
   const calib::PlaneHomographyResult& route = *result.planar;
+  const std::optional<geom::Plane> plane = result.board ? result.board->plane : plan.plane;
+  const char* source = result.board ? "board" : plan.plane_from_rig ? "rig" : "request";
   Learnt out;
   rig::RigProjector projector = projectorEntry(plan);
   projector.intrinsics_known = false;
@@ -186,19 +192,21 @@ Learnt learntByPlaneRoute(const CalibrationPlan& plan, const CalibrationOutcome&
   projector.points = static_cast<long>(route.inliers);
   projector.calibrated = {"structured light, route (b′): camera " + plan.cameras.at(0).device.name +
                               ", plane from the " +
-                              (plan.plane_from_rig ? "rig model" : "calibrate request"),
+                              (result.board          ? "board " + plan.board_text
+                               : plan.plane_from_rig ? std::string("rig model")
+                                                     : std::string("calibrate request")),
                           utcNow()};
   out.update.projectors.push_back(projector);
-  if (!plan.plane_from_rig) out.update.surface.plane = plan.plane;
+  if (!plan.plane_from_rig) out.update.surface.plane = plane;
   rig::RigModel shown = out.update;
-  shown.surface.plane = plan.plane;
+  shown.surface.plane = plane;
   const json learnt = rig::rigToJson(shown);
   out.reply = {{"route", "b'"},
                {"projector", learnt["projectors"][0]},
                {"reprojection_rms_px", route.rms_projector_px},
                {"surface", learnt["surface"]},
                {"surface_type", "plane"},
-               {"plane_source", plan.plane_from_rig ? "rig" : "request"},
+               {"plane_source", source},
                {"homography",
                 {{"rms_camera_px", route.rms_camera_px},
                  {"rms_projector_px", route.rms_projector_px},
@@ -206,6 +214,12 @@ Learnt learntByPlaneRoute(const CalibrationPlan& plan, const CalibrationOutcome&
                  {"coverage", route.coverage},
                  {"samples", route.samples},
                  {"inliers", route.inliers}}}};
+  if (result.board) {
+    out.reply["board"] = {{"spec", plan.board_text},
+                          {"points", result.board->points},
+                          {"rms_px", result.board->rms_px},
+                          {"incidence_deg", result.board->incidence_deg}};
+  }
   return out;
 }
 
@@ -273,7 +287,7 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
            {"state", "started"},
            {"output", plan->output.name},
            {"cameras", cameras},
-           {"route", plan->plane ? "b'" : "a"},
+           {"route", plan->planar() ? "b'" : "a"},
            {"mode", sl::toString(plan->set.options.mode)},
            {"frames", plan->set.frames.size()},
            {"captures", captures},

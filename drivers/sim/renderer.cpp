@@ -152,7 +152,10 @@ cv::Vec3f Renderer::radianceAlong(const geom::Ray& ray) const {
                          (l.distance * l.distance);
     irradiance += lamp.image->sample(l.pixel.x(), l.pixel.y()) * static_cast<float>(scale);
   }
-  return irradiance.mul(albedo_bgr_[static_cast<std::size_t>(hit->surface)]);
+  const auto surface = static_cast<std::size_t>(hit->surface);
+  const cv::Vec3f albedo = albedo_bgr_[surface];
+  const auto& print = scene_->world().surfaces()[surface].print;
+  return irradiance.mul(print ? albedo * print->at(hit->hit.point) : albedo);
 }
 
 cv::Mat Renderer::radianceImage(const geom::CameraModel& view, int supersamples,

@@ -228,6 +228,7 @@ class Reader {
       f.error("type", "unknown surface type '" + s.type +
                           "' (plane, rectangle, box, cylinder, sphere, dome, mesh)");
     }
+    if (f.has("board")) s.print = boardPrint(f, s.shape);
     f.finish();
     return s;
   }
@@ -301,6 +302,29 @@ class Reader {
     std::string name = f.string("name");
     if (!names.insert(name).second) f.error("name", "duplicate name '" + name + "'");
     return name;
+  }
+
+  // board = { spec = "aprilgrid:6x4:0.15", center = [x, y, z], px_per_m = 1000 } on a
+  // plane or a rectangle (SCENE-FORMAT.md).
+  std::shared_ptr<const SurfacePrint> boardPrint(const Fields& f, const Shape& shape) {
+    Vec3 point, normal;
+    if (const auto* p = std::get_if<geom::Plane>(&shape)) {
+      normal = p->n;
+      point = -p->d * p->n;
+    } else if (const auto* r = std::get_if<geom::Rectangle>(&shape)) {
+      normal = r->u.cross(r->v).normalized();
+      point = r->origin;
+    } else {
+      f.error("board", "a board can only be printed on a plane or a rectangle");
+    }
+    const Fields b = f.table("board");
+    const std::string spec = b.string("spec");
+    const Vec3 center = b.vec3("center");
+    const double px_per_m = b.numberIn("px_per_m", 1000, 100, 20000);
+    b.finish();
+    auto print = makeBoardPrint(spec, center, point, normal, px_per_m);
+    if (!print) f.error("board", print.error().message);
+    return std::make_shared<const SurfacePrint>(std::move(*print));
   }
 
   geom::Rectangle rectangle(const Fields& f) {

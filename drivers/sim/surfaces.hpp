@@ -11,6 +11,7 @@
 
 #include "core/types.hpp"
 #include "geometry/intersect.hpp"
+#include "sim/surface_print.hpp"
 
 namespace procam::sim {
 
@@ -27,6 +28,7 @@ struct Surface {
   std::string type;  // as in the scene file: plane, rectangle, box, cylinder, sphere, dome, mesh
   Vec3 albedo_rgb = Vec3::Constant(0.8);  // diffuse reflectance per channel, [0, 1]
   Shape shape;
+  std::shared_ptr<const SurfacePrint> print;  // a board on a plane or rectangle, if any
 };
 
 struct SurfaceHit {

@@ -150,6 +150,13 @@ json truthJson(const Scene& scene, const SceneState& state) {
     j["name"] = s.name;
     j["type"] = s.type;
     j["albedo_rgb"] = vecJson(s.albedo_rgb);
+    if (s.print) {
+      j["board"] = {{"spec", s.print->board},
+                    {"center", vecJson(s.print->center)},
+                    {"right", vecJson(s.print->right)},
+                    {"down", vecJson(s.print->down)},
+                    {"metres_per_px", s.print->metres_per_px}};
+    }
     out["surfaces"].push_back(j);
   }
   return out;

@@ -145,6 +145,26 @@ Result<BoardView> detectBoard(const BoardSpec& s, const cv::Mat& image) {
   return v;
 }
 
+Result<cv::Size2d> boardExtent(const BoardSpec& s) {
+  switch (s.kind) {
+    case BoardKind::kChecker:
+      return cv::Size2d((s.cols + 3) * s.square_m, (s.rows + 3) * s.square_m);
+    case BoardKind::kCharuco:
+      return cv::Size2d((s.cols + 2) * s.square_m, (s.rows + 2) * s.square_m);
+    case BoardKind::kAprilGrid: {
+#ifdef PROCAM_HAVE_APRILTAG
+      double m = 0;
+      auto grid = aprilBoard(s, m);
+      if (!grid) return tl::unexpected(grid.error());
+      return cv::Size2d(grid->options.width * m, grid->options.height * m);
+#else
+      return fail(ErrorCode::kInvalidInput, "AprilTag boards need libapriltag (not built)");
+#endif
+    }
+  }
+  return fail(ErrorCode::kInvalidInput, "unknown board kind");
+}
+
 Result<cv::Mat> renderBoard(const BoardSpec& s, double px_per_m) {
   if (!(px_per_m > 0)) return fail(ErrorCode::kInvalidInput, "board rendering: bad scale");
   const int sq = static_cast<int>(std::lround(s.square_m * px_per_m));

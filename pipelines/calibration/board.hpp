@@ -33,6 +33,11 @@ struct BoardView {
 // kNotFound when the board is not (fully enough) visible; 8-bit grey or BGR input.
 Result<BoardView> detectBoard(const BoardSpec& spec, const cv::Mat& image);
 
+// The physical size (metres, width x height) of what renderBoard draws, margins
+// included, whatever its pixel scale: a print of that image at this size has the
+// board's true dimensions.
+Result<cv::Size2d> boardExtent(const BoardSpec& spec);
+
 // The board as an 8-bit image with `px_per_m` pixels per metre and a white margin of
 // one square: for printing, and for rendering views in tests.
 Result<cv::Mat> renderBoard(const BoardSpec& spec, double px_per_m);

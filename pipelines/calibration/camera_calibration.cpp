@@ -3,9 +3,15 @@
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 
+#include "calibration/opencv_camera.hpp"
+
 namespace procam::calib {
 namespace {
 
+using detail::cameraMatrix;
+using detail::distCoeffs;
+using detail::poseFromMatrix;
+using detail::poseFromRvec;
 using ObjectPoints = std::vector<std::vector<cv::Point3f>>;
 using ImagePoints = std::vector<std::vector<cv::Point2f>>;
 
@@ -19,35 +25,6 @@ void toCv(const BoardView& v, ObjectPoints& object, ImagePoints& image) {
     image.back().emplace_back(static_cast<float>(v.image[i].x()),
                               static_cast<float>(v.image[i].y()));
   }
-}
-
-cv::Mat cameraMatrix(const geom::CameraModel& c) {
-  cv::Mat K = cv::Mat::eye(3, 3, CV_64F);
-  K.at<double>(0, 0) = c.K.fx;
-  K.at<double>(0, 1) = c.K.skew;
-  K.at<double>(0, 2) = c.K.cx;
-  K.at<double>(1, 1) = c.K.fy;
-  K.at<double>(1, 2) = c.K.cy;
-  return K;
-}
-
-cv::Mat distCoeffs(const geom::CameraModel& c) {
-  return (cv::Mat_<double>(1, 5) << c.dist.k1, c.dist.k2, c.dist.p1, c.dist.p2, c.dist.k3);
-}
-
-geom::Pose poseFromMatrix(const cv::Mat& R, const cv::Mat& tvec) {
-  geom::Pose p;
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) p.R(r, c) = R.at<double>(r, c);
-    p.t(r) = tvec.at<double>(r);
-  }
-  return p;
-}
-
-geom::Pose poseFromRvec(const cv::Mat& rvec, const cv::Mat& tvec) {
-  cv::Mat R;
-  cv::Rodrigues(rvec, R);
-  return poseFromMatrix(R, tvec);
 }
 
 Result<void> checkViews(std::span<const BoardView> views) {

@@ -18,14 +18,6 @@ constexpr double kAmbiguousRatio = 1e-12;
 // Multiple of the coordinate rounding below which an extent counts as zero.
 constexpr double kRoundingFloor = 256;
 
-// Deterministic orientation: the largest-magnitude component of n is positive.
-Plane orient(Vec3 n, const Vec3& point_on_plane) {
-  int k = 0;
-  n.cwiseAbs().maxCoeff(&k);
-  if (n[k] < 0) n = -n;
-  return Plane{n, -n.dot(point_on_plane)};
-}
-
 Result<PlaneFit> fitSubset(std::span<const Vec3> points, std::vector<std::uint32_t> idx) {
   if (idx.size() < 3) return fail(ErrorCode::kTooFewPoints, "a plane needs at least 3 points");
   Vec3 centroid = Vec3::Zero();
@@ -55,7 +47,7 @@ Result<PlaneFit> fitSubset(std::span<const Vec3> points, std::vector<std::uint32
     return fail(ErrorCode::kDegenerate, "no unique best plane (isotropic spread)");
   }
   PlaneFit fit;
-  fit.plane = orient(svd.matrixV().col(2), centroid);
+  fit.plane = orientedPlane(svd.matrixV().col(2), centroid);
   double sum = 0;
   for (const std::uint32_t i : idx) sum += std::pow(fit.plane.signedDistance(points[i]), 2);
   fit.rms = std::sqrt(sum / static_cast<double>(idx.size()));
@@ -108,6 +100,13 @@ std::vector<std::uint32_t> inliersOf(std::span<const Vec3> points, const Vec3& n
 }
 
 }  // namespace
+
+Plane orientedPlane(Vec3 n, const Vec3& point_on_plane) {
+  int k = 0;
+  n.cwiseAbs().maxCoeff(&k);
+  if (n[k] < 0) n = -n;
+  return Plane{n, -n.dot(point_on_plane)};
+}
 
 Result<PlaneFit> fitPlane(std::span<const Vec3> points) {
   if (auto ok = checkPoints(points); !ok) return tl::unexpected(ok.error());

@@ -23,6 +23,10 @@ struct PlaneFit {
   std::vector<std::uint32_t> inliers;  // indices (all points for least squares)
 };
 
+// The plane through `point_on_plane` with unit normal `n`, oriented the way every
+// plane procamd writes is: the largest-magnitude component of n is positive.
+Plane orientedPlane(Vec3 n, const Vec3& point_on_plane);
+
 // kDegenerate for coincident or collinear points (extent ratio < 1e-9 or within the
 // rounding of the coordinates) and for isotropic sets with no unique best plane.
 // n is oriented so that its largest-magnitude component is positive.
