@@ -125,6 +125,10 @@ class Daemon {
   std::optional<Mat3> rigKeystoneWarp(cv::Size content) const;  // when on and solvable
   Result<void> setRigKeystone(bool enable);
   nlohmann::json rigKeystoneJson(cv::Size content) const;
+  // tiled_display.cpp: several projectors of the rig on one wall as one display.
+  std::vector<std::pair<std::string, const rig::RigProjector*>> rigTiles() const;
+  const KeystoneRuntime::Tiled* tiledDisplay(cv::Size content);
+  nlohmann::json tiledDisplayJson() const;
   cv::Size currentSourceSize() const;
   void refreshOutputs(std::function<void(bool shown)> done = {});
   // What render::choosePath needs about an output, from the rig model and the viewer.

@@ -273,6 +273,7 @@ json Daemon::keystoneJson() const {
     j["rig_unavailable"] = rig["unavailable"];
   } else if (rig_active) {
     j["wall"] = rig;
+    if (const json display = tiledDisplayJson(); !display.is_null()) j["display"] = display;
   }
   if (settings_.keystone && !auto_active && !rig_active) {
     json c = json::array();

@@ -25,6 +25,12 @@ json rowMajor(const Mat34& m) {
   return v;
 }
 
+json rowMajor(const Mat3& m) {
+  json out = json::array();
+  for (int i = 0; i < 9; ++i) out.push_back(m(i / 3, i % 3));
+  return out;
+}
+
 }  // namespace
 
 bool Daemon::calibrating() const {
@@ -74,11 +80,22 @@ std::optional<OutputDraw> Daemon::planOutput(DeviceEntry& e, const OutputDrawPol
     mesh_image = &m->second;
     r.content = m->second.image;
   }
-  r.homography = currentWarp(sourceSize(r));
+  // Several projectors on one wall: this output's share of the one display.
+  const bool rig_mode = settings_.rig_keystone && !(settings_.auto_keystone && k.estimate);
+  const KeystoneRuntime::Tiled* tiled = rig_mode ? tiledDisplay(sourceSize(r)) : nullptr;
+  const int tile = tiled ? tiled->index(e.name) : -1;
+  r.homography = tile >= 0 ? std::optional<Mat3>(tiled->display.content_to_framebuffer[tile])
+                           : currentWarp(sourceSize(r));
   auto plan = planFrame(r);
   if (!plan) {
     warn("output '" + e.name + "': " + plan.error().message);
     return std::nullopt;
+  }
+  if (tile >= 0 && tiled->alpha[tile].size() == *mode) {
+    // Eq. 4.3 weights in linear light, through the assumed response ([Raskar02] §4.1.2).
+    static const render::Lut kWeightLut = *render::weightLutForGamma(kAssumedGamma);
+    plan->setup.final_stage.alpha = tiled->alpha[tile];
+    plan->setup.final_stage.weight_lut = kWeightLut;
   }
   const render::SceneTraits traits = sceneTraits(e.name, plan->mesh != nullptr);
   auto& st = k.output_state[e.name];
@@ -132,6 +149,8 @@ std::optional<OutputDraw> Daemon::planOutput(DeviceEntry& e, const OutputDrawPol
   st.path = path;
   job.path = path;
   job.viewer = st.viewer;
+  if (plan->setup.path == render::RenderPath::kHomography) job.homography = plan->setup.homography;
+  job.tile = tile;
   const auto chosen = render::choosePath(traits);
   st.chosen = chosen ? render::toString(chosen->path) : std::string("none");
   st.path_note.clear();
@@ -206,7 +225,9 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done) {
         shown = true;
         drawn = drawn || r.drawn;
         if (r.stats) {
-          k.shown[r.name] = {r.source, r.stats->lit_fraction, r.stats->mean_rgb, r.path, r.viewer};
+          k.shown[r.name] = {
+              r.source, r.stats->lit_fraction, r.stats->mean_rgb, r.path, r.viewer, r.homography,
+              r.tile};
         }
       }
       if (drawn) ++k.frames;  // frames drawn, not statistics read again
@@ -247,6 +268,11 @@ json Daemon::outputsJson() const {
     // renderer of the latest plan.
     if (!st.path.empty()) o["path"] = st.path;
     if (st.viewer) o["viewer_matrix"] = rowMajor(*st.viewer);
+    if (st.homography) o["homography"] = rowMajor(*st.homography);
+    if (st.tile >= 0 && keystone_rt_.tiled) {
+      o["display"] = {
+          {"tile", st.tile}, {"tiles", keystone_rt_.tiled->outputs.size()}, {"blend", "feathered"}};
+    }
     if (auto it = keystone_rt_.output_state.find(name); it != keystone_rt_.output_state.end()) {
       const auto& os = it->second;
       o["chosen_path"] = os.chosen;

@@ -13,12 +13,17 @@
 #include <vector>
 
 #include "auto_keystone.hpp"
+#include "blend/tiled_display.hpp"
 #include "content_mesh.hpp"
 #include "driver.hpp"
 #include "output_frames.hpp"
 #include "render/cpu_renderer.hpp"
 
 namespace procam::daemon {
+
+// The response assumed for blending until the projectors' responses are measured:
+// light ~ code^2.2, the sRGB-like curve most projectors ship with.
+inline constexpr double kAssumedGamma = 2.2;
 
 struct KeystoneRuntime {
   // Auto keystone inputs; `unavailable` says why it cannot run (empty: it can).
@@ -74,6 +79,20 @@ struct KeystoneRuntime {
   std::vector<std::function<void(bool shown)>> frame_waiters;
   uint64_t frames = 0;
   std::map<std::string, FrameStats> shown;  // output name -> what it shows
+
+  // Several projectors on one wall plane as one display (tiled_display.cpp): made on
+  // the compute worker for a content size and set of outputs, used by every output.
+  struct Tiled {
+    cv::Size content;
+    std::vector<std::string> outputs;  // in tile order
+    blend::TiledDisplay display;
+    std::vector<cv::Mat> alpha;  // per tile, CV_8UC1 (eq. 4.3 weights)
+    int index(const std::string& output) const;
+  };
+  std::shared_ptr<const Tiled> tiled;  // the display in use, if any
+  std::string tiled_key;               // what `tiled` (or the job running) was made for
+  std::string tiled_error;             // why there is none for tiled_key
+  bool tiling = false;                 // a job runs
 };
 
 }  // namespace procam::daemon

@@ -59,6 +59,8 @@ OutputDrawn drawOutput(const OutputDraw& j) {
   r.source = j.source;
   r.path = j.path;
   r.viewer = j.viewer;
+  r.homography = j.homography;
+  r.tile = j.tile;
   try {
     if (!j.device || !j.device->valid() || !j.setup) {
       r.error = "no device or setup";

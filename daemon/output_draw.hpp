@@ -30,6 +30,8 @@ struct OutputDraw {
   std::string source;                             // FrameStats::source of this frame
   std::string path;                               // render::toString of setup->path
   std::optional<Mat34> viewer;                    // world -> content pixels, if any
+  std::optional<Mat3> homography;                 // content -> framebuffer (homography path)
+  int tile = -1;                                  // of a display across outputs
   std::shared_ptr<render::CpuRenderer> fallback;  // set: the output does not render itself
 };
 
@@ -38,6 +40,8 @@ struct OutputDrawn {
   std::string source;
   std::string path;
   std::optional<Mat34> viewer;
+  std::optional<Mat3> homography;
+  int tile = -1;
   bool ok = false;
   bool drawn = false;       // a new frame is shown
   bool configured = false;  // the setup was handed over and taken

@@ -113,7 +113,7 @@ Result<OutputFrame> renderOutputFrame(const FrameRequest& r) {
   auto st = render::frameStats(out.rgba);
   if (!st) return tl::unexpected(st.error());
   out.stats = {
-      plan->source, st->lit_fraction, st->mean_rgb, render::toString(plan->setup.path), {}};
+      plan->source, st->lit_fraction, st->mean_rgb, render::toString(plan->setup.path), {}, {}, -1};
   return out;
 }
 

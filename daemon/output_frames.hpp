@@ -43,6 +43,8 @@ struct FrameStats {
   // viewer, the viewer's world -> content pixel matrix (status reports them together).
   std::string path;
   std::optional<Mat34> viewer;
+  std::optional<Mat3> homography;  // content -> framebuffer pixels (homography path)
+  int tile = -1;                   // its tile of a display across outputs, if any
 };
 
 // One output's frame as the output renders it: the geometry and the content.

@@ -228,4 +228,17 @@ RunResult runProgram(const std::vector<std::string>& argv, const std::string& st
   return r;
 }
 
+std::optional<json> finalReply(Connection& c, int id, std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout * kSlowdown;
+  while (std::chrono::steady_clock::now() < deadline) {
+    auto msg = c.next(std::chrono::duration_cast<std::chrono::milliseconds>(
+        deadline - std::chrono::steady_clock::now()));
+    if (!msg) return std::nullopt;
+    if ((*msg)["class"] != "EVENT" && (*msg)["id"] == id && (*msg)["state"] != "started") {
+      return msg;
+    }
+  }
+  return std::nullopt;
+}
+
 }  // namespace procam::itest

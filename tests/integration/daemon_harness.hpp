@@ -111,6 +111,10 @@ inline constexpr int kSlowdown = 1;
 template <class F>
 bool eventually(F predicate, std::chrono::milliseconds timeout = 5s);
 
+// The final reply to request `id` of a long operation (not its "started" reply, not an
+// event); nullopt when none comes within `timeout` (times kSlowdown).
+std::optional<json> finalReply(Connection& c, int id, std::chrono::milliseconds timeout);
+
 }  // namespace procam::itest
 
 #include "daemon_harness_inl.hpp"

@@ -41,20 +41,6 @@ json calibrateRequest(int id, const json& plane) {
   return r;
 }
 
-// The final reply to `id` (CALIBRATE done or ERROR), skipping events.
-std::optional<json> finalReply(Connection& c, int id, std::chrono::milliseconds timeout) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout * kSlowdown;
-  while (std::chrono::steady_clock::now() < deadline) {
-    auto msg = c.next(std::chrono::duration_cast<std::chrono::milliseconds>(
-        deadline - std::chrono::steady_clock::now()));
-    if (!msg) return std::nullopt;
-    if ((*msg)["class"] != "EVENT" && (*msg)["id"] == id && (*msg)["state"] != "started") {
-      return msg;
-    }
-  }
-  return std::nullopt;
-}
-
 // Lit framebuffer share of the quad (shoelace) over the w x h frame.
 double quadFraction(const std::array<Vec2, 4>& q, int w, int h) {
   double area2 = 0;

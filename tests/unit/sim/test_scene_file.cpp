@@ -206,6 +206,25 @@ TEST(SimSceneFile, ShippedScenesMatchTheIssue) {
   EXPECT_EQ(ws.cameras[0].model.width, 1280);
   EXPECT_EQ(ws.cameras[0].model.height, 960);
 
+  // The planar multi-projector wall: 2x2 of 1280x800, unmatched responses, two cameras.
+  auto tiled = resolveScene("tiled_wall");
+  ASSERT_TRUE(tiled);
+  ASSERT_EQ(tiled->projectors().size(), 4u);
+  EXPECT_EQ(tiled->cameras().size(), 2u);
+  double gamma_lo = 9, gamma_hi = 0, bright_lo = 1e9, bright_hi = 0;
+  for (const auto& p : tiled->projectors()) {
+    EXPECT_EQ(p.width, 1280);
+    EXPECT_EQ(p.height, 800);
+    gamma_lo = std::min(gamma_lo, p.gamma);
+    gamma_hi = std::max(gamma_hi, p.gamma);
+    bright_lo = std::min(bright_lo, p.brightness);
+    bright_hi = std::max(bright_hi, p.brightness);
+  }
+  EXPECT_EQ(gamma_lo, 2.0);
+  EXPECT_EQ(gamma_hi, 2.6);
+  EXPECT_LE(bright_hi / bright_lo, 1.2 / 0.8);
+  EXPECT_GT(bright_hi / bright_lo, 1.2);
+
   auto corner = resolveScene("corner_stereo");
   ASSERT_TRUE(corner);
   EXPECT_EQ(corner->projectors().size(), 1u);

@@ -1,0 +1,240 @@
+#include "blend/tiled_display.hpp"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace procam::blend {
+namespace {
+
+// Inside a convex quad (either winding), boundary included.
+bool insideQuad(const std::array<Vec2, 4>& q, const Vec2& p) {
+  int sign = 0;
+  for (int i = 0; i < 4; ++i) {
+    const Vec2 a = q[i], b = q[(i + 1) % 4];
+    const double c = (b.x() - a.x()) * (p.y() - a.y()) - (b.y() - a.y()) * (p.x() - a.x());
+    const int s = c > 1e-12 ? 1 : c < -1e-12 ? -1 : 0;
+    if (s == 0) continue;
+    if (sign == 0) sign = s;
+    if (s != sign) return false;
+  }
+  return true;
+}
+
+// A raster of the wall: cell (i, j) has its centre at origin + (j + 0.5, i + 0.5) * cell,
+// 1 where some footprint covers it; `sum` is its integral image.
+struct Raster {
+  Vec2 origin;
+  double cell = 0;
+  int cols = 0, rows = 0;
+  std::vector<int> sum;  // (rows + 1) x (cols + 1)
+
+  int at(int i, int j) const { return sum[static_cast<std::size_t>(i) * (cols + 1) + j]; }
+  int covered(int i0, int j0, int h, int w) const {
+    return at(i0 + h, j0 + w) - at(i0, j0 + w) - at(i0 + h, j0) + at(i0, j0);
+  }
+};
+
+Raster rasterize(std::span<const std::array<Vec2, 4>> quads, const Vec2& lo, const Vec2& hi,
+                 double cell) {
+  Raster r;
+  r.origin = lo;
+  r.cell = cell;
+  r.cols = std::max(1, static_cast<int>(std::ceil((hi.x() - lo.x()) / cell)));
+  r.rows = std::max(1, static_cast<int>(std::ceil((hi.y() - lo.y()) / cell)));
+  r.sum.assign(static_cast<std::size_t>(r.rows + 1) * (r.cols + 1), 0);
+  for (int i = 0; i < r.rows; ++i) {
+    int row = 0;
+    for (int j = 0; j < r.cols; ++j) {
+      const Vec2 p = lo + Vec2(j + 0.5, i + 0.5) * cell;
+      bool in = false;
+      for (const auto& q : quads) in = in || insideQuad(q, p);
+      row += in;
+      r.sum[static_cast<std::size_t>(i + 1) * (r.cols + 1) + j + 1] = r.at(i, j + 1) + row;
+    }
+  }
+  return r;
+}
+
+struct Placement {
+  int i = 0, j = 0, h = 0, w = 0;  // rows, columns of cells
+};
+
+// The largest fully covered h x w block with w = round(aspect h), closest to `prefer`
+// (cell coordinates of the preferred centre) among those of that size.
+std::optional<Placement> largestBlock(const Raster& r, double aspect, const Vec2& prefer,
+                                      int known_h = 0) {
+  auto fits = [&](int h, Placement* best) {
+    const int w = std::max(1, static_cast<int>(std::lround(aspect * h)));
+    if (h > r.rows || w > r.cols) return false;
+    bool any = false;
+    double best_d = std::numeric_limits<double>::infinity();
+    for (int i = 0; i + h <= r.rows; ++i) {
+      for (int j = 0; j + w <= r.cols; ++j) {
+        if (r.covered(i, j, h, w) != h * w) continue;
+        any = true;
+        if (!best) return true;
+        const double d = (Vec2(j + 0.5 * w, i + 0.5 * h) - prefer).squaredNorm();
+        if (d < best_d) {
+          best_d = d;
+          *best = {i, j, h, w};
+        }
+      }
+    }
+    return any;
+  };
+  int lo = std::min(known_h, r.rows), hi = r.rows;  // lo fits, hi + 1 does not
+  if (lo > 0 && !fits(lo, nullptr)) lo = 0;
+  while (lo < hi) {
+    const int mid = (lo + hi + 1) / 2;
+    if (fits(mid, nullptr))
+      lo = mid;
+    else
+      hi = mid - 1;
+  }
+  if (lo == 0) return std::nullopt;
+  Placement p;
+  fits(lo, &p);
+  return p;
+}
+
+keystone::AxisRect toRect(const Raster& r, const Placement& p) {
+  keystone::AxisRect rect;
+  rect.centre = r.origin + Vec2(p.j + 0.5 * p.w, p.i + 0.5 * p.h) * r.cell;
+  rect.half_width = 0.5 * p.w * r.cell;
+  rect.half_height = 0.5 * p.h * r.cell;
+  return rect;
+}
+
+}  // namespace
+
+Mat3 contentToWall(const keystone::AxisRect& rect, int content_width, int content_height) {
+  const double sx = 2 * rect.half_width / content_width;
+  const double sy = 2 * rect.half_height / content_height;
+  const double left = rect.centre.x() - rect.half_width;
+  const double top = rect.centre.y() + rect.half_height;
+  Mat3 m;
+  m << sx, 0, left + 0.5 * sx, 0, -sy, top - 0.5 * sy, 0, 0, 1;
+  return m;
+}
+
+Result<TiledDisplay> solveTiledDisplay(std::span<const DisplayTile> tiles, int content_width,
+                                       int content_height, const TiledDisplayOptions& options) {
+  if (tiles.empty()) return fail(ErrorCode::kInvalidInput, "a display needs at least one tile");
+  if (content_width < 1 || content_height < 1 || content_width > 65536 || content_height > 65536)
+    return fail(ErrorCode::kInvalidInput, "content size out of range");
+  if (options.raster_cells < 16 || options.raster_cells > 8192)
+    return fail(ErrorCode::kInvalidInput, "raster_cells outside [16, 8192]");
+  TiledDisplay out;
+  const geom::PlaneBasis& first = tiles.front().projector_to_plane.basis;
+  const Vec3 n = first.normal();
+  if (!first.origin.allFinite() || !(n.norm() > 0.5))
+    return fail(ErrorCode::kInvalidInput, "the first tile's plane basis is not valid");
+  const geom::Plane plane{n.normalized(), -n.normalized().dot(first.origin)};
+  auto upright = geom::uprightBasis(plane, first.origin + plane.n, first.origin);
+  if (!upright) return tl::unexpected(upright.error());
+  out.basis = *upright;
+  Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (std::size_t t = 0; t < tiles.size(); ++t) {
+    const DisplayTile& tile = tiles[t];
+    const geom::PlaneBasis& b = tile.projector_to_plane.basis;
+    if (tile.width < 2 || tile.height < 2 || tile.width > 16384 || tile.height > 16384)
+      return fail(ErrorCode::kInvalidInput, "tile " + std::to_string(t) + ": bad framebuffer size");
+    if (std::abs(b.u.norm() - 1) > 1e-6 || std::abs(b.v.norm() - 1) > 1e-6 ||
+        std::abs(b.u.dot(b.v)) > 1e-6 || !b.origin.allFinite())
+      return fail(ErrorCode::kInvalidInput,
+                  "tile " + std::to_string(t) + ": the plane basis is not orthonormal");
+    // Same plane, either side: the bases' planes must agree to 1e-6 of normal, 1 mm.
+    if (b.normal().cross(plane.n).norm() > 1e-6 || std::abs(plane.signedDistance(b.origin)) > 1e-3)
+      return fail(ErrorCode::kInvalidInput,
+                  "tile " + std::to_string(t) + " is on another plane than the first");
+    geom::PlaneBasis same_side = out.basis;
+    auto change = geom::changeOfBasis(b, same_side);
+    if (!change) return tl::unexpected(change.error());
+    Mat3 to_wall = *change * tile.projector_to_plane.H;
+    if (!to_wall.allFinite())
+      return fail(ErrorCode::kInvalidInput,
+                  "tile " + std::to_string(t) + ": collineation not finite");
+    const Vec2 centre(0.5 * (tile.width - 1), 0.5 * (tile.height - 1));
+    if ((to_wall * centre.homogeneous()).z() < 0) to_wall = -to_wall;
+    const Eigen::FullPivLU<Mat3> lu(to_wall);
+    if (!lu.isInvertible())
+      return fail(ErrorCode::kInvalidInput,
+                  "tile " + std::to_string(t) + ": collineation singular");
+    std::array<Vec2, 4> quad;
+    const std::array<Vec2, 4> corners = {Vec2(-0.5, -0.5), Vec2(tile.width - 0.5, -0.5),
+                                         Vec2(tile.width - 0.5, tile.height - 0.5),
+                                         Vec2(-0.5, tile.height - 0.5)};
+    for (int k = 0; k < 4; ++k) {
+      const Vec3 w = to_wall * corners[k].homogeneous();
+      if (!(w.z() > 1e-6 * w.norm()))
+        return fail(ErrorCode::kDegenerate,
+                    "tile " + std::to_string(t) + ": a framebuffer corner does not reach the wall");
+      quad[k] = w.head<2>() / w.z();
+      lo = lo.cwiseMin(quad[k]);
+      hi = hi.cwiseMax(quad[k]);
+    }
+    out.footprints.push_back(quad);
+    out.plane_to_framebuffer.push_back(lu.inverse());
+  }
+  const double aspect = double(content_width) / content_height;
+  const double coarse = (hi - lo).maxCoeff() / options.raster_cells;
+  const Raster whole = rasterize(out.footprints, lo, hi, coarse);
+  out.union_area_m2 = whole.at(whole.rows, whole.cols) * coarse * coarse;
+  if (options.rect) {
+    const keystone::AxisRect& r = *options.rect;
+    if (!r.centre.allFinite() || !(r.half_width > 0) || !(r.half_height > 0))
+      return fail(ErrorCode::kInvalidInput, "the given display rectangle is empty");
+    // Inside the union: every point of a fine lattice over it is covered.
+    const int n = 64;
+    for (int i = 0; i <= n; ++i) {
+      for (int j = 0; j <= n; ++j) {
+        const Vec2 p =
+            r.centre + Vec2((2.0 * j / n - 1) * r.half_width, (2.0 * i / n - 1) * r.half_height);
+        bool in = false;
+        for (const auto& q : out.footprints) in = in || insideQuad(q, p);
+        if (!in)
+          return fail(ErrorCode::kInvalidInput,
+                      "the given display rectangle reaches outside the projectors' images");
+      }
+    }
+    out.rect = r;
+    out.cell_m = 0;
+  } else {
+    const Vec2 centroid = 0.5 * (lo + hi);
+    auto block = largestBlock(whole, aspect, (centroid - lo) / coarse);
+    if (!block)
+      return fail(ErrorCode::kNotFound, "no display rectangle fits the projectors' images");
+    const keystone::AxisRect rough = toRect(whole, *block);
+    // Four times finer around it: the true rectangle is at most one coarse cell
+    // larger on every side.
+    const double fine = coarse / 4;
+    const Vec2 margin = Vec2::Constant(2 * coarse) + Vec2(aspect, 1.0) * 2 * coarse;
+    const Vec2 flo =
+        (rough.centre - Vec2(rough.half_width, rough.half_height) - margin).cwiseMax(lo);
+    const Vec2 fhi =
+        (rough.centre + Vec2(rough.half_width, rough.half_height) + margin).cwiseMin(hi);
+    const Raster local = rasterize(out.footprints, flo, fhi, fine);
+    auto fine_block =
+        largestBlock(local, aspect, (rough.centre - flo) / fine, std::max(0, 4 * block->h - 4));
+    out.rect = fine_block ? toRect(local, *fine_block) : rough;
+    out.cell_m = fine_block ? fine : coarse;
+  }
+  // Coverage was sampled at cell centres: half a cell in from every side, the rectangle
+  // is inside the union; then exactly the content's aspect, about the chosen centre.
+  if (!options.rect) {
+    out.rect.half_width -= 0.5 * out.cell_m;
+    out.rect.half_height -= 0.5 * out.cell_m;
+  }
+  out.rect.half_width = std::min(out.rect.half_width, aspect * out.rect.half_height);
+  out.rect.half_height = out.rect.half_width / aspect;
+  const Mat3 c2w = contentToWall(out.rect, content_width, content_height);
+  for (const Mat3& p2f : out.plane_to_framebuffer) {
+    Mat3 H = p2f * c2w;
+    out.content_to_framebuffer.push_back(H / H(2, 2));
+  }
+  return out;
+}
+
+}  // namespace procam::blend

@@ -1,0 +1,189 @@
+// Four projectors on one flat wall shown as one display, end to end on the virtual
+// rig over the socket only: tiled_wall (2x2 projectors of 1280x800 with unmatched
+// responses, two cameras) with nothing handed over but the cameras' calibration
+// (TruthParts::kCamerasOnly) and the wall's plane as an installer measures it.
+// calibrate (route b′) maps each projector onto the wall, `keystone rig on` makes one
+// display of them ([Raskar02] §4.2.4) with feathered overlaps (eq. 4.3), and the
+// homographies the outputs draw with are judged with the TRUE projectors and wall.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <numbers>
+#include <opencv2/imgcodecs.hpp>
+
+#include "blend/tiled_display.hpp"
+#include "daemon_harness.hpp"
+#include "sim/scene_library.hpp"
+#include "truth_rig_file.hpp"
+
+namespace procam::itest {
+namespace {
+
+constexpr double kDeg = 180.0 / std::numbers::pi;
+const char* const kOutputs[] = {"proj_tl", "proj_tr", "proj_bl", "proj_br"};
+const json kWallPlane = {0.0, 1.0, 0.0, -3.0};  // y = 3, as measured by the installer
+
+Mat3 rowMajor3(const json& j) {
+  Mat3 m;
+  for (int i = 0; i < 9; ++i) m(i / 3, i % 3) = j[i].get<double>();
+  return m;
+}
+
+bool inFrame(const geom::CameraModel& p, const Vec2& x, double margin) {
+  return x.x() >= -0.5 + margin && x.y() >= -0.5 + margin && x.x() <= p.width - 0.5 - margin &&
+         x.y() <= p.height - 0.5 - margin;
+}
+
+// Where projector pixel `x` of the TRUE projector meets the TRUE wall y = 3.
+Vec3 onTheWall(const geom::CameraModel& p, const Vec2& x) {
+  const Mat3 Rt = p.pose.R.transpose();
+  const Vec3 centre = p.pose.center();
+  const Vec3 dir = Rt * p.K.matrix().inverse() * x.homogeneous();
+  return centre + dir * ((3.0 - centre.y()) / dir.y());
+}
+
+TEST(SimTiledWall, FourProjectorsCalibratedIntoOneSeamlessDisplay) {
+  auto scene = sim::resolveScene("tiled_wall");
+  ASSERT_TRUE(scene) << scene.error().message;
+  const sim::SceneState state = scene->at(0);
+  std::map<std::string, geom::CameraModel> truth;
+  for (const auto& p : state.projectors) truth[p.spec.name] = p.model;
+  TempDir dir;
+  DaemonProcess d(dir, simWithTruth(dir, "tiled_wall", TruthParts::kCamerasOnly));
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+
+  // Each projector through the camera that sees the whole wall.
+  const auto t0 = std::chrono::steady_clock::now();
+  int id = 1;
+  for (const char* output : kOutputs) {
+    const json request = {{"cmd", "calibrate"},  {"id", id},
+                          {"output", output},    {"cameras", {"cam_a"}},
+                          {"plane", kWallPlane}, {"mode", "gray+phase"},
+                          {"phase_steps", 3},    {"grid", 8},
+                          {"settle_frames", 0}};
+    auto started = c.call(request);
+    ASSERT_TRUE(started);
+    ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
+    auto done = finalReply(c, id, 240s);
+    ASSERT_TRUE(done) << d.log();
+    ASSERT_EQ((*done)["class"], "CALIBRATE") << done->dump();
+    std::printf("[ figures  ] %s: collineation RMS %.4f projector px, %d nodes\n", output,
+                (*done)["homography"]["rms_projector_px"].get<double>(),
+                (*done)["homography"]["inliers"].get<int>());
+    ++id;
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::printf("[ figures  ] four calibrations %.1f s\n", seconds);
+
+  // A 16:9 white slide on the one display.
+  constexpr int kW = 1600, kH = 900;
+  const std::string png = dir.file("slide.png");
+  ASSERT_TRUE(cv::imwrite(png, cv::Mat(kH, kW, CV_8UC3, cv::Scalar(255, 255, 255))));
+  auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", png}}, 30s);
+  ASSERT_TRUE(load);
+  ASSERT_EQ((*load)["class"], "CONTENT") << load->dump();
+  auto on = c.call({{"cmd", "keystone"}, {"action", "rig"}, {"enable", true}});
+  ASSERT_TRUE(on);
+  ASSERT_EQ((*on)["class"], "KEYSTONE") << on->dump();
+
+  // Every output draws its tile of the display.
+  std::map<std::string, Mat3> H;
+  json display;
+  const bool tiled = eventually(
+      [&] {
+        auto s = c.call({{"cmd", "status"}});
+        if (!s) return false;
+        display = (*s)["keystone"].value("display", json());
+        H.clear();
+        for (const json& o : (*s)["outputs"]["shown"]) {
+          if (o["source"] == "content" && o.contains("display") && o.contains("homography") &&
+              display.is_object() && display.value("content_size", json()) == json({kW, kH})) {
+            H[o["name"].get<std::string>()] = rowMajor3(o["homography"]);
+          }
+        }
+        return H.size() == 4;
+      },
+      30s);
+  ASSERT_TRUE(tiled) << display.dump() << "\n" << d.log();
+  EXPECT_EQ(display["outputs"].size(), 4u);
+
+  // Seams: a content point lit by two projectors lands, through the TRUE rig, where the
+  // other projector puts the same content point: within 0.3 px RMS, 1 px at most (in
+  // the other projector's pixels).
+  double sq = 0, worst = 0;
+  int pairs = 0;
+  for (int y = 0; y < kH; y += 10) {
+    for (int x = 0; x < kW; x += 10) {
+      const Vec3 content(x, y, 1);
+      for (const char* a : kOutputs) {
+        const Vec2 pa = (H[a] * content).hnormalized();
+        if (!inFrame(truth[a], pa, 1)) continue;
+        const Vec3 wall = onTheWall(truth[a], pa);
+        for (const char* b : kOutputs) {
+          if (std::string(a) >= b) continue;
+          const Vec2 pb = (H[b] * content).hnormalized();
+          if (!inFrame(truth[b], pb, 1)) continue;
+          const Vec2 seen = *truth[b].project(wall);
+          const double e = (seen - pb).norm();
+          sq += e * e;
+          worst = std::max(worst, e);
+          ++pairs;
+        }
+      }
+    }
+  }
+  ASSERT_GT(pairs, 1000);
+  const double rms = std::sqrt(sq / pairs);
+  std::printf("[ figures  ] seams: %d content points lit twice, RMS %.3f px, max %.3f px\n", pairs,
+              rms, worst);
+  EXPECT_LE(rms, 0.3);
+  EXPECT_LE(worst, 1.0);
+
+  // The display on the TRUE wall: its corners through a projector that shows them.
+  auto wallPoint = [&](const Vec2& content) -> std::optional<Vec3> {
+    for (const char* a : kOutputs) {
+      const Vec2 p = (H[a] * content.homogeneous()).hnormalized();
+      if (inFrame(truth[a], p, -1)) return onTheWall(truth[a], p);
+    }
+    return std::nullopt;
+  };
+  const auto tl = wallPoint({-0.5, -0.5}), tr = wallPoint({kW - 0.5, -0.5}),
+             bl = wallPoint({-0.5, kH - 0.5}), br = wallPoint({kW - 0.5, kH - 0.5});
+  ASSERT_TRUE(tl && tr && bl && br) << "a corner of the display is not lit";
+  const Vec3 top = *tr - *tl, left = *tl - *bl;
+  const double tilt_deg = std::atan2(top.z(), top.x()) * kDeg;
+  const double lean_deg = std::atan2(left.x(), left.z()) * kDeg;
+  const double aspect = top.norm() / left.norm() / (double(kW) / kH) - 1;
+  const double area =
+      0.5 * ((*tr - *tl).cross(*bl - *tl).norm() + (*tr - *br).cross(*bl - *br).norm());
+  // The optimum from the TRUE footprints.
+  std::vector<blend::DisplayTile> tiles;
+  const geom::Plane wall{Vec3(0, 1, 0), -3};
+  auto basis = geom::uprightBasis(wall, Vec3(0, 0, 1.5), Vec3(0, 3, 1.5));
+  ASSERT_TRUE(basis);
+  for (const char* a : kOutputs) {
+    auto to_image = geom::planeToImage(truth[a].K, truth[a].pose, *basis);
+    ASSERT_TRUE(to_image);
+    tiles.push_back({{*basis, to_image->inverse()}, truth[a].width, truth[a].height});
+  }
+  auto optimum = blend::solveTiledDisplay(tiles, kW, kH, {.raster_cells = 2048, .rect = {}});
+  ASSERT_TRUE(optimum) << optimum.error().message;
+  const double of_optimum = area / optimum->rect.area();
+  std::printf(
+      "[ figures  ] display %.3f x %.3f m: top edge %.4f deg off level, side %.4f deg off "
+      "plumb, aspect %+.4f %%, area %.2f %% of the optimum from the true footprints\n",
+      top.norm(), left.norm(), tilt_deg, lean_deg, 100 * aspect, 100 * of_optimum);
+  EXPECT_LE(std::abs(tilt_deg), 0.05);
+  EXPECT_LE(std::abs(lean_deg), 0.05);
+  EXPECT_LE(std::abs(aspect), 1e-3);
+  EXPECT_GE(of_optimum, 0.98);
+  EXPECT_LE(of_optimum, 1.0 + 2 * 4 * optimum->cell_m / left.norm());
+}
+
+}  // namespace
+}  // namespace procam::itest
