@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
+#include <set>
 #include <thread>
 
 #include "device_set.hpp"
@@ -83,8 +84,8 @@ tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const json& requ
   CalibrationArgs a;
   a.settle_frames = defaults.settle_frames;
   a.auto_settle = defaults.auto_settle;
-  static const char* const kKeys[] = {"mode",   "step",    "phase_steps", "grid", "settle_frames",
-                                      "output", "cameras", "plane",       "board"};
+  static const char* const kKeys[] = {"mode",   "step",    "phase_steps", "grid",  "settle_frames",
+                                      "output", "cameras", "plane",       "board", "projectors"};
   for (const auto& [key, value] : request.items()) {
     if (key == "cmd" || key == "id") continue;
     bool known = false;
@@ -119,6 +120,30 @@ tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const json& requ
       return tl::unexpected(std::string("\"output\" must be a device name"));
     }
     a.output = it->get<std::string>();
+  }
+  if (auto it = request.find("projectors"); it != request.end()) {
+    // The outputs the projectors are bound to, at most 64, no name twice; or "all".
+    if (*it == "all") {
+      a.all_outputs = true;
+    } else {
+      const bool names = it->is_array() && !it->empty() && it->size() <= 64 &&
+                         std::all_of(it->begin(), it->end(), [](const json& n) {
+                           return n.is_string() && !n.get<std::string>().empty() &&
+                                  n.get<std::string>().size() <= 256;
+                         });
+      std::set<std::string> seen;
+      if (names) {
+        for (const auto& n : *it) seen.insert(n.get<std::string>());
+      }
+      if (!names || seen.size() != it->size()) {
+        return tl::unexpected(std::string(
+            "\"projectors\" must be \"all\" or a list of 1 to 64 different output names"));
+      }
+      for (const auto& n : *it) a.outputs.push_back(n.get<std::string>());
+    }
+    if (request.contains("output")) {
+      return tl::unexpected(std::string("give either \"output\" or \"projectors\""));
+    }
   }
   if (auto it = request.find("cameras"); it != request.end()) {
     const bool names = it->is_array() && (it->size() == 1 || it->size() == 2) &&
@@ -201,6 +226,17 @@ tl::expected<calib::BoardPlane, CalibrationFailure> planeOfBoard(const Calibrati
 }
 
 }  // namespace
+
+tl::expected<void, CalibrationFailure> blankOutput(const CalibrationPlan& plan) {
+  const cv::Mat black(plan.set.options.height, plan.set.options.width, CV_8UC3, cv::Scalar::all(0));
+  procam_image frame = rgbImage(black);
+  char err[256] = {0};
+  const auto& raw = plan.output.device->raw();
+  if (int rc = raw.ops.output->show(raw.self, &frame, err, sizeof err - 1); rc != PROCAM_OK) {
+    return tl::unexpected(deviceFailure("output", plan.output.name, rc, "show black", err));
+  }
+  return {};
+}
 
 tl::expected<CalibrationOutcome, CalibrationFailure> runCalibration(const CalibrationPlan& plan,
                                                                     const CalibrationHooks& hooks) {

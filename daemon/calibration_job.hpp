@@ -28,10 +28,14 @@ struct CalibrationArgs {
   sl::Mode mode = sl::Mode::kGrayPhase;
   int step = 1;  // one code per `step` projector pixels
   int phase_steps = 8;
-  int grid = 8;                      // projector pixels between solved nodes
-  int settle_frames = 2;             // output frames to wait after showing a pattern
-  bool auto_settle = false;          // settle_frames "auto": measure the latency first
-  std::string output;                // empty: the first usable output
+  int grid = 8;              // projector pixels between solved nodes
+  int settle_frames = 2;     // output frames to wait after showing a pattern
+  bool auto_settle = false;  // settle_frames "auto": measure the latency first
+  std::string output;        // empty: the first usable output
+  // "projectors": these outputs one after the other into one rig model ("all": every
+  // usable output); empty: `output` alone.
+  std::vector<std::string> outputs;
+  bool all_outputs = false;
   std::vector<std::string> cameras;  // empty: the first usable ones; one name: route (b′)
   std::optional<geom::Plane> plane;  // the display plane (world): route (b′)
   // Route (b′) with the display plane found from this board fixed flat on it
@@ -111,6 +115,10 @@ CalibrationFailure deviceFailure(const char* family, const std::string& name, in
 cv::Mat grayImage(const procam_image& img);
 // Waits `seconds`, waking every 20 ms to honour a cancel; false when cancelled.
 bool waitCancellable(double seconds, const CalibrationHooks& hooks);
+
+// Shows black on the plan's output (its pattern size), so that it adds no light to
+// another projector's scan; on a worker.
+tl::expected<void, CalibrationFailure> blankOutput(const CalibrationPlan& plan);
 
 // Runs on a worker: blocks on the devices; never touches daemon state.
 tl::expected<CalibrationOutcome, CalibrationFailure> runCalibration(const CalibrationPlan& plan,

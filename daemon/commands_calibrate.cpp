@@ -265,14 +265,39 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
     return errorTo(client, req, code::kBusy,
                    "calibration " + calibration_.op + " is running; wait for it or cancel it");
   }
-  auto made = makePlan(devices_, *args, config_.calibration, rig_);
-  if (!made) return errorTo(client, req, made.error().code, made.error().message);
-  auto plan = std::make_shared<const CalibrationPlan>(std::move(*made));
+  // One plan per projector: `projectors` one after the other (same cameras, one rig
+  // model written once at the end), else `output` alone.
+  std::vector<std::string> outputs = args->outputs;
+  if (args->all_outputs) {
+    for (const auto& e : devices_.entries()) {
+      if (e.description.family == PROCAM_FAMILY_OUTPUT && e.usable()) outputs.push_back(e.name);
+    }
+    if (outputs.empty()) {
+      return errorTo(client, req, code::kUnavailable, "calibration needs a projector output");
+    }
+  }
+  if (outputs.empty()) outputs.push_back(args->output);
+  std::vector<std::shared_ptr<const CalibrationPlan>> plans;
+  for (const std::string& output : outputs) {
+    CalibrationArgs one = *args;
+    one.output = output;
+    auto made = makePlan(devices_, one, config_.calibration, rig_);
+    if (!made) return errorTo(client, req, made.error().code, made.error().message);
+    plans.push_back(std::make_shared<const CalibrationPlan>(std::move(*made)));
+  }
+  const auto& plan = plans.front();
 
   const std::string op_id = "op-" + std::to_string(next_operation_++);
   auto cancelled = std::make_shared<std::atomic<bool>>(false);
   operations_[op_id] = Operation{"calibrate", client, req.id, cancelled};
-  std::vector<std::string> used{plan->output.name};
+  std::vector<std::string> used;
+  json output_names = json::array();
+  int captures = 0;
+  for (const auto& p : plans) {
+    used.push_back(p->output.name);
+    output_names.push_back(p->output.name);
+    captures += p->captures();
+  }
   for (const auto& c : plan->cameras) used.push_back(c.device.name);
   // The gate closes here; a read the device manager has running on one of
   // these devices ends before the worker's first driver call (read_fence.hpp).
@@ -281,19 +306,21 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
   server_->hold(client);
   json cameras = json::array();
   for (const auto& c : plan->cameras) cameras.push_back(c.device.name);
-  const int captures = plan->captures();
-  replyTo(client, req, "CALIBRATE",
-          {{"operation", op_id},
-           {"state", "started"},
-           {"output", plan->output.name},
-           {"cameras", cameras},
-           {"route", plan->planar() ? "b'" : "a"},
-           {"mode", sl::toString(plan->set.options.mode)},
-           {"frames", plan->set.frames.size()},
-           {"captures", captures},
-           {"settle_frames", plan->auto_settle ? json("auto") : json(plan->settle_frames)}});
+  json started = {{"operation", op_id},
+                  {"state", "started"},
+                  {"output", plan->output.name},
+                  {"cameras", cameras},
+                  {"route", plan->planar() ? "b'" : "a"},
+                  {"mode", sl::toString(plan->set.options.mode)},
+                  {"frames", plan->set.frames.size()},
+                  {"captures", captures},
+                  {"settle_frames", plan->auto_settle ? json("auto") : json(plan->settle_frames)}};
+  if (plans.size() > 1 || !args->outputs.empty() || args->all_outputs) {
+    started["outputs"] = output_names;
+  }
+  replyTo(client, req, "CALIBRATE", started);
   logInfo("calibration " + op_id + ": " + std::to_string(plan->set.frames.size()) +
-          " pattern frames on '" + plan->output.name + "'");
+          " pattern frames on " + output_names.dump());
   auto progress = [op_id, captures](const CalibrationProgress& p) {
     return json{{"operation", op_id}, {"kind", "calibrate"},  {"fraction", p.fraction},
                 {"stage", p.stage},   {"capture", p.capture}, {"captures", captures}};
@@ -301,10 +328,41 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
   operationEvent(client, "progress", progress({0, "starting", 0}));
 
   const CalibrationHooks hooks = operationHooks(client, op_id, cancelled, progress);
-  compute_worker_->submit([this, client, req, op_id, cancelled, plan, progress, hooks, fence] {
+  using Outcomes = tl::expected<std::vector<CalibrationOutcome>, Failure>;
+  compute_worker_->submit([this, client, req, op_id, cancelled, plans, progress, hooks, fence,
+                           captures] {
     fence.wait();
-    auto result = runCalibration(*plan, hooks);
-    return [this, client, req, op_id, cancelled, plan, result, progress] {
+    // The projectors one after the other; progress over the whole run.
+    Outcomes result = std::vector<CalibrationOutcome>{};
+    // Projectors of the run that are not being scanned show black: their light would
+    // fall into the overlaps of the one that is.
+    if (plans.size() > 1) {
+      for (const auto& p : plans) {
+        if (auto ok = blankOutput(*p); !ok && result) result = tl::unexpected(ok.error());
+      }
+    }
+    int done = 0;
+    for (std::size_t i = 0; i < plans.size() && result; ++i) {
+      const double share = double(plans[i]->captures()) / std::max(1, captures);
+      const double before = double(done) / std::max(1, captures);
+      CalibrationHooks one{
+          hooks.cancelled, [&, share, before, done](const CalibrationProgress& p) {
+            hooks.progress({before + share * p.fraction, p.stage, done + p.capture});
+          }};
+      auto r = runCalibration(*plans[i], one);
+      if (!r) {
+        Failure f = r.error();
+        if (plans.size() > 1) f.message = "output '" + plans[i]->output.name + "': " + f.message;
+        result = tl::unexpected(f);
+      } else {
+        result->push_back(std::move(*r));
+        if (plans.size() > 1) {
+          if (auto ok = blankOutput(*plans[i]); !ok) result = tl::unexpected(ok.error());
+        }
+      }
+      done += plans[i]->captures();
+    }
+    return [this, client, req, op_id, cancelled, plans, result, progress, captures] {
       auto finish = [this, client, req, op_id](const json& reply, const Failure* failure) {
         operations_.erase(op_id);
         calibration_.op.clear();
@@ -333,19 +391,31 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
       }
       // From here on the result is written: a cancel no longer finds the operation.
       operations_.erase(op_id);
-      operationEvent(client, "progress", progress({0.98, "writing", plan->captures()}));
-      Learnt learnt =
-          result->planar ? learntByPlaneRoute(*plan, *result) : learntByStereoRoute(*plan, *result);
-      json reply = std::move(learnt.reply);
+      operationEvent(client, "progress", progress({0.98, "writing", captures}));
+      // Every projector's part merged into one update, written once: all or nothing.
+      rig::RigModel update;
+      std::map<std::string, std::string> meshes;
+      json reply, per_output = json::array();
+      for (std::size_t i = 0; i < plans.size(); ++i) {
+        const CalibrationOutcome& outcome = (*result)[i];
+        Learnt learnt = outcome.planar ? learntByPlaneRoute(*plans[i], outcome)
+                                       : learntByStereoRoute(*plans[i], outcome);
+        update = rig::mergeRig(std::move(update), learnt.update);
+        meshes.merge(learnt.meshes);
+        learnt.reply["output"] = plans[i]->output.name;
+        learnt.reply["decoded"] = outcome.decoded;
+        learnt.reply["settle_frames"] = outcome.settle_frames;
+        if (!outcome.latency.is_null()) learnt.reply["latency"] = outcome.latency;
+        if (i == 0) reply = learnt.reply;
+        per_output.push_back(std::move(learnt.reply));
+      }
+      if (plans.size() > 1) reply["outputs"] = per_output;
       reply["operation"] = op_id;
       reply["state"] = "done";
-      reply["decoded"] = result->decoded;
-      reply["settle_frames"] = result->settle_frames;
-      if (!result->latency.is_null()) reply["latency"] = result->latency;
-      // fsync may block: the I/O worker writes the mesh first, then rig.json
+      // fsync may block: the I/O worker writes the meshes first, then rig.json
       // (the previous versions stay as .bak; a failure leaves rig.json as it was).
-      io_worker_->submit([this, dir = options_.state_dir, update = std::move(learnt.update),
-                          meshes = std::move(learnt.meshes), reply, finish] {
+      io_worker_->submit([this, dir = options_.state_dir, update = std::move(update),
+                          meshes = std::move(meshes), reply, finish] {
         auto merged = mergeIntoRig(dir, update, meshes);
         return [this, merged, reply, finish, path = rigStateFile(dir).path()]() mutable {
           if (!merged) {

@@ -56,29 +56,49 @@ TEST(SimTiledWall, FourProjectorsCalibratedIntoOneSeamlessDisplay) {
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
 
-  // Each projector through the camera that sees the whole wall.
-  const auto t0 = std::chrono::steady_clock::now();
-  int id = 1;
-  for (const char* output : kOutputs) {
-    const json request = {{"cmd", "calibrate"},  {"id", id},
-                          {"output", output},    {"cameras", {"cam_a"}},
-                          {"plane", kWallPlane}, {"mode", "gray+phase"},
-                          {"phase_steps", 3},    {"grid", 8},
-                          {"settle_frames", 0}};
-    auto started = c.call(request);
-    ASSERT_TRUE(started);
-    ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
-    auto done = finalReply(c, id, 240s);
-    ASSERT_TRUE(done) << d.log();
-    ASSERT_EQ((*done)["class"], "CALIBRATE") << done->dump();
-    std::printf("[ figures  ] %s: collineation RMS %.4f projector px, %d nodes\n", output,
-                (*done)["homography"]["rms_projector_px"].get<double>(),
-                (*done)["homography"]["inliers"].get<int>());
-    ++id;
+  // Malformed projector lists are refused before anything is shown.
+  for (const json& bad : {json::array(), json({"proj_tl", "proj_tl"}), json("some"), json(7)}) {
+    auto r = c.call({{"cmd", "calibrate"}, {"projectors", bad}, {"plane", kWallPlane}});
+    ASSERT_TRUE(r);
+    EXPECT_EQ((*r)["code"], "bad-argument") << bad.dump() << " " << r->dump();
+    EXPECT_NE((*r)["message"].get<std::string>().find("\"projectors\" must be"), std::string::npos)
+        << r->dump();
   }
+  auto both = c.call({{"cmd", "calibrate"}, {"projectors", "all"}, {"output", "proj_tl"}});
+  ASSERT_TRUE(both);
+  EXPECT_EQ((*both)["code"], "bad-argument") << both->dump();
+  EXPECT_NE((*both)["message"].get<std::string>().find("either"), std::string::npos)
+      << both->dump();
+
+  // Every projector, one after the other, through the camera that sees the whole wall;
+  // one rig model written at the end.
+  const auto t0 = std::chrono::steady_clock::now();
+  const json request = {{"cmd", "calibrate"},  {"id", 1},
+                        {"projectors", "all"}, {"cameras", {"cam_a"}},
+                        {"plane", kWallPlane}, {"mode", "gray+phase"},
+                        {"phase_steps", 3},    {"grid", 8},
+                        {"settle_frames", 0}};
+  auto started = c.call(request);
+  ASSERT_TRUE(started);
+  ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
+  EXPECT_EQ((*started)["outputs"], json({"proj_tl", "proj_tr", "proj_bl", "proj_br"}));
+  auto done = finalReply(c, 1, 600s);
+  ASSERT_TRUE(done) << d.log();
+  ASSERT_EQ((*done)["class"], "CALIBRATE") << done->dump();
+  ASSERT_EQ((*done)["outputs"].size(), 4u) << done->dump();
+  for (const json& o : (*done)["outputs"]) {
+    std::printf("[ figures  ] %s: collineation RMS %.4f projector px, %d nodes\n",
+                o["output"].get<std::string>().c_str(),
+                o["homography"]["rms_projector_px"].get<double>(),
+                o["homography"]["inliers"].get<int>());
+    // Gray + phase decodes within 0.1 projector px RMS (ARCHITECTURE.md).
+    EXPECT_LT(o["homography"]["rms_projector_px"].get<double>(), 0.15);
+  }
+  EXPECT_EQ((*done)["rig"]["projectors"], 4);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::printf("[ figures  ] four calibrations %.1f s\n", seconds);
+  std::printf("[ figures  ] four projectors calibrated in %.1f s (%d captures)\n", seconds,
+              (*started)["captures"].get<int>());
 
   // A 16:9 white slide on the one display.
   constexpr int kW = 1600, kH = 900;
