@@ -5,6 +5,7 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <set>
+#include <span>
 #include <thread>
 
 #include "device_set.hpp"
@@ -84,8 +85,9 @@ tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const json& requ
   CalibrationArgs a;
   a.settle_frames = defaults.settle_frames;
   a.auto_settle = defaults.auto_settle;
-  static const char* const kKeys[] = {"mode",   "step",    "phase_steps", "grid",  "settle_frames",
-                                      "output", "cameras", "plane",       "board", "projectors"};
+  static const char* const kKeys[] = {"mode",          "step",       "phase_steps", "grid",
+                                      "settle_frames", "output",     "cameras",     "plane",
+                                      "board",         "projectors", "response"};
   for (const auto& [key, value] : request.items()) {
     if (key == "cmd" || key == "id") continue;
     bool known = false;
@@ -144,6 +146,10 @@ tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const json& requ
     if (request.contains("output")) {
       return tl::unexpected(std::string("give either \"output\" or \"projectors\""));
     }
+  }
+  if (auto it = request.find("response"); it != request.end()) {
+    if (!it->is_boolean()) return tl::unexpected(std::string("\"response\" must be true or false"));
+    a.response = it->get<bool>();
   }
   if (auto it = request.find("cameras"); it != request.end()) {
     const bool names = it->is_array() && (it->size() == 1 || it->size() == 2) &&
@@ -225,6 +231,58 @@ tl::expected<calib::BoardPlane, CalibrationFailure> planeOfBoard(const Calibrati
   return *plane;
 }
 
+// Shows `rgb` on the plan's output and waits `settle_frames` refreshes for it to reach
+// the screen ([Raskar02] §4.1.1 assumes a static projected image per capture); false
+// when cancelled meanwhile.
+tl::expected<bool, CalibrationFailure> showAndSettle(const CalibrationPlan& plan,
+                                                     const cv::Mat& rgb, const char* what,
+                                                     int settle_frames,
+                                                     const CalibrationHooks& hooks) {
+  procam_image frame = rgbImage(rgb);
+  char err[256] = {0};
+  const auto& raw = plan.output.device->raw();
+  if (int rc = raw.ops.output->show(raw.self, &frame, err, sizeof err - 1); rc != PROCAM_OK) {
+    return tl::unexpected(deviceFailure("output", plan.output.name, rc, what, err));
+  }
+  return waitCancellable(settle_frames / plan.refresh_hz, hooks);
+}
+
+// One frame of `cam` as a single-channel image.
+tl::expected<cv::Mat, CalibrationFailure> captureGray(const CalibrationCamera& cam) {
+  const auto& raw = cam.device.device->raw();
+  procam_image img{};
+  char err[256] = {0};
+  if (int rc = raw.ops.camera->capture(raw.self, 5000, &img, err, sizeof err - 1);
+      rc != PROCAM_OK) {
+    return tl::unexpected(deviceFailure("camera", cam.device.name, rc, "capture", err));
+  }
+  cv::Mat gray = grayImage(img);
+  if (gray.empty()) {
+    return tl::unexpected(CalibrationFailure{
+        code::kIo, "camera '" + cam.device.name + "' returned an unknown pixel format"});
+  }
+  return gray;
+}
+
+// The camera's mean at each ramp level over the pixels that decoded this projector
+// (flags 0), eroded by 3 pixels so that its blurred edge does not count.
+Result<blend::ProjectorResponse> rampResponse(const std::vector<cv::Mat>& ramp,
+                                              const cv::Mat& flags) {
+  cv::Mat mask = flags == 0;
+  cv::erode(mask, mask, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(7, 7)));
+  if (cv::countNonZero(mask) < 100) {
+    return fail(ErrorCode::kTooFewPoints, "fewer than 100 camera pixels see the projector");
+  }
+  std::vector<blend::RampSample> samples;
+  for (std::size_t i = 0; i < ramp.size(); ++i) {
+    if (ramp[i].size() != mask.size()) {
+      return fail(ErrorCode::kInvalidInput, "the ramp's captures changed size");
+    }
+    samples.push_back({CalibrationPlan::kRampLevels[i], cv::mean(ramp[i], mask)[0]});
+  }
+  return blend::fitResponse(samples);
+}
+
 }  // namespace
 
 tl::expected<void, CalibrationFailure> blankOutput(const CalibrationPlan& plan) {
@@ -265,39 +323,19 @@ tl::expected<CalibrationOutcome, CalibrationFailure> runCalibration(const Calibr
     outcome.latency = latencyJson(*measured, probe);
     start = 0.1;
   }
-  const auto& out_raw = plan.output.device->raw();
   std::vector<std::vector<cv::Mat>> captures(plan.cameras.size());
-  char err[256];
   int done = 0;
   for (std::size_t f = 0; f < plan.set.frames.size(); ++f) {
     if (hooks.cancelled()) return tl::unexpected(cancelled);
     cv::Mat rgb;
     cv::cvtColor(sl::renderFrame(plan.set, f), rgb, cv::COLOR_GRAY2RGB);
-    procam_image frame = rgbImage(rgb);
-    err[0] = '\0';
-    if (int rc = out_raw.ops.output->show(out_raw.self, &frame, err, sizeof err - 1);
-        rc != PROCAM_OK) {
-      return tl::unexpected(deviceFailure("output", plan.output.name, rc, "show a pattern", err));
-    }
-    // The frame reaches the screen within a few refreshes ([Raskar02] §4.1.1 assumes a
-    // static projected image per capture).
-    if (!waitCancellable(outcome.settle_frames / plan.refresh_hz, hooks))
-      return tl::unexpected(cancelled);
+    auto shown = showAndSettle(plan, rgb, "show a pattern", outcome.settle_frames, hooks);
+    if (!shown) return tl::unexpected(shown.error());
+    if (!*shown) return tl::unexpected(cancelled);
     for (std::size_t c = 0; c < plan.cameras.size(); ++c) {
-      const CalibrationCamera& cam = plan.cameras[c];
-      const auto& raw = cam.device.device->raw();
-      procam_image img{};
-      err[0] = '\0';
-      if (int rc = raw.ops.camera->capture(raw.self, 5000, &img, err, sizeof err - 1);
-          rc != PROCAM_OK) {
-        return tl::unexpected(deviceFailure("camera", cam.device.name, rc, "capture", err));
-      }
-      cv::Mat gray = grayImage(img);
-      if (gray.empty()) {
-        return tl::unexpected(CalibrationFailure{
-            code::kIo, "camera '" + cam.device.name + "' returned an unknown pixel format"});
-      }
-      captures[c].push_back(std::move(gray));
+      auto gray = captureGray(plan.cameras[c]);
+      if (!gray) return tl::unexpected(gray.error());
+      captures[c].push_back(std::move(*gray));
       ++done;
       hooks.progress({start + (0.9 - start) * done / total, "capturing", done});
       if (hooks.cancelled()) return tl::unexpected(cancelled);
@@ -309,6 +347,22 @@ tl::expected<CalibrationOutcome, CalibrationFailure> runCalibration(const Calibr
       if (!found) return tl::unexpected(found.error());
       outcome.board = *found;
     }
+  }
+  // The response ramp: grey levels on the whole frame, seen by the first camera.
+  std::vector<cv::Mat> ramp;
+  for (int level : plan.response ? std::span<const int>(CalibrationPlan::kRampLevels)
+                                 : std::span<const int>()) {
+    if (hooks.cancelled()) return tl::unexpected(cancelled);
+    const cv::Mat grey(plan.set.options.height, plan.set.options.width, CV_8UC3,
+                       cv::Scalar::all(level));
+    auto shown = showAndSettle(plan, grey, "show a grey", outcome.settle_frames, hooks);
+    if (!shown) return tl::unexpected(shown.error());
+    if (!*shown) return tl::unexpected(cancelled);
+    auto gray = captureGray(plan.cameras[0]);
+    if (!gray) return tl::unexpected(gray.error());
+    ramp.push_back(std::move(*gray));
+    ++done;
+    hooks.progress({start + (0.9 - start) * done / total, "capturing", done});
   }
   std::vector<calib::DecodedView> views;
   for (std::size_t c = 0; c < plan.cameras.size(); ++c) {
@@ -324,6 +378,15 @@ tl::expected<CalibrationOutcome, CalibrationFailure> runCalibration(const Calibr
                              "' decoded no pixel: it does not see the projected patterns"});
     }
     outcome.decoded.push_back(d->decoded);
+    if (c == 0 && !ramp.empty()) {
+      auto response = rampResponse(ramp, d->flags);
+      if (!response) {
+        return tl::unexpected(CalibrationFailure{
+            code::kFailed, "the response of output '" + plan.output.name + "' seen by camera '" +
+                               plan.cameras[0].device.name + "': " + response.error().message});
+      }
+      outcome.response = *response;
+    }
     views.push_back({plan.cameras[c].device.name, plan.cameras[c].model, std::move(*d)});
     if (hooks.cancelled()) return tl::unexpected(cancelled);
   }

@@ -5,6 +5,7 @@
 // (a) ([Raskar02] §4.1.1, two cameras) through calib::solveStereoRoute, the pipeline
 // procam-calibrate uses on files, or route (b′) ([Raskar02] §4.2.4, one camera and
 // the display plane) through calib::solvePlaneHomographyRoute.
+#include <array>
 #include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -12,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "blend/response.hpp"
 #include "calibration/board_plane.hpp"
 #include "calibration/plane_homography_route.hpp"
 #include "calibration/stereo_route.hpp"
@@ -42,6 +44,9 @@ struct CalibrationArgs {
   // (calib::parseBoard form), seen by the camera in the white frame.
   std::optional<calib::BoardSpec> board;
   std::string board_text;
+  // Also show a grey ramp and measure the projector's response and brightness
+  // (blend/response.hpp); null: only when several projectors are calibrated.
+  std::optional<bool> response;
 };
 
 // The message names the offending key; `defaults` ([calibration] of procamd.toml)
@@ -74,10 +79,16 @@ struct CalibrationPlan {
   bool plane_from_rig = false;             // the rig model's surface plane, not an argument
   std::optional<calib::BoardSpec> board;   // set: route (b′), the plane from this board
   std::string board_text;
+  bool response = false;  // a grey ramp after the patterns: the projector's response
 
   bool planar() const { return plane || board; }
 
-  int captures() const { return static_cast<int>(set.frames.size() * cameras.size()); }
+  int captures() const {
+    return static_cast<int>(set.frames.size() * cameras.size()) +
+           (response ? static_cast<int>(kRampLevels.size()) : 0);
+  }
+  // The grey levels of the response ramp.
+  static constexpr std::array<int, 9> kRampLevels = {0, 32, 64, 96, 128, 160, 192, 224, 255};
 };
 
 struct CalibrationProgress {
@@ -102,6 +113,7 @@ struct CalibrationOutcome {
   calib::StereoRouteResult route;                      // route (a)
   std::optional<calib::PlaneHomographyResult> planar;  // route (b′)
   std::optional<calib::BoardPlane> board;              // route (b′) on a board's plane
+  std::optional<blend::ProjectorResponse> response;    // from the grey ramp
   std::vector<int> decoded;                            // camera pixels decoded, per camera
   int settle_frames = 0;                               // waited after every pattern
   nlohmann::json latency;  // the measured latency (auto_settle; latencyJson), else null

@@ -109,6 +109,7 @@ tl::expected<CalibrationPlan, Failure> makePlan(DeviceSet& devices, const Calibr
   if (!set) return tl::unexpected(Failure{code::kBadArgument, set.error().message});
   plan.set = std::move(*set);
   plan.grid = args.grid;
+  plan.response = args.response.value_or(false);
   plan.settle_frames = args.settle_frames;
   plan.auto_settle = args.auto_settle;
   plan.latency = latency;
@@ -223,6 +224,13 @@ Learnt learntByPlaneRoute(const CalibrationPlan& plan, const CalibrationOutcome&
   return out;
 }
 
+// rig.json's photometric record of a projector: its response as the camera saw it.
+json responseJson(const blend::ProjectorResponse& r, const CalibrationCamera& camera) {
+  return {{"response_gamma", r.gamma}, {"black", r.black},   {"white", r.white},
+          {"fit_rms", r.rms},          {"levels", r.levels}, {"camera", camera.device.name},
+          {"measured", utcNow()}};
+}
+
 }  // namespace
 
 void Daemon::beginCalibrationOp(const std::string& op_id, std::vector<std::string> devices) {
@@ -281,6 +289,10 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
   for (const std::string& output : outputs) {
     CalibrationArgs one = *args;
     one.output = output;
+    // Several projectors are blended: measure their responses unless told not to.
+    if (!one.response && (outputs.size() > 1 || !args->outputs.empty() || args->all_outputs)) {
+      one.response = true;
+    }
     auto made = makePlan(devices_, one, config_.calibration, rig_);
     if (!made) return errorTo(client, req, made.error().code, made.error().message);
     plans.push_back(std::make_shared<const CalibrationPlan>(std::move(*made)));
@@ -400,6 +412,11 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
         const CalibrationOutcome& outcome = (*result)[i];
         Learnt learnt = outcome.planar ? learntByPlaneRoute(*plans[i], outcome)
                                        : learntByStereoRoute(*plans[i], outcome);
+        if (outcome.response) {
+          const json photometric = responseJson(*outcome.response, plans[i]->cameras[0]);
+          for (auto& p : learnt.update.projectors) p.photometric = photometric;
+          learnt.reply["response"] = photometric;
+        }
         update = rig::mergeRig(std::move(update), learnt.update);
         meshes.merge(learnt.meshes);
         learnt.reply["output"] = plans[i]->output.name;

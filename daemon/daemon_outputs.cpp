@@ -92,10 +92,10 @@ std::optional<OutputDraw> Daemon::planOutput(DeviceEntry& e, const OutputDrawPol
     return std::nullopt;
   }
   if (tile >= 0 && tiled->alpha[tile].size() == *mode) {
-    // Eq. 4.3 weights in linear light, through the assumed response ([Raskar02] §4.1.2).
-    static const render::Lut kWeightLut = *render::weightLutForGamma(kAssumedGamma);
+    // Eq. 4.3 weights in linear light, through the projector's response and its
+    // brightness gain ([Raskar02] §4.1.2).
     plan->setup.final_stage.alpha = tiled->alpha[tile];
-    plan->setup.final_stage.weight_lut = kWeightLut;
+    plan->setup.final_stage.weight_lut = tiled->weight_lut[tile];
   }
   const render::SceneTraits traits = sceneTraits(e.name, plan->mesh != nullptr);
   auto& st = k.output_state[e.name];

@@ -87,6 +87,11 @@ struct KeystoneRuntime {
     std::vector<std::string> outputs;  // in tile order
     blend::TiledDisplay display;
     std::vector<cv::Mat> alpha;  // per tile, CV_8UC1 (eq. 4.3 weights)
+    // Per tile, the weight table through its response and brightness gain: measured
+    // (rig.json photometric, every tile) or the assumed gamma and no gain.
+    std::vector<render::Lut> weight_lut;
+    std::vector<double> gamma, gain;
+    bool measured = false;
     int index(const std::string& output) const;
   };
   std::shared_ptr<const Tiled> tiled;  // the display in use, if any

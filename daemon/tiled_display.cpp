@@ -7,9 +7,11 @@
 // blend/feather.hpp). The display is made on the compute worker (the feathering
 // takes about half a second for four 1280x800 outputs) and kept until the content's
 // size, the outputs or the rig change.
+#include <cmath>
 #include <sstream>
 
 #include "blend/feather.hpp"
+#include "blend/response.hpp"
 #include "daemon.hpp"
 #include "log.hpp"
 
@@ -36,6 +38,24 @@ std::vector<std::pair<std::string, const rig::RigProjector*>> Daemon::rigTiles()
 
 namespace {
 
+// A projector's measured response (rig.json photometric), if it has one.
+std::optional<blend::ProjectorResponse> responseOf(const rig::RigProjector& p) {
+  const json& ph = p.photometric;
+  if (!ph.is_object()) return std::nullopt;
+  const auto number = [&](const char* key) {
+    const auto it = ph.find(key);
+    return it != ph.end() && it->is_number() ? it->get<double>() : std::nan("");
+  };
+  blend::ProjectorResponse r;
+  r.gamma = number("response_gamma");
+  r.black = number("black");
+  r.white = number("white");
+  if (!(r.gamma >= 1 && r.gamma <= 4) || !std::isfinite(r.black) || !(r.white > r.black)) {
+    return std::nullopt;
+  }
+  return r;
+}
+
 // What a display is made for: the content's size and every tile's mapping.
 std::string tiledKey(cv::Size content,
                      const std::vector<std::pair<std::string, const rig::RigProjector*>>& tiles) {
@@ -47,7 +67,7 @@ std::string tiledKey(cv::Size content,
     const auto& ph = *p->plane_homography;
     for (int i = 0; i < 9; ++i) key << ' ' << ph.H(i / 3, i % 3);
     key << ' ' << ph.basis.origin.transpose() << ' ' << ph.basis.u.transpose() << ' '
-        << ph.basis.v.transpose();
+        << ph.basis.v.transpose() << ' ' << p->photometric.dump();
   }
   return key.str();
 }
@@ -71,12 +91,14 @@ const KeystoneRuntime::Tiled* Daemon::tiledDisplay(cv::Size content) {
   k.tiling = true;
   std::vector<std::string> names;
   std::vector<blend::DisplayTile> input;
+  std::vector<blend::ProjectorResponse> responses;
   for (const auto& [name, p] : tiles) {
     names.push_back(name);
     input.push_back({*p->plane_homography, p->width, p->height});
+    if (auto r = responseOf(*p)) responses.push_back(*r);
   }
   logInfo("display across " + std::to_string(names.size()) + " outputs: solving");
-  compute_worker_->submit([this, key, content, names, input] {
+  compute_worker_->submit([this, key, content, names, input, responses] {
     auto made = std::make_shared<KeystoneRuntime::Tiled>();
     std::string error;
     auto display = blend::solveTiledDisplay(input, content.width, content.height);
@@ -89,6 +111,17 @@ const KeystoneRuntime::Tiled* Daemon::tiledDisplay(cv::Size content) {
       auto weights = blend::featherWeights(feather);
       if (weights) {
         for (const cv::Mat& w : *weights) made->alpha.push_back(blend::alphaMask(w));
+        // Brightness matched to the dimmest projector and weights in linear light, when
+        // every projector's response is measured; the assumed gamma otherwise.
+        made->measured = responses.size() == input.size();
+        const std::vector<double> gains = made->measured ? blend::matchedGains(responses)
+                                                         : std::vector<double>(input.size(), 1.0);
+        for (std::size_t t = 0; t < input.size(); ++t) {
+          const double gamma = made->measured ? responses[t].gamma : kAssumedGamma;
+          made->gamma.push_back(gamma);
+          made->gain.push_back(gains[t]);
+          made->weight_lut.push_back(*blend::weightLut(gamma, gains[t]));
+        }
         made->content = content;
         made->outputs = names;
         made->display = std::move(*display);
@@ -134,7 +167,10 @@ json Daemon::tiledDisplayJson() const {
   for (std::size_t t = 0; t < k.tiled->outputs.size(); ++t) {
     json quad = json::array();
     for (const Vec2& q : d.footprints[t]) quad.push_back({q.x(), q.y()});
-    tiles.push_back({{"output", k.tiled->outputs[t]}, {"footprint_m", quad}});
+    tiles.push_back({{"output", k.tiled->outputs[t]},
+                     {"footprint_m", quad},
+                     {"response_gamma", k.tiled->gamma[t]},
+                     {"gain", k.tiled->gain[t]}});
   }
   return {{"state", "ready"},
           {"outputs", k.tiled->outputs},
@@ -149,7 +185,9 @@ json Daemon::tiledDisplayJson() const {
             {"u", {d.basis.u.x(), d.basis.u.y(), d.basis.u.z()}},
             {"v", {d.basis.v.x(), d.basis.v.y(), d.basis.v.z()}}}},
           {"tiles", tiles},
-          {"blend", {{"weights", "feathered"}, {"response_gamma", kAssumedGamma}}}};
+          {"blend",
+           {{"weights", "feathered"},
+            {"response", k.tiled->measured ? "measured" : "assumed gamma 2.2"}}}};
 }
 
 }  // namespace procam::daemon

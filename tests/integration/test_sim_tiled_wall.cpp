@@ -13,9 +13,14 @@
 #include <fstream>
 #include <numbers>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
+#include "blend/feather.hpp"
+#include "blend/response.hpp"
 #include "blend/tiled_display.hpp"
 #include "daemon_harness.hpp"
+#include "render/cpu_renderer.hpp"
+#include "sim/renderer.hpp"
 #include "sim/scene_library.hpp"
 #include "truth_rig_file.hpp"
 
@@ -45,12 +50,124 @@ Vec3 onTheWall(const geom::CameraModel& p, const Vec2& x) {
   return centre + dir * ((3.0 - centre.y()) / dir.y());
 }
 
+// The display as the daemon reports it: per output its homography, the display
+// rectangle and basis, every image's footprint and the response and gain it blends with.
+struct Reported {
+  keystone::AxisRect rect;
+  geom::PlaneBasis basis;  // the display's, world
+  std::map<std::string, Mat3> H;
+  std::map<std::string, std::array<Vec2, 4>> footprint;
+  std::map<std::string, double> gamma, gain;
+};
+
+Reported reported(const json& display, const std::map<std::string, Mat3>& H) {
+  Reported r;
+  r.H = H;
+  r.rect.centre = Vec2(display["rect_m"]["centre"][0].get<double>(),
+                       display["rect_m"]["centre"][1].get<double>());
+  r.rect.half_width = 0.5 * display["rect_m"]["size"][0].get<double>();
+  r.rect.half_height = 0.5 * display["rect_m"]["size"][1].get<double>();
+  auto vec = [&](const char* key) {
+    const json& v = display["basis"][key];
+    return Vec3(v[0].get<double>(), v[1].get<double>(), v[2].get<double>());
+  };
+  r.basis.origin = vec("origin");
+  r.basis.u = vec("u");
+  r.basis.v = vec("v");
+  for (const json& t : display["tiles"]) {
+    const std::string name = t["output"].get<std::string>();
+    for (int k = 0; k < 4; ++k) {
+      r.footprint[name][k] =
+          Vec2(t["footprint_m"][k][0].get<double>(), t["footprint_m"][k][1].get<double>());
+    }
+    r.gamma[name] = t["response_gamma"].get<double>();
+    r.gain[name] = t["gain"].get<double>();
+  }
+  return r;
+}
+
+// White content through each output's homography, feathering weights and weight table
+// (the daemon's render setup, rebuilt from what it reports), lit by the TRUE projectors
+// (their own gamma and brightness) and seen from the scene's viewer in linear light:
+// the largest relative step between neighbouring viewer pixels over the display (inset
+// by 3 %) and its uniformity (min / max). `gamma`/`gain` override the reported ones.
+struct Luminance {
+  double step = 0, uniformity = 0;
+  Vec2 at = Vec2::Zero();  // viewer pixel of the largest step
+};
+Luminance whiteSeenByTheViewer(const sim::Scene& scene, const sim::SceneState& state,
+                               const Reported& r, int kW, int kH, bool matched) {
+  const Mat3 c2w = blend::contentToWall(r.rect, kW, kH);
+  std::vector<blend::FeatherTile> tiles;
+  std::vector<std::string> names;
+  for (const auto& [name, H] : r.H) {
+    names.push_back(name);
+    tiles.push_back({r.footprint.at(name), H * c2w.inverse(), 1280, 800});
+  }
+  auto weights = blend::featherWeights(tiles);
+  EXPECT_TRUE(weights);
+  if (!weights) return {};
+  const cv::Mat white(kH, kW, CV_8UC4, cv::Scalar::all(255));
+  sim::Framebuffers shown;
+  for (std::size_t t = 0; t < names.size(); ++t) {
+    render::RenderSetup setup;
+    setup.output_size = cv::Size(1280, 800);
+    setup.content_size = cv::Size(kW, kH);
+    setup.homography = r.H.at(names[t]);
+    setup.final_stage.alpha = blend::alphaMask((*weights)[t]);
+    setup.final_stage.weight_lut = *blend::weightLut(matched ? r.gamma.at(names[t]) : 2.2,
+                                                     matched ? r.gain.at(names[t]) : 1.0);
+    render::CpuRenderer cpu;
+    EXPECT_TRUE(cpu.configure(setup));
+    EXPECT_TRUE(cpu.render({&white, nullptr, 1}));
+    cv::Mat bgr;
+    cv::cvtColor(cpu.frame(), bgr, cv::COLOR_RGBA2BGR);
+    shown[names[t]] = bgr;
+  }
+  auto lit = sim::Renderer::create(scene, state, shown);
+  EXPECT_TRUE(lit);
+  if (!lit) return {};
+  const cv::Mat view = lit->renderViewer(4);
+  // Viewer pixels whose wall point lies inside the inset display rectangle.
+  const geom::CameraModel& eye = state.viewer;
+  Luminance out;
+  double lo = 1e9, hi = 0;
+  auto inside = [&](int x, int y) {
+    auto ray = eye.backproject(Vec2(x, y));
+    if (!ray || !(ray->dir.y() > 0)) return false;
+    const Vec3 p = ray->origin + ray->dir * ((3.0 - ray->origin.y()) / ray->dir.y());
+    const Vec2 q = r.basis.toPlane(p) - r.rect.centre;
+    return std::abs(q.x()) < 0.97 * r.rect.half_width &&
+           std::abs(q.y()) < 0.97 * r.rect.half_height;
+  };
+  for (int y = 0; y + 1 < view.rows; ++y) {
+    for (int x = 0; x + 1 < view.cols; ++x) {
+      if (!inside(x, y) || !inside(x + 1, y + 1)) continue;
+      const double l = view.at<cv::Vec3f>(y, x)[0];
+      const double right = view.at<cv::Vec3f>(y, x + 1)[0], down = view.at<cv::Vec3f>(y + 1, x)[0];
+      const double st = std::max(std::abs(right - l) / l, std::abs(down - l) / l);
+      if (st > out.step) {
+        out.step = st;
+        out.at = Vec2(x, y);
+      }
+      lo = std::min(lo, l);
+      hi = std::max(hi, l);
+    }
+  }
+  out.uniformity = hi > 0 ? lo / hi : 0;
+  return out;
+}
+
 TEST(SimTiledWall, FourProjectorsCalibratedIntoOneSeamlessDisplay) {
   auto scene = sim::resolveScene("tiled_wall");
   ASSERT_TRUE(scene) << scene.error().message;
   const sim::SceneState state = scene->at(0);
   std::map<std::string, geom::CameraModel> truth;
-  for (const auto& p : state.projectors) truth[p.spec.name] = p.model;
+  std::map<std::string, sim::ProjectorSpec> spec;
+  for (const auto& p : state.projectors) {
+    truth[p.spec.name] = p.model;
+    spec[p.spec.name] = p.spec;
+  }
   TempDir dir;
   DaemonProcess d(dir, simWithTruth(dir, "tiled_wall", TruthParts::kCamerasOnly));
   ASSERT_TRUE(d.started()) << d.log();
@@ -93,6 +210,14 @@ TEST(SimTiledWall, FourProjectorsCalibratedIntoOneSeamlessDisplay) {
                 o["homography"]["inliers"].get<int>());
     // Gray + phase decodes within 0.1 projector px RMS (ARCHITECTURE.md).
     EXPECT_LT(o["homography"]["rms_projector_px"].get<double>(), 0.15);
+    // The response from the grey ramp, through a linear camera: its mean over some
+    // 100k pixels at levels of 5-170 units fixes gamma to about 0.01; 0.05 allowed.
+    const std::string name = o["output"].get<std::string>();
+    const double gamma = o["response"]["response_gamma"].get<double>();
+    std::printf("[ figures  ] %s: response gamma %.4f (true %.1f), white %.1f, black %.2f\n",
+                name.c_str(), gamma, spec[name].gamma, o["response"]["white"].get<double>(),
+                o["response"]["black"].get<double>());
+    EXPECT_NEAR(gamma, spec[name].gamma, 0.05) << name;
   }
   EXPECT_EQ((*done)["rig"]["projectors"], 4);
   const double seconds =
@@ -131,6 +256,18 @@ TEST(SimTiledWall, FourProjectorsCalibratedIntoOneSeamlessDisplay) {
       30s);
   ASSERT_TRUE(tiled) << display.dump() << "\n" << d.log();
   EXPECT_EQ(display["outputs"].size(), 4u);
+  // Brightness matched to the dimmest projector: gains follow the true brightness
+  // (9, 10, 11, 13) to within the projectors' different views of the camera (2 %).
+  EXPECT_EQ(display["blend"]["response"], "measured") << display.dump();
+  double dimmest = 1e9;
+  for (const auto& [name, s] : spec) dimmest = std::min(dimmest, s.brightness);
+  for (const json& t : display["tiles"]) {
+    const std::string name = t["output"].get<std::string>();
+    const double expected = dimmest / spec[name].brightness;
+    std::printf("[ figures  ] %s: gain %.4f (true brightness ratio %.4f)\n", name.c_str(),
+                t["gain"].get<double>(), expected);
+    EXPECT_NEAR(t["gain"].get<double>(), expected, 0.02) << name;
+  }
 
   // Seams: a content point lit by two projectors lands, through the TRUE rig, where the
   // other projector puts the same content point: within 0.3 px RMS, 1 px at most (in
@@ -202,6 +339,18 @@ TEST(SimTiledWall, FourProjectorsCalibratedIntoOneSeamlessDisplay) {
   EXPECT_LE(std::abs(lean_deg), 0.05);
   EXPECT_LE(std::abs(aspect), 1e-3);
   EXPECT_GE(of_optimum, 0.98);
+
+  // Luminance: white seen by the viewer in linear light has no step above 2 % between
+  // neighbouring pixels over the display (a seam would step by the overlap's error).
+  const Reported rep = reported(display, H);
+  const Luminance before = whiteSeenByTheViewer(*scene, state, rep, kW, kH, false);
+  const Luminance after = whiteSeenByTheViewer(*scene, state, rep, kW, kH, true);
+  std::printf(
+      "[ figures  ] white seen by the viewer: largest step %.2f %% at viewer pixel (%.0f, %.0f) "
+      "(assumed gamma 2.2, no gains: %.2f %%), uniformity min/max %.3f (%.3f)\n",
+      100 * after.step, after.at.x(), after.at.y(), 100 * before.step, after.uniformity,
+      before.uniformity);
+  EXPECT_LE(after.step, 0.02);
   EXPECT_LE(of_optimum, 1.0 + 2 * 4 * optimum->cell_m / left.norm());
 }
 
