@@ -194,6 +194,11 @@ tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const json& requ
           "checker:COLSxROWS:SQUARE_M or charuco:COLSxROWS:SQUARE_M:MARKER_M (metres): " +
           spec.error().message);
     }
+    // Bounded: the detector's work and memory grow with the board's cells.
+    if (spec->cols > 64 || spec->rows > 64 || !(spec->square_m >= 0.001 && spec->square_m <= 10)) {
+      return tl::unexpected(std::string(
+          "\"board\" must have at most 64 x 64 cells of 1 mm to 10 m (a board on a wall)"));
+    }
     if (a.plane) {
       return tl::unexpected(
           std::string("give either \"plane\" or \"board\": both say where the display plane is"));

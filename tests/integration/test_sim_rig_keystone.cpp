@@ -209,7 +209,8 @@ TEST(SimRigKeystone, WallFoundFromABoardOnItKeystonesFromTheRig) {
   Connection c(d.socketPath());
 
   // Malformed boards are refused before anything is shown.
-  for (const json& bad : {json("aprilgrid:6x4"), json("poster:6x4:0.15"), json(42)}) {
+  for (const json& bad : {json("aprilgrid:6x4"), json("poster:6x4:0.15"), json(42),
+                          json("aprilgrid:100000x100000:0.15"), json("checker:9x6:1e9")}) {
     json request = calibrateRequest(5, nullptr);
     request["board"] = bad;
     auto r = c.call(request);
