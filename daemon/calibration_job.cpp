@@ -195,9 +195,12 @@ tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const json& requ
           spec.error().message);
     }
     // Bounded: the detector's work and memory grow with the board's cells.
-    if (spec->cols > 64 || spec->rows > 64 || !(spec->square_m >= 0.001 && spec->square_m <= 10)) {
+    if (spec->cols > 64 || spec->rows > 64 || !(spec->square_m >= 0.001 && spec->square_m <= 10) ||
+        !(spec->gap_m >= 0 && spec->gap_m <= 10 * spec->square_m) ||
+        (spec->kind == calib::BoardKind::kAprilGrid && spec->cols * spec->rows > 587)) {
       return tl::unexpected(std::string(
-          "\"board\" must have at most 64 x 64 cells of 1 mm to 10 m (a board on a wall)"));
+          "\"board\" must have at most 64 x 64 cells of 1 mm to 10 m, a gap of at most 10 "
+          "cells and, for aprilgrid, at most 587 tags (tag36h11)"));
     }
     if (a.plane) {
       return tl::unexpected(

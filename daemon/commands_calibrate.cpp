@@ -285,6 +285,12 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
     }
   }
   if (outputs.empty()) outputs.push_back(args->output);
+  if (args->board && outputs.size() > 1) {
+    // Each projector's run would find the board again, lit by that projector alone.
+    return errorTo(client, req, code::kBadArgument,
+                   "\"board\" finds the plane for one projector: calibrate one projector with it "
+                   "(the plane goes into the rig model), then the others without it");
+  }
   std::vector<std::shared_ptr<const CalibrationPlan>> plans;
   for (const std::string& output : outputs) {
     CalibrationArgs one = *args;

@@ -87,6 +87,7 @@ const KeystoneRuntime::Tiled* Daemon::tiledDisplay(cv::Size content) {
   if (key == k.tiled_key) return k.tiled.get();  // made, failed, or on its way
   k.tiled_key = key;
   k.tiled_error.clear();
+  k.tiled.reset();               // made for something else: no output draws with it meanwhile
   if (k.tiling) return nullptr;  // the job running sees the new key when it ends
   k.tiling = true;
   std::vector<std::string> names;
@@ -120,7 +121,12 @@ const KeystoneRuntime::Tiled* Daemon::tiledDisplay(cv::Size content) {
           const double gamma = made->measured ? responses[t].gamma : kAssumedGamma;
           made->gamma.push_back(gamma);
           made->gain.push_back(gains[t]);
-          made->weight_lut.push_back(*blend::weightLut(gamma, gains[t]));
+          auto lut = blend::weightLut(gamma, gains[t]);
+          if (!lut) {
+            error = lut.error().message;
+            break;
+          }
+          made->weight_lut.push_back(*lut);
         }
         made->content = content;
         made->outputs = names;
