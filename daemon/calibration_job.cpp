@@ -295,12 +295,9 @@ Result<blend::ProjectorResponse> rampResponse(const std::vector<cv::Mat>& ramp,
 
 tl::expected<void, CalibrationFailure> blankOutput(const CalibrationPlan& plan) {
   const cv::Mat black(plan.set.options.height, plan.set.options.width, CV_8UC3, cv::Scalar::all(0));
-  procam_image frame = rgbImage(black);
-  char err[256] = {0};
-  const auto& raw = plan.output.device->raw();
-  if (int rc = raw.ops.output->show(raw.self, &frame, err, sizeof err - 1); rc != PROCAM_OK) {
-    return tl::unexpected(deviceFailure("output", plan.output.name, rc, "show black", err));
-  }
+  const CalibrationHooks no_cancel{[] { return false; }, {}};
+  auto shown = showAndSettle(plan, black, "show black", 0, no_cancel);
+  if (!shown) return tl::unexpected(shown.error());
   return {};
 }
 

@@ -15,6 +15,9 @@ bool sameStage(const FinalStage& a, const FinalStage& b) {
   if (a.weight_lut != b.weight_lut || a.output_lut != b.output_lut) return false;
   if (a.alpha.empty() || b.alpha.empty()) return a.alpha.empty() == b.alpha.empty();
   if (a.alpha.size() != b.alpha.size() || a.alpha.type() != b.alpha.type()) return false;
+  // One buffer (a mask kept and handed to every plan, as a tiled display's is): equal
+  // without reading its megabyte on every refresh.
+  if (a.alpha.data == b.alpha.data && a.alpha.step == b.alpha.step) return true;
   for (int y = 0; y < a.alpha.rows; ++y) {
     if (std::memcmp(a.alpha.ptr(y), b.alpha.ptr(y), a.alpha.cols * a.alpha.elemSize()) != 0) {
       return false;

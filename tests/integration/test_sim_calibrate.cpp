@@ -221,6 +221,19 @@ TEST(SimCalibrate, WritesRigJsonWithTheProjectorsIntrinsics) {
   EXPECT_EQ((*status)["operations"], json::array());
 }
 
+// Runs calibrate to a successful final reply (fatal test failures otherwise), handed
+// back in `reply` when given.
+void calibrateToTheEnd(Connection& c, const DaemonProcess& d, json* reply = nullptr) {
+  auto started = c.call(calibrateRequest(1));
+  ASSERT_TRUE(started);
+  ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
+  CalibrateRun run;
+  follow(c, 1, run);
+  ASSERT_TRUE(run.reply) << d.log();
+  ASSERT_EQ((*run.reply)["class"], "CALIBRATE") << run.reply->dump();
+  if (reply) *reply = *run.reply;
+}
+
 // The projector at its full 1280x800 with the cameras at 512x384: one camera pixel
 // spans ~3.3 projector pixels, and the same tolerances hold.
 // Also: the run merges into a rig that holds another projector and keeps it, and 3D
@@ -237,14 +250,9 @@ TEST(SimCalibrate, CamerasCoarserThanTheProjector) {
       c.call({{"cmd", "content"}, {"action", "load"}, {"path", dir.file("cube.obj")}}, 30s);
   ASSERT_TRUE(before);
   EXPECT_EQ((*before)["code"], "unavailable") << before->dump();  // no projector on 'proj' yet
-  auto started = c.call(calibrateRequest(1));
-  ASSERT_TRUE(started);
-  ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
-  CalibrateRun run;
-  follow(c, 1, run);
-  ASSERT_TRUE(run.reply) << d.log();
-  ASSERT_EQ((*run.reply)["class"], "CALIBRATE") << run.reply->dump();
-  expectRigMatchesTruth(dir, *run.reply, scene, 1280);
+  json reply;
+  ASSERT_NO_FATAL_FAILURE(calibrateToTheEnd(c, d, &reply));
+  expectRigMatchesTruth(dir, reply, scene, 1280);
   const json was = json::parse(previous);
   const json now = json::parse(readFile(dir.path() + "/state/rig.json"));
   ASSERT_EQ(now["projectors"].size(), 2u);
@@ -452,17 +460,6 @@ DaemonProcess::Launch cornerWithViewer(const TempDir& dir, const std::string& sc
                                {},
                                -1,
                                true};
-}
-
-// Runs calibrate to a successful final reply (fatal test failures otherwise).
-void calibrateToTheEnd(Connection& c, const DaemonProcess& d) {
-  auto started = c.call(calibrateRequest(1));
-  ASSERT_TRUE(started);
-  ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
-  CalibrateRun run;
-  follow(c, 1, run);
-  ASSERT_TRUE(run.reply) << d.log();
-  ASSERT_EQ((*run.reply)["class"], "CALIBRATE") << run.reply->dump();
 }
 
 // The first output's status entry once it shows content through the lookup warp.
