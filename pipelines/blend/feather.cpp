@@ -108,7 +108,7 @@ Result<std::vector<cv::Mat>> featherWeights(std::span<const FeatherTile> tiles, 
             continue;
           }
           const Vec2 p = h.head<2>() / h.z();
-          const Vec2 r = toRaster(p) - Vec2(0.5, 0.5);  // cell centres at integers
+          const Vec2 r = toRaster(p);  // the fill's coordinates: cell centres at integers
           double own = 0, sum = 0;
           for (std::size_t i = 0; i < tiles.size(); ++i) {
             if (i != m && insideDistance(tiles[i].footprint, p) <= 0) continue;
