@@ -19,6 +19,24 @@ void Daemon::errorTo(ClientId client, const proto::Request& req, const char* err
   server_->send(client, proto::error(req.id, error_code, message));
 }
 
+WorkerPool::Failure Daemon::answerFailure(ClientId client, const proto::Request& req) {
+  return [this, client, req](const std::string& what) {
+    errorTo(client, req, proto::code::kInternal, "the job failed: " + what);
+    server_->release(client);
+  };
+}
+
+bool Daemon::refuseOverJobLimit(ClientId client, const proto::Request& req) {
+  const size_t queued = io_worker_->queued(client) + compute_worker_->queued(client);
+  const auto limit = config_.limits.client_jobs;
+  if (queued < limit) return false;
+  errorTo(client, req, proto::code::kTooLarge,
+          "this client has " + std::to_string(queued) +
+              " jobs queued already ([limits] client_jobs = " + std::to_string(limit) +
+              "): wait for their replies");
+  return true;
+}
+
 void Daemon::broadcast(const std::string& event, json body) {
   const std::string line = proto::event(event, std::move(body));
   // Copy the ids: a send may drop a slow watcher (removed later, on reap).

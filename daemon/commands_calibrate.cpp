@@ -347,114 +347,133 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
 
   const CalibrationHooks hooks = operationHooks(client, op_id, cancelled, progress);
   using Outcomes = tl::expected<std::vector<CalibrationOutcome>, Failure>;
-  compute_worker_->submit([this, client, req, op_id, cancelled, plans, progress, hooks, fence,
-                           captures] {
-    fence.wait();
-    // The projectors one after the other; progress over the whole run.
-    Outcomes result = std::vector<CalibrationOutcome>{};
-    // Projectors of the run that are not being scanned show black: their light would
-    // fall into the overlaps of the one that is.
-    if (plans.size() > 1) {
-      for (const auto& p : plans) {
-        if (auto ok = blankOutput(*p); !ok && result) result = tl::unexpected(ok.error());
-      }
-    }
-    int done = 0;
-    for (std::size_t i = 0; i < plans.size() && result; ++i) {
-      const double share = double(plans[i]->captures()) / std::max(1, captures);
-      const double before = double(done) / std::max(1, captures);
-      CalibrationHooks one{
-          hooks.cancelled, [&, share, before, done](const CalibrationProgress& p) {
-            hooks.progress({before + share * p.fraction, p.stage, done + p.capture});
-          }};
-      auto r = runCalibration(*plans[i], one);
-      if (!r) {
-        Failure f = r.error();
-        if (plans.size() > 1) f.message = "output '" + plans[i]->output.name + "': " + f.message;
-        result = tl::unexpected(f);
-      } else {
-        result->push_back(std::move(*r));
+  compute_worker_->submit(
+      [this, client, req, op_id, cancelled, plans, progress, hooks, fence, captures] {
+        fence.wait();
+        // The projectors one after the other; progress over the whole run.
+        Outcomes result = std::vector<CalibrationOutcome>{};
+        // Projectors of the run that are not being scanned show black: their light would
+        // fall into the overlaps of the one that is.
         if (plans.size() > 1) {
-          if (auto ok = blankOutput(*plans[i]); !ok) result = tl::unexpected(ok.error());
+          for (const auto& p : plans) {
+            if (auto ok = blankOutput(*p); !ok && result) result = tl::unexpected(ok.error());
+          }
         }
-      }
-      done += plans[i]->captures();
-    }
-    return [this, client, req, op_id, cancelled, plans, result, progress, captures] {
-      auto finish = [this, client, req, op_id](const json& reply, const Failure* failure) {
-        operations_.erase(op_id);
-        calibration_.op.clear();
-        json finished = {{"operation", op_id}, {"kind", "calibrate"}, {"ok", failure == nullptr}};
-        if (failure) {
-          finished["error"] = failure->message;
-          logWarning("calibration " + op_id + ": " + failure->message);
-          errorTo(client, req, failure->code, failure->message);
-        } else {
-          replyTo(client, req, "CALIBRATE", reply);
+        int done = 0;
+        for (std::size_t i = 0; i < plans.size() && result; ++i) {
+          const double share = double(plans[i]->captures()) / std::max(1, captures);
+          const double before = double(done) / std::max(1, captures);
+          CalibrationHooks one{
+              hooks.cancelled, [&, share, before, done](const CalibrationProgress& p) {
+                hooks.progress({before + share * p.fraction, p.stage, done + p.capture});
+              }};
+          auto r = runCalibration(*plans[i], one);
+          if (!r) {
+            Failure f = r.error();
+            if (plans.size() > 1)
+              f.message = "output '" + plans[i]->output.name + "': " + f.message;
+            result = tl::unexpected(f);
+          } else {
+            result->push_back(std::move(*r));
+            if (plans.size() > 1) {
+              if (auto ok = blankOutput(*plans[i]); !ok) result = tl::unexpected(ok.error());
+            }
+          }
+          done += plans[i]->captures();
         }
-        operationEvent(client, "finished", finished);
-        server_->release(client);  // after the reply: a half-closed client may close now
-        // The device manager closes a lost device and retries it (or an ended one).
-        if (failure && closesDevice(failure->rc)) {
-          device_manager_->report(failure->device, failure->rc, failure->message);
-        }
-        refreshOutputs();  // what the outputs showed before the pattern frames
-      };
-      if (!result || cancelled->load()) {
-        Failure f = result ? Failure{code::kCancelled, "calibration cancelled"} : result.error();
-        if (f.code == code::kCancelled && !calibration_.removed.empty()) {
-          f.message = calibration_.removed;
-        }
-        return finish({}, &f);
-      }
-      // From here on the result is written: a cancel no longer finds the operation.
-      operations_.erase(op_id);
-      operationEvent(client, "progress", progress({0.98, "writing", captures}));
-      // Every projector's part merged into one update, written once: all or nothing.
-      rig::RigModel update;
-      std::map<std::string, std::string> meshes;
-      json reply, per_output = json::array();
-      for (std::size_t i = 0; i < plans.size(); ++i) {
-        const CalibrationOutcome& outcome = (*result)[i];
-        Learnt learnt = outcome.planar ? learntByPlaneRoute(*plans[i], outcome)
-                                       : learntByStereoRoute(*plans[i], outcome);
-        if (outcome.response) {
-          const json photometric = responseJson(*outcome.response, plans[i]->cameras[0]);
-          for (auto& p : learnt.update.projectors) p.photometric = photometric;
-          learnt.reply["response"] = photometric;
-        }
-        update = rig::mergeRig(std::move(update), learnt.update);
-        meshes.merge(learnt.meshes);
-        learnt.reply["output"] = plans[i]->output.name;
-        learnt.reply["decoded"] = outcome.decoded;
-        learnt.reply["settle_frames"] = outcome.settle_frames;
-        if (!outcome.latency.is_null()) learnt.reply["latency"] = outcome.latency;
-        if (i == 0) reply = learnt.reply;
-        per_output.push_back(std::move(learnt.reply));
-      }
-      if (plans.size() > 1) reply["outputs"] = per_output;
-      reply["operation"] = op_id;
-      reply["state"] = "done";
-      // fsync may block: the I/O worker writes the meshes first, then rig.json
-      // (the previous versions stay as .bak; a failure leaves rig.json as it was).
-      io_worker_->submit([this, dir = options_.state_dir, update = std::move(update),
-                          meshes = std::move(meshes), reply, finish] {
-        auto merged = mergeIntoRig(dir, update, meshes);
-        return [this, merged, reply, finish, path = rigStateFile(dir).path()]() mutable {
-          if (!merged) {
-            const Failure f{code::kIo, "rig.json not written: " + merged.error().message};
+        return [this, client, req, op_id, cancelled, plans, result, progress, captures] {
+          auto finish = [this, client, req, op_id](const json& reply, const Failure* failure) {
+            operations_.erase(op_id);
+            calibration_.op.clear();
+            json finished = {
+                {"operation", op_id}, {"kind", "calibrate"}, {"ok", failure == nullptr}};
+            if (failure) {
+              finished["error"] = failure->message;
+              logWarning("calibration " + op_id + ": " + failure->message);
+              errorTo(client, req, failure->code, failure->message);
+            } else {
+              replyTo(client, req, "CALIBRATE", reply);
+            }
+            operationEvent(client, "finished", finished);
+            server_->release(client);  // after the reply: a half-closed client may close now
+            // The device manager closes a lost device and retries it (or an ended one).
+            if (failure && closesDevice(failure->rc)) {
+              device_manager_->report(failure->device, failure->rc, failure->message);
+            }
+            refreshOutputs();  // what the outputs showed before the pattern frames
+          };
+          if (!result || cancelled->load()) {
+            Failure f =
+                result ? Failure{code::kCancelled, "calibration cancelled"} : result.error();
+            if (f.code == code::kCancelled && !calibration_.removed.empty()) {
+              f.message = calibration_.removed;
+            }
             return finish({}, &f);
           }
-          rig_ = *merged;
-          reply["path"] = path;
-          reply["rig"] = {{"cameras", rig_.cameras.size()}, {"projectors", rig_.projectors.size()}};
-          logInfo("calibration written to " + path);
-          finish(reply, nullptr);
-          onRigChanged();
+          // From here on the result is written: a cancel no longer finds the operation.
+          operations_.erase(op_id);
+          operationEvent(client, "progress", progress({0.98, "writing", captures}));
+          // Every projector's part merged into one update, written once: all or nothing.
+          rig::RigModel update;
+          std::map<std::string, std::string> meshes;
+          json reply, per_output = json::array();
+          for (std::size_t i = 0; i < plans.size(); ++i) {
+            const CalibrationOutcome& outcome = (*result)[i];
+            Learnt learnt = outcome.planar ? learntByPlaneRoute(*plans[i], outcome)
+                                           : learntByStereoRoute(*plans[i], outcome);
+            if (outcome.response) {
+              const json photometric = responseJson(*outcome.response, plans[i]->cameras[0]);
+              for (auto& p : learnt.update.projectors) p.photometric = photometric;
+              learnt.reply["response"] = photometric;
+            }
+            update = rig::mergeRig(std::move(update), learnt.update);
+            meshes.merge(learnt.meshes);
+            learnt.reply["output"] = plans[i]->output.name;
+            learnt.reply["decoded"] = outcome.decoded;
+            learnt.reply["settle_frames"] = outcome.settle_frames;
+            if (!outcome.latency.is_null()) learnt.reply["latency"] = outcome.latency;
+            if (i == 0) reply = learnt.reply;
+            per_output.push_back(std::move(learnt.reply));
+          }
+          if (plans.size() > 1) reply["outputs"] = per_output;
+          reply["operation"] = op_id;
+          reply["state"] = "done";
+          // fsync may block: the I/O worker writes the meshes first, then rig.json
+          // (the previous versions stay as .bak; a failure leaves rig.json as it was).
+          io_worker_->submit(
+              [this, dir = options_.state_dir, update = std::move(update),
+               meshes = std::move(meshes), reply, finish] {
+                auto merged = mergeIntoRig(dir, update, meshes);
+                return [this, merged, reply, finish, path = rigStateFile(dir).path()]() mutable {
+                  if (!merged) {
+                    const Failure f{code::kIo, "rig.json not written: " + merged.error().message};
+                    return finish({}, &f);
+                  }
+                  rig_ = *merged;
+                  reply["path"] = path;
+                  reply["rig"] = {{"cameras", rig_.cameras.size()},
+                                  {"projectors", rig_.projectors.size()}};
+                  logInfo("calibration written to " + path);
+                  finish(reply, nullptr);
+                  onRigChanged();
+                };
+              },
+              [finish](const std::string& what) {
+                const Failure f{code::kIo, "rig.json not written: " + what};
+                finish({}, &f);
+              });
         };
-      });
-    };
-  });
+      },
+      [this, client, req, op_id](const std::string& what) {
+        operations_.erase(op_id);
+        calibration_.op.clear();
+        operationEvent(
+            client, "finished",
+            {{"operation", op_id}, {"kind", "calibrate"}, {"ok", false}, {"error", what}});
+        answerFailure(client, req)(what);
+        refreshOutputs();
+      },
+      client);
 }
 
 }  // namespace procam::daemon

@@ -75,6 +75,7 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
   if (!path || path->empty()) {
     return errorTo(client, req, code::kBadArgument, "content load needs \"path\"");
   }
+  if (refuseOverJobLimit(client, req)) return;
   if (isMeshFile(*path)) {
     // 3D content (content_mesh.hpp): prepared on a worker, then shown instead of any image.
     const std::string file = *path;
@@ -95,28 +96,30 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
     const std::optional<Vec3> eye = viewer ? std::optional<Vec3>(viewer->position) : std::nullopt;
     const json eye_source = viewer ? viewer->source : json();
     server_->hold(client);
-    compute_worker_->submit([this, client, req, file, outputs, eye, eye_source] {
-      auto prepared = std::make_shared<tl::expected<PreparedMesh, MeshFailure>>(
-          prepareMeshContent(file, outputs, eye, eye_source));
-      return [this, client, req, prepared] {
-        if (!*prepared) {
-          errorTo(client, req, (*prepared).error().code, (*prepared).error().message);
-        } else {
-          stopLiveContent();
-          settings_.content.clear();
-          content_info_ = {};
-          keystone_rt_.content.reset();
-          keystone_rt_.meshes = std::move((*prepared)->meshes);
-          keystone_rt_.mesh_images = std::move((*prepared)->images);
-          keystone_rt_.mesh_info = std::move((*prepared)->info);
-          followMeshViewer(**prepared);
-          broadcast("content", {{"content", contentJson()}});
-          refreshOutputs();
-          replyTo(client, req, "CONTENT", {{"content", contentJson()}});
-        }
-        server_->release(client);
-      };
-    });
+    compute_worker_->submit(
+        [this, client, req, file, outputs, eye, eye_source, access = contentAccess()] {
+          auto prepared = std::make_shared<tl::expected<PreparedMesh, MeshFailure>>(
+              prepareMeshContent(access, file, outputs, eye, eye_source));
+          return [this, client, req, prepared] {
+            if (!*prepared) {
+              errorTo(client, req, (*prepared).error().code, (*prepared).error().message);
+            } else {
+              stopLiveContent();
+              settings_.content.clear();
+              content_info_ = {};
+              keystone_rt_.content.reset();
+              keystone_rt_.meshes = std::move((*prepared)->meshes);
+              keystone_rt_.mesh_images = std::move((*prepared)->images);
+              keystone_rt_.mesh_info = std::move((*prepared)->info);
+              followMeshViewer(**prepared);
+              broadcast("content", {{"content", contentJson()}});
+              refreshOutputs();
+              replyTo(client, req, "CONTENT", {{"content", contentJson()}});
+            }
+            server_->release(client);
+          };
+        },
+        answerFailure(client, req), client);
     return;
   }
   // Decoding may take long: done on a worker, applied back on the loop.
@@ -127,66 +130,104 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
   operationEvent(
       client, "progress",
       {{"operation", op_id}, {"kind", "content-load"}, {"fraction", 0.0}, {"stage", "decoding"}});
-  compute_worker_->submit([this, client, req, op_id, cancelled, file = *path] {
-    auto decoded = decodeContent(file);
-    std::shared_ptr<const cv::Mat> image = decoded ? *decoded : nullptr;
-    const std::string failure = decoded ? std::string() : decoded.error().message;
-    return [this, client, req, op_id, cancelled, file, image, failure] {
-      operations_.erase(op_id);
-      json finished = {{"operation", op_id}, {"kind", "content-load"}, {"ok", true}};
-      if (cancelled->load()) {
-        finished["ok"] = false;
-        finished["error"] = "cancelled";
-      } else if (!failure.empty()) {
-        finished["ok"] = false;
-        finished["error"] = failure;
-      } else {
-        operationEvent(client, "progress",
-                       {{"operation", op_id},
-                        {"kind", "content-load"},
-                        {"fraction", 1.0},
-                        {"stage", "decoded"}});
-      }
-      operationEvent(client, "finished", finished);
-      if (cancelled->load()) {
-        errorTo(client, req, code::kCancelled, "content load cancelled");
-      } else if (!failure.empty()) {
-        errorTo(client, req, code::kIo, failure);
-      } else {
-        stopLiveContent();
-        settings_.content = file;
-        content_info_ = {image->cols, image->rows};
-        keystone_rt_.content = image;
-        keystone_rt_.meshes.clear();
-        keystone_rt_.mesh_images.clear();
-        broadcast("content", {{"content", contentJson()}});
-        refreshOutputs();
-        replyTo(client, req, "CONTENT", {{"content", contentJson()}, {"operation", op_id}});
-      }
-      server_->release(client);  // after the reply: a half-closed client may close now
-    };
-  });
+  compute_worker_->submit(
+      [this, client, req, op_id, cancelled, file = *path, access = contentAccess()] {
+        auto decoded = decodeContent(access, file);
+        std::shared_ptr<const cv::Mat> image = decoded ? decoded->image : nullptr;
+        const std::string resolved = decoded ? decoded->path : std::string();
+        const std::string failure = decoded ? std::string() : decoded.error().message;
+        const char* failure_code = decoded ? "" : protoCode(decoded.error().code);
+        return [this, client, req, op_id, cancelled, resolved, image, failure, failure_code] {
+          operations_.erase(op_id);
+          json finished = {{"operation", op_id}, {"kind", "content-load"}, {"ok", true}};
+          if (cancelled->load()) {
+            finished["ok"] = false;
+            finished["error"] = "cancelled";
+          } else if (!failure.empty()) {
+            finished["ok"] = false;
+            finished["error"] = failure;
+          } else {
+            operationEvent(client, "progress",
+                           {{"operation", op_id},
+                            {"kind", "content-load"},
+                            {"fraction", 1.0},
+                            {"stage", "decoded"}});
+          }
+          operationEvent(client, "finished", finished);
+          if (cancelled->load()) {
+            errorTo(client, req, code::kCancelled, "content load cancelled");
+          } else if (!failure.empty()) {
+            errorTo(client, req, failure_code, failure);
+          } else {
+            stopLiveContent();
+            settings_.content = resolved;
+            content_info_ = {image->cols, image->rows};
+            keystone_rt_.content = image;
+            keystone_rt_.meshes.clear();
+            keystone_rt_.mesh_images.clear();
+            broadcast("content", {{"content", contentJson()}});
+            refreshOutputs();
+            replyTo(client, req, "CONTENT", {{"content", contentJson()}, {"operation", op_id}});
+          }
+          server_->release(client);  // after the reply: a half-closed client may close now
+        };
+      },
+      [this, client, req, op_id](const std::string& what) {
+        operations_.erase(op_id);
+        operationEvent(
+            client, "finished",
+            {{"operation", op_id}, {"kind", "content-load"}, {"ok", false}, {"error", what}});
+        answerFailure(client, req)(what);
+      },
+      client);
 }
 
 void Daemon::cmdSave(ClientId client, const proto::Request& req) {
   RequestArgs args(req.body);
   PROCAM_CHECK_KEYS(args, "");
-  // fsync may block: the write runs on the I/O worker (one thread, so saves
-  // land in order).
+  if (refuseOverJobLimit(client, req)) return;
+  // fsync may block: the write runs on the I/O worker. Its one thread writes the
+  // newest settings any client asked to save, so saves that queue up behind
+  // each other (other clients' jobs may come between) write once and never
+  // put older settings over newer ones.
+  {
+    std::lock_guard lock(save_slot_->mutex);
+    save_slot_->text = settingsToJson(settings_);
+    ++save_slot_->requested;
+  }
   server_->hold(client);
-  io_worker_->submit([this, client, req, text = settingsToJson(settings_)] {
-    auto ok = settings_file_->write(text);
-    return [this, client, req, ok, bytes = text.size()] {
-      if (!ok) {
-        warn("save failed: " + ok.error().message);
-        errorTo(client, req, code::kIo, ok.error().message);
-      } else {
-        logInfo("settings saved to " + settings_file_->path());
-        replyTo(client, req, "SAVE", {{"path", settings_file_->path()}, {"bytes", bytes}});
-      }
-      server_->release(client);  // after the reply: a half-closed client may close now
-    };
-  });
+  io_worker_->submit(
+      [this, client, req, slot = save_slot_] {
+        std::string text;
+        uint64_t generation = 0;
+        {
+          std::lock_guard lock(slot->mutex);
+          text = slot->text;
+          generation = slot->requested;
+          if (slot->written >= generation) {  // on disk already, by an earlier job
+            return WorkerPool::Completion([this, client, req, bytes = text.size()] {
+              replyTo(client, req, "SAVE", {{"path", settings_file_->path()}, {"bytes", bytes}});
+              server_->release(client);
+            });
+          }
+        }
+        auto ok = settings_file_->write(text);
+        if (ok) {
+          std::lock_guard lock(slot->mutex);
+          slot->written = std::max(slot->written, generation);
+        }
+        return WorkerPool::Completion([this, client, req, ok, bytes = text.size()] {
+          if (!ok) {
+            warn("save failed: " + ok.error().message);
+            errorTo(client, req, code::kIo, ok.error().message);
+          } else {
+            logInfo("settings saved to " + settings_file_->path());
+            replyTo(client, req, "SAVE", {{"path", settings_file_->path()}, {"bytes", bytes}});
+          }
+          server_->release(client);  // after the reply: a half-closed client may close now
+        });
+      },
+      answerFailure(client, req), client);
 }
 
 Result<void> Daemon::reloadConfig() {

@@ -1,7 +1,13 @@
 #include "config.hpp"
 
+#include <fcntl.h>
+#include <grp.h>
+#include <sys/stat.h>
 #include <toml++/toml.h>
+#include <unistd.h>
 
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -111,7 +117,9 @@ void parseDaemon(Checker& c, const toml::table& t, Config& cfg) {
     }
   }
   if (auto* n = t.get("plugin_dir")) c.string(*n, "daemon.plugin_dir", cfg.plugin_dir);
-  if (auto* n = t.get("group")) c.string(*n, "daemon.group", cfg.group);
+  if (auto* n = t.get("group")) {
+    if (c.string(*n, "daemon.group", cfg.group)) cfg.group_line = int(n->source().begin.line);
+  }
   if (auto* n = t.get("max_clients")) c.integer(*n, "daemon.max_clients", 1, 4096, cfg.max_clients);
   if (auto* n = t.get("client_queue_kib")) {
     c.integer(*n, "daemon.client_queue_kib", 64, 65536, cfg.client_queue_kib);
@@ -161,7 +169,27 @@ bool numbers(Checker& c, const toml::node& node, const std::string& key, double 
 }
 
 void parseContent(Checker& c, const toml::table& t, Config& cfg) {
-  c.onlyKnown(t, "content.", {"viewer", "viewer_threshold_m"});
+  c.onlyKnown(t, "content.", {"viewer", "viewer_threshold_m", "roots", "allow_pipeline"});
+  if (auto* n = t.get("allow_pipeline")) {
+    c.boolean(*n, "content.allow_pipeline", cfg.content_allow_pipeline);
+  }
+  if (auto* n = t.get("roots")) {
+    const toml::array* a = n->as_array();
+    if (!a || a->empty() || a->size() > 64) {
+      c.error(n->source(), "content.roots", "expected an array of 1 to 64 absolute folder paths");
+    } else {
+      for (std::size_t i = 0; i < a->size(); ++i) {
+        const std::string key = "content.roots[" + std::to_string(i) + "]";
+        std::string dir;
+        if (!c.string(*a->get(i), key, dir)) continue;
+        if (dir.empty() || dir.front() != '/') {
+          c.error(a->get(i)->source(), key, "'" + dir + "' is not an absolute path");
+          continue;
+        }
+        cfg.content_roots.push_back(dir);
+      }
+    }
+  }
   if (auto* n = t.get("viewer_threshold_m")) {
     c.number(*n, "content.viewer_threshold_m", 0.0, 1.0, cfg.content_viewer_threshold_m);
   }
@@ -169,6 +197,26 @@ void parseContent(Checker& c, const toml::table& t, Config& cfg) {
   if (auto* n = t.get("viewer"); n && numbers(c, *n, "content.viewer", -1e4, 1e4, eye)) {
     cfg.content_viewer = eye;
   }
+}
+
+void parseLimits(Checker& c, const toml::table& t, Config& cfg) {
+  c.onlyKnown(t, "limits.",
+              {"file_mib", "image_pixels", "frame_pixels", "mesh_vertices", "mesh_faces",
+               "face_indices", "client_jobs"});
+  ContentLimits& l = cfg.limits;
+  auto bounded = [&](const char* key, int lo, int hi, std::uint64_t& out, std::uint64_t scale) {
+    if (auto* n = t.get(key)) {
+      int v = 0;
+      if (c.integer(*n, std::string("limits.") + key, lo, hi, v)) out = std::uint64_t(v) * scale;
+    }
+  };
+  bounded("file_mib", 1, 4096, l.file_bytes, std::uint64_t{1} << 20);
+  bounded("image_pixels", 4, 1 << 30, l.image_pixels, 1);
+  bounded("frame_pixels", 4, 1 << 30, l.frame_pixels, 1);
+  bounded("mesh_vertices", 3, 100'000'000, l.mesh_vertices, 1);
+  bounded("mesh_faces", 1, 100'000'000, l.mesh_faces, 1);
+  bounded("face_indices", 3, 1'000'000, l.face_indices, 1);
+  bounded("client_jobs", 1, 100'000, l.client_jobs, 1);
 }
 
 void parseKeystone(Checker& c, const toml::table& t, Config& cfg) {
@@ -292,8 +340,8 @@ Result<Config> parseConfig(std::string_view text, const std::string& source) {
   cfg.source = source;
   Checker c(source);
   c.onlyKnown(root, "",
-              {"daemon", "policy", "keystone", "calibration", "content", "sim", "projector",
-               "camera", "tilt", "tracker"});
+              {"daemon", "policy", "keystone", "calibration", "content", "limits", "sim",
+               "projector", "camera", "tilt", "tracker"});
   auto section = [&](const char* name, void (*parse)(Checker&, const toml::table&, Config&)) {
     if (auto* n = root.get(name)) {
       if (const toml::table* t = n->as_table()) {
@@ -309,6 +357,7 @@ Result<Config> parseConfig(std::string_view text, const std::string& source) {
   section("keystone", parseKeystone);
   section("calibration", parseCalibration);
   section("content", parseContent);
+  section("limits", parseLimits);
   std::set<std::string> names;
   const std::pair<const char*, procam_family> families[] = {{"projector", PROCAM_FAMILY_OUTPUT},
                                                             {"camera", PROCAM_FAMILY_CAMERA},
@@ -322,12 +371,44 @@ Result<Config> parseConfig(std::string_view text, const std::string& source) {
 }
 
 Result<Config> loadConfig(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return fail(ErrorCode::kIo, "cannot open config file " + path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) return fail(ErrorCode::kIo, "cannot read config file " + path);
-  return parseConfig(text.str(), path);
+  // Non-blocking open: a FIFO must not hang start-up or the loop on reload.
+  UniqueFd fd(::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC));
+  if (!fd.valid()) {
+    return fail(ErrorCode::kIo, "cannot open config file " + path + ": " + std::strerror(errno));
+  }
+  struct stat st {};
+  if (::fstat(fd.get(), &st) != 0 || !S_ISREG(st.st_mode)) {
+    return fail(ErrorCode::kIo, "config file " + path + " is not a regular file");
+  }
+  if (std::uint64_t(st.st_size) > kMaxConfigBytes) {
+    return fail(ErrorCode::kTooLarge, "config file " + path + " is over " +
+                                          std::to_string(kMaxConfigBytes >> 10) + " KiB");
+  }
+  std::string text(std::size_t(st.st_size), '\0');
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = ::read(fd.get(), text.data() + done, text.size() - done);
+    if (n < 0 && (errno == EINTR || errno == EAGAIN)) continue;
+    if (n < 0) return fail(ErrorCode::kIo, "cannot read config file " + path);
+    if (n == 0) break;
+    done += std::size_t(n);
+  }
+  text.resize(done);
+  auto cfg = parseConfig(text, path);
+  if (!cfg) return cfg;
+  if (cfg->group_line > 0) {
+    // A group named in the file must exist; the default may be absent (no group
+    // then shares the socket).
+    struct group g {};
+    struct group* found = nullptr;
+    std::vector<char> buf(16384);
+    if (::getgrnam_r(cfg->group.c_str(), &g, buf.data(), buf.size(), &found) != 0 || !found) {
+      return fail(ErrorCode::kInvalidInput, path + ":" + std::to_string(cfg->group_line) +
+                                                ": daemon.group: no group '" + cfg->group +
+                                                "' on this system");
+    }
+  }
+  return cfg;
 }
 
 }  // namespace procam::daemon

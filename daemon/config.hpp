@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "content_access.hpp"
 #include "core/error.hpp"
 #include "log.hpp"
 #include "procamd/procam_plugin.h"
@@ -55,6 +56,7 @@ struct Config {
   LogLevel log_level = LogLevel::kInfo;
   std::string plugin_dir;  // empty: the built-in default
   std::string group = "procam";
+  int group_line = 0;  // where the file set it (0: the default, which may be absent)
   int max_clients = 128;
   int client_queue_kib = 1024;
   double client_stall_timeout_s = 10.0;
@@ -67,6 +69,11 @@ struct Config {
   // [content] viewer_threshold_m: a tracked viewer who moved this far since the mesh was
   // last drawn has it drawn again (content_follow.cpp says why 5 mm).
   double content_viewer_threshold_m = 0.005;
+  // [content] roots: where clients may take content from (empty: the state
+  // directory's content/); allow_pipeline: raw gst-launch text from clients.
+  std::vector<std::string> content_roots;
+  bool content_allow_pipeline = false;
+  ContentLimits limits;  // [limits]
   KeystoneConfig keystone;
   CalibrationConfig calibration;
   std::vector<DeviceConfig> devices;
@@ -75,6 +82,10 @@ struct Config {
 // Parses TOML text; `source` names it in messages. All problems found are
 // reported, one per line, in the error message.
 Result<Config> parseConfig(std::string_view text, const std::string& source);
+// Reads a regular file of at most kMaxConfigBytes (never a FIFO or device, which
+// could block or never end), parses it, and checks what only this machine can
+// tell: that a configured group exists.
+inline constexpr std::size_t kMaxConfigBytes = std::size_t{1} << 20;
 Result<Config> loadConfig(const std::string& path);
 
 const char* recalibratePolicyName(RecalibratePolicy policy);

@@ -9,6 +9,8 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <functional>
+#include <optional>
 
 #include "content/raw_source.hpp"
 #include "content/shm_frames.hpp"
@@ -57,6 +59,13 @@ void Daemon::cmdContentShare(ClientId client, const proto::Request& req) {
   if (!args.ok()) return errorTo(client, req, code::kBadArgument, args.error());
   auto format = content::parsePixelFormat(format_name);
   if (!format) return errorTo(client, req, code::kBadArgument, format.error().message);
+  const auto max_pixels = config_.limits.frame_pixels;
+  if (std::uint64_t(*width) * std::uint64_t(*height) > max_pixels) {
+    return errorTo(client, req, code::kTooLarge,
+                   std::to_string(*width) + "x" + std::to_string(*height) +
+                       " frames are over the " + std::to_string(max_pixels) +
+                       "-pixel limit ([limits] frame_pixels)");
+  }
   if (fds.size() != 1) {
     return errorTo(client, req, code::kBadArgument,
                    "content share needs exactly one memfd passed with the request "
@@ -72,10 +81,43 @@ void Daemon::cmdContentShare(ClientId client, const proto::Request& req) {
   replyTo(client, req, "CONTENT", {{"content", contentJson()}});
 }
 
+#if PROCAM_HAVE_GSTREAMER
+namespace {
+
+// A file: URI's path, percent-decoded; nullopt for another host or a malformed escape.
+std::optional<std::string> fileUriPath(const std::string& uri) {
+  std::string rest = uri.substr(std::string("file://").size());
+  if (rest.rfind("localhost/", 0) == 0) rest = rest.substr(std::string("localhost").size());
+  if (rest.empty() || rest.front() != '/') return std::nullopt;
+  std::string path;
+  for (std::size_t i = 0; i < rest.size(); ++i) {
+    if (rest[i] != '%') {
+      path += rest[i];
+      continue;
+    }
+    if (i + 2 >= rest.size() || !std::isxdigit(static_cast<unsigned char>(rest[i + 1])) ||
+        !std::isxdigit(static_cast<unsigned char>(rest[i + 2]))) {
+      return std::nullopt;
+    }
+    const char c = static_cast<char>(std::stoi(rest.substr(i + 1, 2), nullptr, 16));
+    if (c == '\0') return std::nullopt;
+    path += c;
+    i += 2;
+  }
+  return path;
+}
+
+}  // namespace
+#endif
+
 void Daemon::cmdContentStream(ClientId client, const proto::Request& req) {
   RequestArgs args(req.body);
-  PROCAM_CHECK_KEYS(args, "action", "path", "pipeline", "width", "height", "format", "fps");
+  PROCAM_CHECK_KEYS(args, "action", "path", "uri", "v4l2", "test", "pipeline", "width", "height",
+                    "format", "fps");
   const auto path = args.string("path");
+  const auto uri = args.string("uri");
+  const auto v4l2 = args.string("v4l2");
+  const auto test = args.string("test");
   const auto pipeline = args.string("pipeline");
   const auto width = sideArg(args, "width", false);
   const auto height = sideArg(args, "height", false);
@@ -89,53 +131,117 @@ void Daemon::cmdContentStream(ClientId client, const proto::Request& req) {
     }
   }
   if (!args.ok()) return errorTo(client, req, code::kBadArgument, args.error());
-  if (bool(path) == bool(pipeline) || (path && path->empty())) {
+  const int sources =
+      int(bool(path)) + int(bool(uri)) + int(bool(v4l2)) + int(bool(test)) + int(bool(pipeline));
+  if (sources != 1 || (path && path->empty())) {
     return errorTo(client, req, code::kBadArgument,
-                   "content stream needs either \"path\" or \"pipeline\"");
+                   "content stream needs one of \"path\", \"uri\", \"v4l2\", \"test\" "
+                   "(or \"pipeline\" where the configuration allows it)");
   }
-  json info;
-  Result<std::unique_ptr<content::ContentSource>> source =
-      fail(ErrorCode::kInvalidInput, "no source");
-  if (width || height) {
+  const ContentAccess access = contentAccess();
+  if (width && height &&
+      std::uint64_t(*width) * std::uint64_t(*height) > access.limits.frame_pixels) {
+    return errorTo(client, req, code::kTooLarge,
+                   std::to_string(*width) + "x" + std::to_string(*height) +
+                       " frames are over the " + std::to_string(access.limits.frame_pixels) +
+                       "-pixel limit ([limits] frame_pixels)");
+  }
+  if (pipeline && !access.allow_pipeline) {
+    return errorTo(client, req, code::kForbidden,
+                   "raw GStreamer pipelines are off ([content] allow_pipeline = false): use "
+                   "\"path\", \"uri\", \"v4l2\" or \"test\"");
+  }
+  if (path && (width || height)) {
     // Raw frames: the size (and format) say how to cut the bytes into frames.
-    if (!width || !height || !path) {
+    if (!width || !height) {
       return errorTo(client, req, code::kBadArgument,
                      "raw frames need \"path\", \"width\" and \"height\"");
     }
     auto format = content::parsePixelFormat(format_name);
     if (!format) return errorTo(client, req, code::kBadArgument, format.error().message);
-    source = content::openRawFrames(*path, {{*width, *height}, *format, fps});
-    info = {{"path", *path}, {"raw", {{"format", format_name}, {"fps", fps}}}};
-  } else {
-#if PROCAM_HAVE_GSTREAMER
-    // Opening waits for the first decoded frame (up to the preroll timeout): on
-    // a worker, the reply once it is shown or refused.
-    info = path ? json{{"path", *path}, {"video", true}}
-                : json{{"pipeline", *pipeline}, {"video", true}};
-    server_->hold(client);
-    compute_worker_->submit([this, client, req, path, pipeline, info] {
-      auto opened = std::make_shared<Result<std::unique_ptr<content::ContentSource>>>(
-          path ? content::openVideoFile(*path) : content::openGstPipeline(*pipeline));
-      return [this, client, req, opened, info] {
-        startStream(client, req, std::move(*opened), info);
-        server_->release(client);
-      };
-    });
-    return;
-#else
-    return errorTo(client, req, code::kUnavailable,
-                   "video needs GStreamer, which this procamd was built without");
-#endif
+    auto resolved = resolveContentPath(access, *path);
+    if (!resolved) {
+      return errorTo(client, req, protoCode(resolved.error().code), resolved.error().message);
+    }
+    auto source = content::openRawFrames(*resolved, {{*width, *height}, *format, fps});
+    return startStream(client, req, std::move(source),
+                       {{"path", *resolved}, {"raw", {{"format", format_name}, {"fps", fps}}}});
   }
-  startStream(client, req, std::move(source), info);
+  if ((width || height) && !test) {
+    return errorTo(client, req, code::kBadArgument,
+                   "\"width\" and \"height\" go with raw frames from \"path\" or a \"test\" "
+                   "video");
+  }
+#if PROCAM_HAVE_GSTREAMER
+  // The source to open, checked here (roots, names); opening waits for the first
+  // decoded frame (up to the preroll timeout): on a worker, the reply once it is
+  // shown or refused.
+  std::function<Result<std::unique_ptr<content::ContentSource>>()> open;
+  json info = {{"video", true}};
+  std::optional<std::string> file = path;
+  if (uri && uri->rfind("file:", 0) == 0) {
+    file = uri->rfind("file://", 0) == 0 ? fileUriPath(*uri) : std::nullopt;
+    if (!file) {
+      return errorTo(client, req, code::kBadArgument,
+                     "file URI '" + *uri + "' is not file:///absolute/path");
+    }
+  }
+  if (file) {
+    auto resolved = resolveContentPath(access, *file);
+    if (!resolved) {
+      return errorTo(client, req, protoCode(resolved.error().code), resolved.error().message);
+    }
+    if (auto fd = openContentFile(*resolved, ContentKind::kRegular); !fd) {
+      return errorTo(client, req, protoCode(fd.error().code), fd.error().message);
+    }
+    info["path"] = *resolved;
+    open = [f = *resolved] { return content::openVideoFile(f); };
+  } else if (uri) {
+    info["uri"] = *uri;
+    open = [u = *uri] { return content::openVideoUri(u); };
+  } else if (v4l2) {
+    info["v4l2"] = *v4l2;
+    open = [d = *v4l2] { return content::openV4l2Video(d); };
+  } else if (test) {
+    const cv::Size size(width.value_or(1280), height.value_or(720));
+    if (std::uint64_t(size.area()) > access.limits.frame_pixels) {
+      return errorTo(client, req, code::kTooLarge, "test video over [limits] frame_pixels");
+    }
+    const double rate = fps > 0 ? fps : 30.0;
+    info["test"] = *test;
+    open = [t = *test, size, rate] { return content::openTestVideo(t, size, rate); };
+  } else {
+    info["pipeline"] = *pipeline;
+    open = [p = *pipeline] { return content::openGstPipeline(p); };
+  }
+  if (refuseOverJobLimit(client, req)) return;
+  server_->hold(client);
+  compute_worker_->submit(
+      [this, client, req, open, info, max_pixels = access.limits.frame_pixels] {
+        auto opened = std::make_shared<Result<std::unique_ptr<content::ContentSource>>>(open());
+        // A source whose first frame is over the limit is closed before it plays.
+        if (*opened && std::uint64_t((**opened)->size().area()) > max_pixels) {
+          const cv::Size s = (**opened)->size();
+          *opened = fail(ErrorCode::kTooLarge,
+                         std::to_string(s.width) + "x" + std::to_string(s.height) +
+                             " video frames are over the " + std::to_string(max_pixels) +
+                             "-pixel limit ([limits] frame_pixels)");
+        }
+        return [this, client, req, opened, info] {
+          startStream(client, req, std::move(*opened), info);
+          server_->release(client);
+        };
+      },
+      answerFailure(client, req), client);
+#else
+  return errorTo(client, req, code::kUnavailable,
+                 "video needs GStreamer, which this procamd was built without");
+#endif
 }
 
 void Daemon::startStream(ClientId client, const proto::Request& req,
                          Result<std::unique_ptr<content::ContentSource>> source, const json& info) {
-  if (!source) {
-    const bool io = source.error().code == ErrorCode::kIo;
-    return errorTo(client, req, io ? code::kIo : code::kBadArgument, source.error().message);
-  }
+  if (!source) return errorTo(client, req, protoCode(source.error().code), source.error().message);
   if (auto ok = startLiveContent(std::move(*source), {{"stream", info}}); !ok) {
     return errorTo(client, req, code::kInternal, ok.error().message);
   }
@@ -285,7 +391,8 @@ Result<ViewerImage> drawForViewer(const content::MeshContent& mesh, const geom::
 
 }  // namespace
 
-tl::expected<PreparedMesh, MeshFailure> prepareMeshContent(const std::string& file,
+tl::expected<PreparedMesh, MeshFailure> prepareMeshContent(const ContentAccess& access,
+                                                           const std::string& file,
                                                            const std::vector<MeshOutput>& outputs,
                                                            const std::optional<Vec3>& eye,
                                                            const json& eye_source) {
@@ -313,10 +420,15 @@ tl::expected<PreparedMesh, MeshFailure> prepareMeshContent(const std::string& fi
                     "3D content needs a viewer: a tracker, [content] viewer in the "
                     "configuration, or the rig model's viewer"});
   }
-  auto loaded = content::loadMeshContent(file);
+  auto bytes = readContentFile(access, file);
+  if (!bytes) {
+    return tl::unexpected(MeshFailure{protoCode(bytes.error().code), bytes.error().message});
+  }
+  const sim::MeshLimits limits{access.limits.mesh_vertices, access.limits.mesh_faces,
+                               access.limits.face_indices, access.limits.file_bytes};
+  auto loaded = content::meshContentFromBytes(*bytes, file, limits);
   if (!loaded) {
-    const bool io = loaded.error().code == ErrorCode::kIo;
-    return tl::unexpected(MeshFailure{io ? code::kIo : code::kBadArgument, loaded.error().message});
+    return tl::unexpected(MeshFailure{protoCode(loaded.error().code), loaded.error().message});
   }
   PreparedMesh out;
   for (const MeshOutput& o : outputs) {

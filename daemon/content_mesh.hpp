@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "content/mesh_placement.hpp"
+#include "content_access.hpp"
 #include "core/error.hpp"
 #include "core/types.hpp"
 #include "geometry/camera_model.hpp"
@@ -96,7 +97,8 @@ bool isMeshFile(const std::string& path);
 // `unavailable` when there is no viewer, or an output's projector pose or display surface
 // is unknown (or a non-planar surface's mesh is not loaded); `io-error` / `bad-argument`
 // when the file cannot be read or parsed.
-tl::expected<PreparedMesh, MeshFailure> prepareMeshContent(const std::string& file,
+tl::expected<PreparedMesh, MeshFailure> prepareMeshContent(const ContentAccess& access,
+                                                           const std::string& file,
                                                            const std::vector<MeshOutput>& outputs,
                                                            const std::optional<Vec3>& eye,
                                                            const nlohmann::json& eye_source);

@@ -1,5 +1,6 @@
 #include "control_server.hpp"
 
+#include <fcntl.h>
 #include <sys/epoll.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -33,7 +34,53 @@ ControlServer::~ControlServer() {
   if (listen_fd_.valid()) loop_.remove(listen_fd_.get());
 }
 
+void ControlServer::refuseWithoutDescriptors() {
+  // The reserve descriptor makes room for one accept, so that the client in the
+  // backlog hears why instead of waiting; then it is taken back.
+  if (reserve_fd_.valid()) {
+    reserve_fd_.reset();
+    UniqueFd fd(::accept4(listen_fd_.get(), nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC));
+    if (fd.valid()) {
+      const std::string line =
+          proto::error(nullptr, proto::code::kBusy, "procamd is out of file descriptors");
+      ssize_t rc = ::send(fd.get(), line.data(), line.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
+      (void)rc;
+      ++stats_.refused;
+    }
+    fd.reset();
+    reserve_fd_.reset(::open("/dev/null", O_RDONLY | O_CLOEXEC));
+  }
+  // Without a reserve (or with clients still queued behind it) the listening
+  // socket would stay readable and the loop spin: stop watching it a while.
+  if (!reserve_fd_.valid()) {
+    reserve_fd_.reset(::open("/dev/null", O_RDONLY | O_CLOEXEC));
+    pauseAccepting();
+  }
+}
+
+void ControlServer::pauseAccepting() {
+  if (accept_paused_) return;
+  accept_paused_ = true;
+  loop_.remove(listen_fd_.get());
+  // A timer takes a descriptor too: without one, checkStalls() (every second)
+  // resumes instead.
+  std::weak_ptr<bool> alive = alive_;
+  (void)loop_.addTimer(std::chrono::milliseconds(100), false, [this, alive] {
+    if (!alive.expired()) resumeAccepting();
+  });
+}
+
+void ControlServer::resumeAccepting() {
+  if (!accept_paused_) return;
+  if (auto ok = loop_.add(listen_fd_.get(), EPOLLIN, [this](uint32_t) { onAccept(); }); !ok) {
+    if (auto line = accept_log_.pass("control socket: " + ok.error().message)) logError(*line);
+    return;  // tried again on the next checkStalls()
+  }
+  accept_paused_ = false;
+}
+
 Result<void> ControlServer::start() {
+  reserve_fd_.reset(::open("/dev/null", O_RDONLY | O_CLOEXEC));
   return loop_.add(listen_fd_.get(), EPOLLIN, [this](uint32_t) { onAccept(); });
 }
 
@@ -57,9 +104,17 @@ void ControlServer::onAccept() {
   for (int i = 0; i < 64; ++i) {
     UniqueFd fd(::accept4(listen_fd_.get(), nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC));
     if (!fd.valid()) {
-      if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) {
-        logWarning(std::string("accept: ") + std::strerror(errno));
+      const int err = errno;
+      if (err == EAGAIN || err == EWOULDBLOCK || err == EINTR) return;
+      if (auto line = accept_log_.pass(std::string("accept: ") + std::strerror(err))) {
+        logWarning(*line);
       }
+      if (err == EMFILE || err == ENFILE) {
+        refuseWithoutDescriptors();
+        continue;
+      }
+      // Anything else (ENOMEM, ENOBUFS...): give the system a moment, do not spin.
+      pauseAccepting();
       return;
     }
     PeerCred cred;
@@ -128,10 +183,64 @@ void ControlServer::onClientEvent(ClientId id, uint32_t events) {
   }
 }
 
+uint32_t ControlServer::eventsFor(const Client& c) const {
+  const bool reading = !c.read_closed && !c.reading_paused;
+  return (reading ? uint32_t{EPOLLIN | EPOLLRDHUP} : 0u) | (c.want_write ? uint32_t{EPOLLOUT} : 0u);
+}
+
+bool ControlServer::dispatch(ClientId id, Client& c) {
+  proto::LineFramer::Item item;
+  for (;;) {
+    // A client whose replies pile up unread is not read further until they drain:
+    // its requests wait in the socket (back-pressure) instead of filling memory.
+    if (c.queued > options_.queue_limit_bytes / 2) {
+      if (!c.reading_paused) {
+        c.reading_paused = true;
+        loop_.modify(c.fd.get(), eventsFor(c));
+      }
+      return true;
+    }
+    if (!c.framer.next(item)) return true;
+    if (item.oversized) {
+      ++stats_.malformed;
+      send(id, proto::error(nullptr, proto::code::kTooLarge,
+                            "request longer than " + std::to_string(proto::kMaxRequestBytes) +
+                                " bytes; skipped up to its newline"));
+    } else if (item.line.find_first_not_of(" \t") == std::string::npos) {
+      c.passed_fds.clear();
+      continue;  // blank lines are ignored
+    } else {
+      auto req = proto::parseRequest(item.line);
+      ++stats_.requests;
+      if (!req) {
+        ++stats_.malformed;
+        send(id, proto::error(req.error().id, req.error().code, req.error().message));
+      } else {
+        std::weak_ptr<bool> alive = alive_;
+        on_request_(id, *req);
+        if (alive.expired()) return false;  // the server itself went away (shutdown)
+      }
+    }
+    if (!connected(id)) return false;  // dropped while handling (queue overflow)
+    c.passed_fds.clear();              // descriptors the handler did not take
+  }
+}
+
+void ControlServer::resumeReading(ClientId id) {
+  auto it = clients_.find(id);
+  if (it == clients_.end() || it->second->closing) return;
+  Client& c = *it->second;
+  if (!c.reading_paused || c.queued > options_.queue_limit_bytes / 4) return;
+  c.reading_paused = false;
+  loop_.modify(c.fd.get(), eventsFor(c));
+  readFrom(id, c);  // the requests already framed first
+}
+
 void ControlServer::readFrom(ClientId id, Client& c) {
+  if (!dispatch(id, c)) return;
   char buf[kReadChunk];
   size_t budget = kReadBudgetPerWakeup;
-  while (budget > 0 && !c.read_closed) {
+  while (budget > 0 && !c.read_closed && !c.reading_paused) {
     const ssize_t n = receive(c, buf, sizeof buf);
     if (n < 0) {
       if (errno == EINTR) continue;
@@ -145,34 +254,10 @@ void ControlServer::readFrom(ClientId id, Client& c) {
     }
     budget -= std::min(budget, static_cast<size_t>(n));
     c.framer.feed(std::string_view(buf, static_cast<size_t>(n)));
-    proto::LineFramer::Item item;
-    while (c.framer.next(item)) {
-      if (item.oversized) {
-        ++stats_.malformed;
-        send(id, proto::error(nullptr, proto::code::kTooLarge,
-                              "request longer than " + std::to_string(proto::kMaxRequestBytes) +
-                                  " bytes; skipped up to its newline"));
-      } else if (item.line.find_first_not_of(" \t") == std::string::npos) {
-        c.passed_fds.clear();
-        continue;  // blank lines are ignored
-      } else {
-        auto req = proto::parseRequest(item.line);
-        ++stats_.requests;
-        if (!req) {
-          ++stats_.malformed;
-          send(id, proto::error(req.error().id, req.error().code, req.error().message));
-        } else {
-          std::weak_ptr<bool> alive = alive_;
-          on_request_(id, *req);
-          if (alive.expired()) return;  // the server itself went away (shutdown)
-        }
-      }
-      if (!connected(id)) return;  // dropped while handling (queue overflow)
-      c.passed_fds.clear();        // descriptors the handler did not take
-    }
+    if (!dispatch(id, c)) return;
   }
   if (c.read_closed) {
-    loop_.modify(c.fd.get(), c.want_write ? uint32_t{EPOLLOUT} : 0u);
+    loop_.modify(c.fd.get(), eventsFor(c));
     maybeFinish(id, c);
   }
 }
@@ -249,15 +334,20 @@ void ControlServer::flush(ClientId id, Client& c) {
   const bool want = !c.out.empty();
   if (want != c.want_write) {
     c.want_write = want;
-    const uint32_t ev =
-        (c.read_closed ? 0u : uint32_t{EPOLLIN | EPOLLRDHUP}) | (want ? uint32_t{EPOLLOUT} : 0u);
-    loop_.modify(c.fd.get(), ev);
+    loop_.modify(c.fd.get(), eventsFor(c));
+  }
+  if (c.reading_paused && c.queued <= options_.queue_limit_bytes / 4) {
+    // Read again from the loop, not from inside this send.
+    std::weak_ptr<bool> alive = alive_;
+    loop_.post([this, alive, id] {
+      if (!alive.expired()) resumeReading(id);
+    });
   }
   maybeFinish(id, c);
 }
 
 void ControlServer::maybeFinish(ClientId id, Client& c) {
-  if (c.read_closed && c.out.empty() && c.holds == 0 && !c.closing) {
+  if (c.read_closed && c.out.empty() && c.holds == 0 && !c.reading_paused && !c.closing) {
     logDebug(describe(c) + " disconnected");
     c.closing = true;
     loop_.remove(c.fd.get());
@@ -306,6 +396,7 @@ void ControlServer::release(ClientId id) {
 }
 
 void ControlServer::checkStalls() {
+  resumeAccepting();
   const auto now = std::chrono::steady_clock::now();
   for (auto& [id, c] : clients_) {
     if (c->closing || c->out.empty()) continue;

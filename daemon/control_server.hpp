@@ -17,6 +17,7 @@
 
 #include "core/unique_fd.hpp"
 #include "event_loop.hpp"
+#include "log.hpp"
 #include "protocol.hpp"
 
 namespace procam::daemon {
@@ -91,14 +92,24 @@ class ControlServer {
     std::chrono::steady_clock::time_point last_progress;
     bool want_write = false;
     bool read_closed = false;
+    bool reading_paused = false;  // replies over half the queue bound wait to be read
     bool closing = false;
     int holds = 0;
     std::vector<UniqueFd> passed_fds;  // for the next request that completes
   };
 
   void onAccept();
+  // accept() failed for want of descriptors: refuse one client with `busy`.
+  void refuseWithoutDescriptors();
+  void pauseAccepting();  // 100 ms without watching the listening socket
+  void resumeAccepting();
   void onClientEvent(ClientId id, uint32_t events);
   void readFrom(ClientId id, Client& c);
+  // Handles the framed requests while the client's output queue allows; false
+  // when the client or the server went away meanwhile.
+  bool dispatch(ClientId id, Client& c);
+  void resumeReading(ClientId id);
+  uint32_t eventsFor(const Client& c) const;
   // recv() that also collects SCM_RIGHTS descriptors into c.passed_fds.
   ssize_t receive(Client& c, char* buf, size_t size);
   void flush(ClientId id, Client& c);
@@ -110,6 +121,9 @@ class ControlServer {
 
   EventLoop& loop_;
   UniqueFd listen_fd_;
+  UniqueFd reserve_fd_;  // /dev/null, closed when accept() finds no descriptor free
+  bool accept_paused_ = false;
+  LogThrottle accept_log_;
   ServerOptions options_;
   RequestHandler on_request_;
   DisconnectHandler on_disconnect_;

@@ -28,8 +28,8 @@ Daemon::Daemon(DaemonOptions options) : options_(std::move(options)) {}
 Daemon::~Daemon() {
   for (auto& [id, op] : operations_) op.cancelled->store(true);  // a running job stops early
   server_.reset();
+  io_worker_.reset();  // a state write in progress ends first
   compute_worker_.reset();
-  io_worker_.reset();
   device_manager_.reset();
   devices_.closeAll();
   removeControlSocket(socket_info_);
@@ -42,10 +42,25 @@ Result<std::unique_ptr<Daemon>> Daemon::create(DaemonOptions options) {
 }
 
 void Daemon::warn(const std::string& message) {
-  logWarning(message);
+  // The same warning over and over (a device failing every read) is logged and
+  // broadcast once per interval, with a count of the ones held back.
+  auto& throttle = warn_throttles_.try_emplace(message, std::chrono::seconds(10), 5).first->second;
+  auto line = throttle.pass(message);
+  if (warn_throttles_.size() > 256) warn_throttles_.clear();  // bounded; forgets old ones
+  if (!line) return;
+  logWarning(*line);
   warnings_.push_back(message);
   if (warnings_.size() > 32) warnings_.erase(warnings_.begin());
   if (server_) broadcast("warning", {{"message", message}});
+}
+
+ContentAccess Daemon::contentAccess() const {
+  ContentAccess a;
+  a.roots = config_.content_roots;
+  if (a.roots.empty()) a.roots.push_back(std::filesystem::absolute(options_.state_dir) / "content");
+  a.limits = config_.limits;
+  a.allow_pipeline = config_.content_allow_pipeline;
+  return a;
 }
 
 ServerOptions Daemon::serverOptions() const {
@@ -98,6 +113,13 @@ Result<void> Daemon::setup() {
                                                  return {};
                                                });
   if (auto ok = settings_file_->ensureDirectory(); !ok) return ok;
+  // The default content root, made here so that an installer finds where content goes.
+  if (config_.content_roots.empty()) {
+    std::filesystem::create_directory(options_.state_dir + "/content", ec);
+    if (!ec)
+      std::filesystem::permissions(options_.state_dir + "/content", std::filesystem::perms(0750),
+                                   ec);
+  }
   loadSettings();
   if (auto ok = loadRigModel(); !ok) return ok;
   loadDrivers();

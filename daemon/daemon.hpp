@@ -6,6 +6,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -70,6 +71,7 @@ class Daemon {
   void housekeeping();
   void warn(const std::string& message);
   ServerOptions serverOptions() const;
+  ContentAccess contentAccess() const;  // [content] roots and [limits], defaults filled in
 
   // commands.cpp
   void handle(ClientId client, const proto::Request& req);
@@ -81,6 +83,12 @@ class Daemon {
                nlohmann::json body = nlohmann::json::object());
   void errorTo(ClientId client, const proto::Request& req, const char* code,
                const std::string& message);
+  // The failure handler of a worker job that answers `req` for a held client: an
+  // internal-error reply naming what went wrong, then the client released.
+  WorkerPool::Failure answerFailure(ClientId client, const proto::Request& req);
+  // True (and `req` refused with too-large) when the client already has its
+  // [limits] client_jobs worth of jobs queued on the workers.
+  bool refuseOverJobLimit(ClientId client, const proto::Request& req);
   void cmdVersion(ClientId, const proto::Request&);
   void cmdStatus(ClientId, const proto::Request&);
   void cmdDevices(ClientId, const proto::Request&);
@@ -196,6 +204,15 @@ class Daemon {
   Config config_;
   Settings settings_;
   std::unique_ptr<StateFile> settings_file_;
+  // The newest settings a `save` asked for, shared with the I/O worker.
+  struct SaveSlot {
+    std::mutex mutex;
+    std::string text;
+    uint64_t requested = 0;  // saves asked for
+    uint64_t written = 0;    // the newest of them on disk
+  };
+  std::shared_ptr<SaveSlot> save_slot_ = std::make_shared<SaveSlot>();
+  std::map<std::string, LogThrottle> warn_throttles_;  // Daemon::warn, per message
   rig::RigModel rig_;  // the state directory's rig.json: the only source of geometry
   // rig_'s surface meshes by projector name ("" for the unified mesh).
   std::map<std::string, std::shared_ptr<const RigSurfaceMesh>> rig_surfaces_;

@@ -219,6 +219,10 @@ void Daemon::requestSolve() {
             requestSolve();
           }
         };
+      },
+      [this](const std::string& what) {
+        keystone_rt_.solving = false;
+        warn("keystone solve failed: " + what);
       });
 }
 

@@ -206,55 +206,75 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done) {
     }
   }
   k.rendering = true;
-  compute_worker_->submit([this, jobs = std::move(jobs), waiters = std::move(waiters)]() mutable {
-    auto results = std::make_shared<std::vector<OutputDrawn>>();
-    for (const auto& job : jobs) results->push_back(drawOutput(job));
-    return [this, results, waiters = std::move(waiters)] {
-      KeystoneRuntime& k = keystone_rt_;
-      k.rendering = false;
-      bool shown = false, drawn = false;
-      for (const OutputDrawn& r : *results) {
-        auto st = k.output_state.find(r.name);
-        if (!r.ok) {
-          warn("output '" + r.name + "': " + r.error);
-          // Hand the setup over again next time: the output may not hold it.
-          if (st != k.output_state.end()) st->second.setup.reset();
-          if (closesDevice(r.rc)) device_manager_->report(r.name, r.rc, r.error);
-          continue;
+  // Shared with the failure handler: the waiters are answered either way.
+  auto waiting = std::make_shared<decltype(waiters)>(std::move(waiters));
+  compute_worker_->submit(
+      [this, jobs = std::move(jobs), waiting] {
+        auto results = std::make_shared<std::vector<OutputDrawn>>();
+        for (const auto& job : jobs) results->push_back(drawOutput(job));
+        return [this, results, waiting] {
+          KeystoneRuntime& k = keystone_rt_;
+          k.rendering = false;
+          bool shown = false, drawn = false;
+          for (const OutputDrawn& r : *results) {
+            auto st = k.output_state.find(r.name);
+            if (!r.ok) {
+              warn("output '" + r.name + "': " + r.error);
+              // Hand the setup over again next time: the output may not hold it.
+              if (st != k.output_state.end()) st->second.setup.reset();
+              if (closesDevice(r.rc)) device_manager_->report(r.name, r.rc, r.error);
+              continue;
+            }
+            shown = true;
+            drawn = drawn || r.drawn;
+            if (r.stats) {
+              k.shown[r.name] = {r.source,
+                                 r.stats->lit_fraction,
+                                 r.stats->mean_rgb,
+                                 r.path,
+                                 r.viewer,
+                                 r.homography,
+                                 r.tile};
+            }
+          }
+          if (drawn) ++k.frames;  // frames drawn, not statistics read again
+          for (auto& w : *waiting) w(shown);
+          if (k.render_again) {
+            k.render_again = false;
+            refreshOutputs();
+          }
+        };
+      },
+      [this, waiting](const std::string& what) {
+        // Nothing was shown; the state that asked for the frame is answered all the same.
+        keystone_rt_.rendering = false;
+        warn("drawing the outputs failed: " + what);
+        for (auto& w : *waiting) w(false);
+        if (keystone_rt_.render_again) {
+          keystone_rt_.render_again = false;
+          refreshOutputs();
         }
-        shown = true;
-        drawn = drawn || r.drawn;
-        if (r.stats) {
-          k.shown[r.name] = {
-              r.source, r.stats->lit_fraction, r.stats->mean_rgb, r.path, r.viewer, r.homography,
-              r.tile};
-        }
-      }
-      if (drawn) ++k.frames;  // frames drawn, not statistics read again
-      for (auto& w : waiters) w(shown);
-      if (k.render_again) {
-        k.render_again = false;
-        refreshOutputs();
-      }
-    };
-  });
+      });
 }
 
 void Daemon::loadContentAtStart() {
   if (settings_.content.empty()) return;
-  compute_worker_->submit([this, file = settings_.content] {
-    auto image = decodeContent(file);
-    return [this, file, image = std::move(image)] {
-      if (settings_.content != file) return;  // replaced meanwhile
-      if (!image) {
-        warn("saved content not shown: " + image.error().message);
-        return;
-      }
-      keystone_rt_.content = *image;
-      content_info_ = {(*image)->cols, (*image)->rows};
-      refreshOutputs();
-    };
-  });
+  // The saved path goes through the content roots as a client's would.
+  compute_worker_->submit(
+      [this, file = settings_.content, access = contentAccess()] {
+        auto image = decodeContent(access, file);
+        return [this, file, image = std::move(image)] {
+          if (settings_.content != file) return;  // replaced meanwhile
+          if (!image) {
+            warn("saved content not shown: " + image.error().message);
+            return;
+          }
+          keystone_rt_.content = image->image;
+          content_info_ = {image->image->cols, image->image->rows};
+          refreshOutputs();
+        };
+      },
+      [this](const std::string& what) { warn("saved content not shown: " + what); });
 }
 
 json Daemon::outputsJson() const {

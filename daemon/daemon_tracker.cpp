@@ -222,29 +222,34 @@ void Daemon::cmdTracker(ClientId client, const proto::Request& req) {
   }
   const std::string text = trackerFileText(trackers_.registrations);
   json reply = {{"tracker", name}, {"registration", registrationJson(*fit)}};
-  io_worker_->submit([this, dir = options_.state_dir, text, reply, client, req, name, generation,
-                      previous] {
-    const StateFile file = trackerFile(dir);
-    Result<void> ok = file.write(text);
-    return [this, ok, reply, client, req, name, generation, previous,
-            path = file.path()]() mutable {
-      if (!ok) {
-        // Undo this registration unless a later one replaced it meanwhile.
-        if (trackers_.generation[name] == generation) {
-          if (previous) {
-            trackers_.registrations[name] = *previous;
-          } else {
-            trackers_.registrations.erase(name);
+  io_worker_->submit(
+      [this, dir = options_.state_dir, text, reply, client, req, name, generation, previous] {
+        const StateFile file = trackerFile(dir);
+        Result<void> ok = file.write(text);
+        return [this, ok, reply, client, req, name, generation, previous,
+                path = file.path()]() mutable {
+          if (!ok) {
+            // Undo this registration unless a later one replaced it meanwhile.
+            if (trackers_.generation[name] == generation) {
+              if (previous) {
+                trackers_.registrations[name] = *previous;
+              } else {
+                trackers_.registrations.erase(name);
+              }
+            }
+            return errorTo(client, req, code::kIo,
+                           "tracker.json not written: " + ok.error().message);
           }
-        }
-        return errorTo(client, req, code::kIo, "tracker.json not written: " + ok.error().message);
-      }
-      reply["path"] = path;
-      logInfo("tracker '" + name + "' registered (rms " +
-              std::to_string(reply["registration"]["rms_m"].get<double>() * 1e3) + " mm)");
-      replyTo(client, req, "TRACKER", reply);
-    };
-  });
+          reply["path"] = path;
+          logInfo("tracker '" + name + "' registered (rms " +
+                  std::to_string(reply["registration"]["rms_m"].get<double>() * 1e3) + " mm)");
+          replyTo(client, req, "TRACKER", reply);
+        };
+      },
+      [this, client, req](const std::string& what) {
+        errorTo(client, req, code::kInternal, "tracker.json not written: " + what);
+      },
+      client);
 }
 
 }  // namespace procam::daemon

@@ -42,4 +42,21 @@ void log(LogLevel level, std::string_view message) {
   (void)rc;
 }
 
+std::optional<std::string> LogThrottle::pass(std::string_view message,
+                                             std::chrono::steady_clock::time_point now) {
+  if (!window_ || now - *window_ >= interval_) {
+    window_ = now;
+    passed_ = 0;
+  }
+  if (passed_ >= burst_) {
+    ++held_;
+    return std::nullopt;
+  }
+  ++passed_;
+  std::string line(message);
+  if (held_ > 0) line += " (" + std::to_string(held_) + " more like it not logged)";
+  held_ = 0;
+  return line;
+}
+
 }  // namespace procam::daemon

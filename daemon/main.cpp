@@ -1,17 +1,24 @@
 // procamd: the projector-camera daemon (see daemon/PROTOCOL.md, ARCHITECTURE.md).
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <thread>
 
+#include "core/guarded_main.hpp"
 #include "daemon.hpp"
 #include "loader.hpp"
 #include "log.hpp"
 #include "registry.hpp"
 
 namespace {
+
+// What a stop may take once the loop has ended; systemd's TimeoutStopSec is far
+// longer, but a service that is told to stop should be gone in 2 s.
+constexpr std::chrono::milliseconds kStopDeadline{1500};
 
 // `--sim` without a scene: a handheld projector with an accelerometer.
 constexpr const char* kDefaultSimScene = "handheld";
@@ -60,7 +67,7 @@ int listDrivers(const std::string& plugin_dir) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run(int argc, char** argv) {
   procam::daemon::DaemonOptions opts;
   opts.runtime_dir = envOr("RUNTIME_DIRECTORY", "/run/procamd");
   opts.state_dir = envOr("STATE_DIRECTORY", "/var/lib/procamd");
@@ -117,5 +124,21 @@ int main(int argc, char** argv) {
     procam::daemon::logError("procamd: " + daemon.error().message);
     return 1;
   }
-  return (*daemon)->run();
+  const int rc = (*daemon)->run();
+  // Releasing devices may block in their libraries (libaravis waits on a dead
+  // camera for many seconds): the state is on disk by now (every write is
+  // atomic), so a stop never waits past the deadline for them.
+  std::thread([] {
+    std::this_thread::sleep_for(kStopDeadline);
+    procam::daemon::logWarning("devices not released within " +
+                               std::to_string(kStopDeadline.count()) +
+                               " ms of the stop: exiting without them");
+    std::_Exit(0);
+  }).detach();
+  daemon->reset();
+  return rc;
+}
+
+int main(int argc, char** argv) {
+  return procam::guardedMain("procamd", [&] { return run(argc, argv); });
 }

@@ -52,12 +52,16 @@ std::shared_ptr<const cv::Mat> patternImage(const std::string& name, cv::Size si
   return rgba;
 }
 
-Result<std::shared_ptr<const cv::Mat>> decodeContent(const std::string& path) {
-  auto source = content::openStillImage(path);
+Result<DecodedContent> decodeContent(const ContentAccess& access, const std::string& path) {
+  auto resolved = resolveContentPath(access, path);
+  if (!resolved) return tl::unexpected(resolved.error());
+  auto bytes = readContentFile(access, *resolved);
+  if (!bytes) return tl::unexpected(bytes.error());
+  auto source = content::decodeStillImage(*bytes, *resolved, access.limits.image_pixels);
   if (!source) return tl::unexpected(source.error());
   content::Frame frame;
   if (auto r = (*source)->read(frame); !r) return tl::unexpected(r.error());
-  return std::make_shared<const cv::Mat>(content::toRgba(frame));
+  return DecodedContent{std::make_shared<const cv::Mat>(content::toRgba(frame)), *resolved};
 }
 
 cv::Size sourceSize(const FrameRequest& r) {

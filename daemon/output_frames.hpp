@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 
+#include "content_access.hpp"
 #include "core/error.hpp"
 #include "core/types.hpp"
 #include "procamd/procam_plugin.h"
@@ -65,9 +66,14 @@ procam_image rgbImage(const cv::Mat& rgb);
 // pattern or nothing, the content's size otherwise.
 cv::Size sourceSize(const FrameRequest& request);
 
-// Reads an image file as RGBA (grey and 16-bit images converted); kIo when it
-// cannot be read.
-Result<std::shared_ptr<const cv::Mat>> decodeContent(const std::string& path);
+struct DecodedContent {
+  std::shared_ptr<const cv::Mat> image;  // RGBA (grey and 16-bit images converted)
+  std::string path;                      // resolved under a content root
+};
+// An image file a client named, read through `access` (content_access.hpp), its
+// size checked from its header before it is decoded: kForbidden outside the
+// roots, kTooLarge over a limit, kIo when it cannot be read or decoded.
+Result<DecodedContent> decodeContent(const ContentAccess& access, const std::string& path);
 
 // kInvalidInput for empty sizes, content of the wrong type or a pattern without its image.
 Result<PlannedFrame> planFrame(const FrameRequest& request);

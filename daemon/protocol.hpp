@@ -20,7 +20,7 @@ inline constexpr size_t kMaxRequestBytes = 64 * 1024;  // newline excluded
 namespace code {
 inline constexpr const char* kParse = "parse-error";       // not JSON
 inline constexpr const char* kBadRequest = "bad-request";  // JSON, but not a request
-inline constexpr const char* kTooLarge = "too-large";      // over kMaxRequestBytes
+inline constexpr const char* kTooLarge = "too-large";  // over kMaxRequestBytes or a [limits] bound
 inline constexpr const char* kUnknownCommand = "unknown-command";
 inline constexpr const char* kBadArgument = "bad-argument";
 inline constexpr const char* kUnavailable = "unavailable";  // not built / no device

@@ -27,38 +27,43 @@ void Daemon::loadRigSurfaces() {
     rig_surfaces_.clear();
     return;
   }
-  io_worker_->submit([this, generation, files, dir = options_.state_dir] {
-    auto loaded = std::make_shared<std::map<std::string, std::shared_ptr<const RigSurfaceMesh>>>();
-    auto problems = std::make_shared<std::vector<std::string>>();
-    for (const auto& [projector, file] : files) {
-      if (!plainFileName(file)) {
-        problems->push_back("surface mesh '" + file +
-                            "' is not a file name in the state directory");
-        continue;
-      }
-      auto mesh = content::loadMeshContent(std::filesystem::path(dir) / file);
-      if (!mesh) {
-        problems->push_back("surface mesh " + file + ": " + mesh.error().message);
-        continue;
-      }
-      render::SurfaceMesh surface;
-      surface.vertices = mesh->mesh.vertices;
-      for (const auto& f : mesh->mesh.faces) surface.triangles.push_back({f.x(), f.y(), f.z()});
-      auto intersector = geom::MeshIntersector::build(std::move(mesh->mesh));
-      if (!intersector) {
-        problems->push_back("surface mesh " + file + ": " + intersector.error().message);
-        continue;
-      }
-      (*loaded)[projector] = std::make_shared<const RigSurfaceMesh>(
-          RigSurfaceMesh{std::move(*intersector), std::move(surface)});
-    }
-    return [this, generation, loaded, problems] {
-      for (const auto& p : *problems) warn(p);
-      if (generation != rig_generation_) return;  // the rig changed again meanwhile
-      rig_surfaces_ = std::move(*loaded);
-      refreshOutputs();
-    };
-  });
+  io_worker_->submit(
+      [this, generation, files, dir = options_.state_dir] {
+        auto loaded =
+            std::make_shared<std::map<std::string, std::shared_ptr<const RigSurfaceMesh>>>();
+        auto problems = std::make_shared<std::vector<std::string>>();
+        for (const auto& [projector, file] : files) {
+          if (!plainFileName(file)) {
+            problems->push_back("surface mesh '" + file +
+                                "' is not a file name in the state directory");
+            continue;
+          }
+          auto mesh = content::loadMeshContent(std::filesystem::path(dir) / file);
+          if (!mesh) {
+            problems->push_back("surface mesh " + file + ": " + mesh.error().message);
+            continue;
+          }
+          render::SurfaceMesh surface;
+          surface.vertices = mesh->mesh.vertices;
+          for (const auto& f : mesh->mesh.faces) surface.triangles.push_back({f.x(), f.y(), f.z()});
+          auto intersector = geom::MeshIntersector::build(std::move(mesh->mesh));
+          if (!intersector) {
+            problems->push_back("surface mesh " + file + ": " + intersector.error().message);
+            continue;
+          }
+          (*loaded)[projector] = std::make_shared<const RigSurfaceMesh>(
+              RigSurfaceMesh{std::move(*intersector), std::move(surface)});
+        }
+        return [this, generation, loaded, problems] {
+          for (const auto& p : *problems) warn(p);
+          if (generation != rig_generation_) return;  // the rig changed again meanwhile
+          rig_surfaces_ = std::move(*loaded);
+          refreshOutputs();
+        };
+      },
+      [this](const std::string& what) {
+        warn("the rig's surface meshes were not loaded: " + what);
+      });
 }
 
 std::optional<Daemon::ViewerEye> Daemon::staticEye() const {

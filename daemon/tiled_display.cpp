@@ -99,65 +99,77 @@ const KeystoneRuntime::Tiled* Daemon::tiledDisplay(cv::Size content) {
     if (auto r = responseOf(*p)) responses.push_back(*r);
   }
   logInfo("display across " + std::to_string(names.size()) + " outputs: solving");
-  compute_worker_->submit([this, key, content, names, input, responses] {
-    auto made = std::make_shared<KeystoneRuntime::Tiled>();
-    std::string error;
-    auto display = blend::solveTiledDisplay(input, content.width, content.height);
-    if (display) {
-      std::vector<blend::FeatherTile> feather;
-      for (std::size_t t = 0; t < input.size(); ++t) {
-        feather.push_back({display->footprints[t], display->plane_to_framebuffer[t], input[t].width,
-                           input[t].height});
-      }
-      auto weights = blend::featherWeights(feather);
-      if (weights) {
-        for (const cv::Mat& w : *weights) made->alpha.push_back(blend::alphaMask(w));
-        // Brightness matched to the dimmest projector and weights in linear light, when
-        // every projector's response is measured; the assumed gamma otherwise.
-        made->measured = responses.size() == input.size();
-        const std::vector<double> gains = made->measured ? blend::matchedGains(responses)
-                                                         : std::vector<double>(input.size(), 1.0);
-        for (std::size_t t = 0; t < input.size(); ++t) {
-          const double gamma = made->measured ? responses[t].gamma : kAssumedGamma;
-          made->gamma.push_back(gamma);
-          made->gain.push_back(gains[t]);
-          auto lut = blend::weightLut(gamma, gains[t]);
-          if (!lut) {
-            error = lut.error().message;
-            break;
+  compute_worker_->submit(
+      [this, key, content, names, input, responses] {
+        auto made = std::make_shared<KeystoneRuntime::Tiled>();
+        std::string error;
+        auto display = blend::solveTiledDisplay(input, content.width, content.height);
+        if (display) {
+          std::vector<blend::FeatherTile> feather;
+          for (std::size_t t = 0; t < input.size(); ++t) {
+            feather.push_back({display->footprints[t], display->plane_to_framebuffer[t],
+                               input[t].width, input[t].height});
           }
-          made->weight_lut.push_back(*lut);
-        }
-        made->content = content;
-        made->outputs = names;
-        made->display = std::move(*display);
-      } else {
-        error = weights.error().message;
-      }
-    } else {
-      error = display.error().message;
-    }
-    return [this, key, made, error] {
-      KeystoneRuntime& k = keystone_rt_;
-      k.tiling = false;
-      if (key == k.tiled_key) {
-        if (error.empty()) {
-          k.tiled = made;
-          logInfo("display across " + std::to_string(made->outputs.size()) +
-                  " outputs: " + std::to_string(2 * made->display.rect.half_width) + " m x " +
-                  std::to_string(2 * made->display.rect.half_height) + " m");
+          auto weights = blend::featherWeights(feather);
+          if (weights) {
+            for (const cv::Mat& w : *weights) made->alpha.push_back(blend::alphaMask(w));
+            // Brightness matched to the dimmest projector and weights in linear light, when
+            // every projector's response is measured; the assumed gamma otherwise.
+            made->measured = responses.size() == input.size();
+            const std::vector<double> gains = made->measured
+                                                  ? blend::matchedGains(responses)
+                                                  : std::vector<double>(input.size(), 1.0);
+            for (std::size_t t = 0; t < input.size(); ++t) {
+              const double gamma = made->measured ? responses[t].gamma : kAssumedGamma;
+              made->gamma.push_back(gamma);
+              made->gain.push_back(gains[t]);
+              auto lut = blend::weightLut(gamma, gains[t]);
+              if (!lut) {
+                error = lut.error().message;
+                break;
+              }
+              made->weight_lut.push_back(*lut);
+            }
+            made->content = content;
+            made->outputs = names;
+            made->display = std::move(*display);
+          } else {
+            error = weights.error().message;
+          }
         } else {
-          k.tiled.reset();
-          k.tiled_error = error;
-          warn("no display across the rig's projectors: " + error);
+          error = display.error().message;
         }
-        broadcast("keystone", keystoneJson());
-      } else {
-        k.tiled_key.clear();  // made for something older: make it again
-      }
-      refreshOutputs();
-    };
-  });
+        return [this, key, made, error] {
+          KeystoneRuntime& k = keystone_rt_;
+          k.tiling = false;
+          if (key == k.tiled_key) {
+            if (error.empty()) {
+              k.tiled = made;
+              logInfo("display across " + std::to_string(made->outputs.size()) +
+                      " outputs: " + std::to_string(2 * made->display.rect.half_width) + " m x " +
+                      std::to_string(2 * made->display.rect.half_height) + " m");
+            } else {
+              k.tiled.reset();
+              k.tiled_error = error;
+              warn("no display across the rig's projectors: " + error);
+            }
+            broadcast("keystone", keystoneJson());
+          } else {
+            k.tiled_key.clear();  // made for something older: make it again
+          }
+          refreshOutputs();
+        };
+      },
+      [this, key](const std::string& what) {
+        KeystoneRuntime& k = keystone_rt_;
+        k.tiling = false;
+        if (key == k.tiled_key) {
+          k.tiled.reset();
+          k.tiled_error = what;
+          warn("no display across the rig's projectors: " + what);
+          broadcast("keystone", keystoneJson());
+        }
+      });
   return nullptr;
 }
 

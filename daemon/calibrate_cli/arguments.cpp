@@ -86,6 +86,7 @@ Result<std::pair<int, int>> toSize(const std::string& text, const std::string& w
   if (std::sscanf(text.c_str(), "%dx%d%n", &w, &h, &n) != 2 || n != static_cast<int>(text.size()) ||
       w < 1 || h < 1)
     return usage(what + ": expected WIDTHxHEIGHT, got '" + text + "'");
+  if (w > 16384 || h > 16384) return usage(what + ": at most 16384 pixels a side");
   return std::pair{w, h};
 }
 

@@ -36,12 +36,22 @@ Result<void> writeText(const fs::path& file, const std::string& text) {
 }
 
 Result<nlohmann::json> readJson(const fs::path& file) {
+  // Reading a directory throws from the stream buffer; a FIFO would block.
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec)) {
+    return fail(ErrorCode::kIo, "cannot read " + file.string() + ": not a regular file");
+  }
+  if (fs::file_size(file, ec) > (std::uintmax_t{64} << 20)) {
+    return fail(ErrorCode::kTooLarge, file.string() + " is over 64 MiB");
+  }
   std::ifstream in(file);
   if (!in) return fail(ErrorCode::kIo, "cannot read " + file.string());
   try {
     return nlohmann::json::parse(in);
   } catch (const nlohmann::json::exception& e) {
     return fail(ErrorCode::kParse, file.string() + ": " + e.what());
+  } catch (const std::exception& e) {
+    return fail(ErrorCode::kIo, file.string() + ": " + e.what());
   }
 }
 

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "core/guarded_main.hpp"
 
 namespace {
 
@@ -28,7 +29,7 @@ aprilgrid:COLSxROWS:TAG_M[:GAP_M]. See README.md for the file formats.
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run(int argc, char** argv) {
   if (argc < 2 || !std::strcmp(argv[1], "-h") || !std::strcmp(argv[1], "--help")) {
     std::fputs(kUsage, argc < 2 ? stderr : stdout);
     return argc < 2 ? 2 : 0;
@@ -67,4 +68,8 @@ int main(int argc, char** argv) {
   }
   std::fprintf(stderr, "procam-calibrate: unknown command '%s'\n%s", argv[1], kUsage);
   return 2;
+}
+
+int main(int argc, char** argv) {
+  return procam::guardedMain("procam-calibrate", [&] { return run(argc, argv); });
 }

@@ -3,9 +3,10 @@
 #include <string>
 #include <vector>
 
+#include "core/guarded_main.hpp"
 #include "keystone_command.hpp"
 
-int main(int argc, char** argv) {
+static int run(int argc, char** argv) {
   using namespace procam;
   std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty() || args[0] == "--help" || args[0] == "-h" ||
@@ -32,4 +33,8 @@ int main(int argc, char** argv) {
   }
   std::fputs(keystone_cli::formatSolution(*solution, parsed->json).c_str(), stdout);
   return 0;
+}
+
+int main(int argc, char** argv) {
+  return procam::guardedMain("procam-keystone", [&] { return run(argc, argv); });
 }

@@ -59,7 +59,13 @@ std::string keystoneText(const json& k) {
 std::string contentText(const json& c) {
   if (c.is_null()) return "none";
   std::string s = c.value("path", "");
-  if (c.contains("stream")) s = c["stream"].value("path", c["stream"].value("pipeline", ""));
+  if (c.contains("stream")) {
+    const json& st = c["stream"];
+    for (const char* key : {"path", "uri", "v4l2", "pipeline"}) {
+      if (st.contains(key)) s = st[key].get<std::string>();
+    }
+    if (st.contains("test")) s = "test video " + st["test"].get<std::string>();
+  }
   if (c.contains("shared")) s = "shared memory";
   if (c.contains("size")) s += " (" + scalar(c["size"][0]) + "x" + scalar(c["size"][1]) + ")";
   if (c.contains("frames")) {

@@ -3,11 +3,13 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
 
 #include "client.hpp"
+#include "core/guarded_main.hpp"
 #include "format.hpp"
 
 namespace {
@@ -32,7 +34,13 @@ constexpr const char* kUsage =
     "  content [get] | content load PATH | content clear\n"
     "  content stream PATH [WxH [rgb8|rgba8 [FPS]]]\n"
     "                                 raw frames (with a size) or a video file\n"
+    "                                 (PATH: under the daemon's content roots; a relative\n"
+    "                                 PATH that exists here is sent as an absolute one)\n"
+    "  content uri URI                video from file:, http(s): or rtsp(s): URIs\n"
+    "  content v4l2 /dev/videoN       video from a capture device\n"
+    "  content test PATTERN [WxH [FPS]]  a test video (smpte, ball, snow, white...)\n"
     "  content pipeline 'GST-SOURCE'  video from a gst-launch source description\n"
+    "                                 (only where [content] allow_pipeline = true)\n"
     "  log-level [error|warning|info|debug]\n"
     "  tracker [get]                  trackers: positions, rates, registrations\n"
     "  tracker register FILE          FILE: the request's JSON, e.g. {\"points\": [{\"tracker\":\n"
@@ -64,6 +72,25 @@ bool parsePoint(const std::string& text, json& out) {
 }
 
 // The request for a one-shot command line.
+// A relative path that names a file here is what the user means: sent absolute.
+// Otherwise it is sent as given, and the daemon takes it under its first content root.
+std::string clientPath(const std::string& path) {
+  std::error_code ec;
+  if (path.empty() || path.front() == '/' || !std::filesystem::exists(path, ec)) return path;
+  return std::filesystem::absolute(path, ec).lexically_normal().string();
+}
+
+// "WxH" into the request's width and height; usage error otherwise.
+void sizeInto(json& r, const std::string& what, const std::string& text) {
+  int w = 0, h = 0;
+  char tail = 0;
+  if (std::sscanf(text.c_str(), "%dx%d%c", &w, &h, &tail) != 2) {
+    usage(what + ": size '" + text + "' is not WxH");
+  }
+  r["width"] = w;
+  r["height"] = h;
+}
+
 json buildRequest(const std::string& cmd, const std::vector<std::string>& a) {
   auto arity = [&](size_t lo, size_t hi) {
     if (a.size() < lo || a.size() > hi) usage("wrong number of arguments for " + cmd);
@@ -108,21 +135,23 @@ json buildRequest(const std::string& cmd, const std::vector<std::string>& a) {
     r["action"] = action;
     if (action == "load") {
       arity(2, 2);
-      r["path"] = a[1];
+      r["path"] = clientPath(a[1]);
     } else if (action == "get" || action == "clear") {
       arity(0, 1);
+    } else if (action == "uri" || action == "v4l2") {
+      arity(2, 2);
+      r["action"] = "stream";
+      r[action] = a[1];
+    } else if (action == "test") {
+      arity(2, 4);
+      r["action"] = "stream";
+      r["test"] = a[1];
+      if (a.size() > 2) sizeInto(r, "content test", a[2]);
+      if (a.size() > 3) r["fps"] = std::atof(a[3].c_str());
     } else if (action == "stream") {
       arity(2, 5);
-      r["path"] = a[1];
-      if (a.size() > 2) {
-        int w = 0, h = 0;
-        char tail = 0;
-        if (std::sscanf(a[2].c_str(), "%dx%d%c", &w, &h, &tail) != 2) {
-          usage("content stream: size '" + a[2] + "' is not WxH");
-        }
-        r["width"] = w;
-        r["height"] = h;
-      }
+      r["path"] = clientPath(a[1]);
+      if (a.size() > 2) sizeInto(r, "content stream", a[2]);
       if (a.size() > 3) r["format"] = a[3];
       if (a.size() > 4) r["fps"] = std::atof(a[4].c_str());
     } else if (action == "pipeline") {
@@ -245,7 +274,7 @@ int runOperation(const Options& o, procam::ctl::Client& c, const json& request) 
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run(int argc, char** argv) {
   Options o;
   const char* env = std::getenv("PROCAMD_SOCKET");
   o.socket = env && *env ? env : "/run/procamd/control.sock";
@@ -289,4 +318,8 @@ int main(int argc, char** argv) {
   if (!reply) return fail(reply.error());
   print(o, *reply, false);
   return exitFor(*reply);
+}
+
+int main(int argc, char** argv) {
+  return procam::guardedMain("procamctl", [&] { return run(argc, argv); });
 }

@@ -4,6 +4,8 @@
 #include <gst/gst.h>
 #include <gst/video/video.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 
 namespace procam::content {
@@ -158,6 +160,63 @@ Result<std::unique_ptr<ContentSource>> openGstPipeline(const std::string& descri
   gst_element_set_state(pipeline.get(), GST_STATE_PLAYING);
   return std::unique_ptr<ContentSource>(
       std::make_unique<GstVideo>(std::move(pipeline), sink, size, interval));
+}
+
+Result<std::unique_ptr<ContentSource>> openVideoUri(const std::string& uri,
+                                                    const GstOptions& options) {
+  const std::size_t colon = uri.find("://");
+  const std::string scheme = colon == std::string::npos ? "" : uri.substr(0, colon);
+  if (scheme != "http" && scheme != "https" && scheme != "rtsp" && scheme != "rtsps") {
+    return fail(ErrorCode::kInvalidInput,
+                "video URI '" + uri + "': the scheme must be http, https, rtsp or rtsps");
+  }
+  if (uri.size() > 2048) return fail(ErrorCode::kInvalidInput, "video URI over 2048 characters");
+  for (const char ch : uri) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c <= 0x20 || c >= 0x7F || ch == '"' || ch == '\\' || ch == '\'') {
+      return fail(ErrorCode::kInvalidInput,
+                  "video URI with a character that must be percent-encoded (quote, backslash, "
+                  "space, control or non-ASCII)");
+    }
+  }
+  if (auto ok = initGstreamer(); !ok) return tl::unexpected(ok.error());
+  if (!gst_uri_is_valid(uri.c_str())) {
+    return fail(ErrorCode::kInvalidInput, "video URI '" + uri + "' is not a valid URI");
+  }
+  return openGstPipeline("uridecodebin uri=\"" + uri + "\"", options);
+}
+
+Result<std::unique_ptr<ContentSource>> openV4l2Video(const std::string& device,
+                                                     const GstOptions& options) {
+  const std::string prefix = "/dev/video";
+  const std::string number =
+      device.substr(0, prefix.size()) == prefix ? device.substr(prefix.size()) : std::string();
+  if (number.empty() || number.size() > 3 ||
+      number.find_first_not_of("0123456789") != std::string::npos) {
+    return fail(ErrorCode::kInvalidInput, "V4L2 device '" + device + "' is not /dev/videoN");
+  }
+  return openGstPipeline("v4l2src device=" + device, options);
+}
+
+Result<std::unique_ptr<ContentSource>> openTestVideo(const std::string& pattern, cv::Size size,
+                                                     double fps, const GstOptions& options) {
+  if (std::find(std::begin(kTestVideoPatterns), std::end(kTestVideoPatterns), pattern) ==
+      std::end(kTestVideoPatterns)) {
+    std::string names;
+    for (const char* p : kTestVideoPatterns) names += (names.empty() ? "" : ", ") + std::string(p);
+    return fail(ErrorCode::kInvalidInput, "unknown test video '" + pattern + "' (" + names + ")");
+  }
+  if (size.width < 2 || size.height < 2 || size.width > 16384 || size.height > 16384) {
+    return fail(ErrorCode::kInvalidInput, "a test video is 2x2 to 16384x16384 pixels");
+  }
+  if (!(fps > 0 && fps <= 1000)) {
+    return fail(ErrorCode::kInvalidInput, "a test video's frame rate is over 0 and at most 1000");
+  }
+  const int rate = static_cast<int>(std::lround(fps * 1000));
+  return openGstPipeline(
+      "videotestsrc pattern=" + pattern + " ! video/x-raw,width=" + std::to_string(size.width) +
+          ",height=" + std::to_string(size.height) + ",framerate=" + std::to_string(rate) + "/1000",
+      options);
 }
 
 Result<std::unique_ptr<ContentSource>> openVideoFile(const std::string& path,

@@ -2,12 +2,11 @@
 
 #include <limits>
 
-#include "sim/mesh_io.hpp"
-
 namespace procam::content {
 
-Result<MeshContent> loadMeshContent(const std::filesystem::path& file) {
-  auto mesh = sim::loadMesh(file);
+namespace {
+
+Result<MeshContent> bounded(Result<geom::TriangleMesh> mesh) {
   if (!mesh) return tl::unexpected(mesh.error());
   // The reader refuses a mesh without faces: the bounds below are finite.
   MeshContent out;
@@ -22,6 +21,18 @@ Result<MeshContent> loadMeshContent(const std::filesystem::path& file) {
   }
   out.mesh = std::move(*mesh);
   return out;
+}
+
+}  // namespace
+
+Result<MeshContent> loadMeshContent(const std::filesystem::path& file,
+                                    const sim::MeshLimits& limits) {
+  return bounded(sim::loadMesh(file, limits));
+}
+
+Result<MeshContent> meshContentFromBytes(std::string_view bytes, const std::string& name,
+                                         const sim::MeshLimits& limits) {
+  return bounded(sim::parseMesh(bytes, name, limits));
 }
 
 }  // namespace procam::content

@@ -7,6 +7,7 @@
 
 #include "core/error.hpp"
 #include "geometry/intersect.hpp"
+#include "sim/mesh_io.hpp"
 
 namespace procam::content {
 
@@ -17,7 +18,11 @@ struct MeshContent {
 };
 
 // kIo / kParse / kInvalidInput from the reader (which refuses a mesh without a
-// triangle).
-Result<MeshContent> loadMeshContent(const std::filesystem::path& file);
+// triangle); kTooLarge over `limits`.
+Result<MeshContent> loadMeshContent(const std::filesystem::path& file,
+                                    const sim::MeshLimits& limits = {});
+// The same from the file's bytes; `name` gives the format (.obj, .ply).
+Result<MeshContent> meshContentFromBytes(std::string_view bytes, const std::string& name,
+                                         const sim::MeshLimits& limits = {});
 
 }  // namespace procam::content

@@ -92,7 +92,8 @@ Result<std::unique_ptr<ContentSource>> openRawFrames(const std::string& path,
     return fail(ErrorCode::kInvalidInput, "fps must be a finite number >= 0");
   }
   // Non-blocking so that opening a FIFO does not wait for its writer.
-  UniqueFd fd(::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC));
+  // O_NOFOLLOW: a symlink put where the file was checked is refused, not followed.
+  UniqueFd fd(::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOFOLLOW | O_CLOEXEC));
   if (!fd.valid()) return fail(ErrorCode::kIo, path + ": " + std::strerror(errno));
   struct stat st {};
   if (::fstat(fd.get(), &st) != 0) return fail(ErrorCode::kIo, path + ": " + std::strerror(errno));

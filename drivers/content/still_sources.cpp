@@ -1,9 +1,14 @@
 #include "still_sources.hpp"
 
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <limits>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "image_header.hpp"
 #include "test_pattern.hpp"
 
 namespace procam::content {
@@ -37,10 +42,38 @@ std::unique_ptr<ContentSource> singleFrameSource(cv::Mat pixels, PixelFormat for
   return std::make_unique<SingleFrame>(std::move(pixels), format);
 }
 
-Result<std::unique_ptr<ContentSource>> openStillImage(const std::string& path) {
+Result<std::unique_ptr<ContentSource>> openStillImage(const std::string& path,
+                                                      std::uint64_t max_pixels) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    return fail(ErrorCode::kIo, "cannot read an image from " + path + ": not a regular file");
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return fail(ErrorCode::kIo, "cannot read an image from " + path);
+  const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  return decodeStillImage(bytes, path, max_pixels);
+}
+
+Result<std::unique_ptr<ContentSource>> decodeStillImage(std::string_view bytes,
+                                                        const std::string& path,
+                                                        std::uint64_t max_pixels) {
+  auto header = readImageHeader(bytes);
+  if (!header) return fail(ErrorCode::kIo, path + ": " + header.error().message);
+  const std::uint64_t pixels =
+      std::uint64_t(header->size.width) * std::uint64_t(header->size.height);
+  if (pixels > max_pixels) {
+    return fail(ErrorCode::kTooLarge, path + ": " + std::to_string(header->size.width) + "x" +
+                                          std::to_string(header->size.height) +
+                                          " pixels, over the " + std::to_string(max_pixels) +
+                                          "-pixel limit");
+  }
+  if (bytes.size() > std::size_t(std::numeric_limits<int>::max())) {
+    return fail(ErrorCode::kTooLarge, path + ": over 2 GiB");
+  }
   cv::Mat image;
   try {
-    image = cv::imread(path, cv::IMREAD_UNCHANGED);
+    const cv::Mat raw(1, int(bytes.size()), CV_8U, const_cast<char*>(bytes.data()));
+    image = cv::imdecode(raw, cv::IMREAD_UNCHANGED);
     if (image.empty()) return fail(ErrorCode::kIo, "cannot read an image from " + path);
     if (image.depth() == CV_16U) image.convertTo(image, CV_8U, 1.0 / 257.0);
     if (image.depth() != CV_8U) return fail(ErrorCode::kIo, path + ": unsupported pixel type");

@@ -43,9 +43,16 @@ bool objIndex(const std::string& token, int vertex_count, int& out) {
   return true;
 }
 
+tl::unexpected<Error> tooLarge(const std::string& origin, const std::string& what,
+                               std::size_t limit) {
+  return fail(ErrorCode::kTooLarge,
+              origin + ": more than " + std::to_string(limit) + " " + what + " (the limit)");
+}
+
 }  // namespace
 
-Result<geom::TriangleMesh> parseObj(std::string_view text, const std::string& origin) {
+Result<geom::TriangleMesh> parseObj(std::string_view text, const std::string& origin,
+                                    const MeshLimits& limits) {
   geom::TriangleMesh mesh;
   std::istringstream in{std::string(text)};
   std::string line;
@@ -58,6 +65,8 @@ Result<geom::TriangleMesh> parseObj(std::string_view text, const std::string& or
     if (tag == "v") {
       Vec3 v;
       if (!(fields >> v.x() >> v.y() >> v.z())) return parseError(origin, line_no, "bad vertex");
+      if (mesh.vertices.size() >= limits.vertices)
+        return tooLarge(origin, "vertices", limits.vertices);
       mesh.vertices.push_back(v);
     } else if (tag == "f") {
       std::vector<int> idx;
@@ -66,9 +75,14 @@ Result<geom::TriangleMesh> parseObj(std::string_view text, const std::string& or
         int i = 0;
         if (!objIndex(token, static_cast<int>(mesh.vertices.size()), i))
           return parseError(origin, line_no, "bad face index '" + token + "'");
+        if (idx.size() >= limits.face_indices)
+          return tooLarge(origin + ":" + std::to_string(line_no), "vertices in one face",
+                          limits.face_indices);
         idx.push_back(i);
       }
       if (idx.size() < 3) return parseError(origin, line_no, "face with fewer than 3 vertices");
+      if (mesh.faces.size() + idx.size() - 2 > limits.faces)
+        return tooLarge(origin, "triangles", limits.faces);
       for (std::size_t k = 1; k + 1 < idx.size(); ++k)
         mesh.faces.emplace_back(idx[0], idx[k], idx[k + 1]);
     }
@@ -181,7 +195,8 @@ class PlyReader {
 
 }  // namespace
 
-Result<geom::TriangleMesh> parsePly(std::string_view bytes, const std::string& origin) {
+Result<geom::TriangleMesh> parsePly(std::string_view bytes, const std::string& origin,
+                                    const MeshLimits& limits) {
   const std::size_t end = bytes.find("end_header");
   if (bytes.substr(0, 3) != "ply" || end == std::string_view::npos)
     return fail(ErrorCode::kParse, origin + ": not a PLY file");
@@ -208,6 +223,17 @@ Result<geom::TriangleMesh> parsePly(std::string_view bytes, const std::string& o
     } else if (tag == "element") {
       PlyElement e;
       if (!(f >> e.name >> e.count)) return parseError(origin, line_no, "bad element line");
+      // What an element may declare: each of its records takes at least one byte
+      // (binary) or two (ascii), so a count beyond the body is a lie.
+      if (e.count > bytes.size()) {
+        return parseError(origin, line_no,
+                          "element '" + e.name + "' declares " + std::to_string(e.count) +
+                              " records in a file of " + std::to_string(bytes.size()) + " bytes");
+      }
+      if (e.name == "vertex" && e.count > limits.vertices)
+        return tooLarge(origin, "vertices", limits.vertices);
+      if (e.name == "face" && e.count > limits.faces)
+        return tooLarge(origin, "faces", limits.faces);
       elements.push_back(e);
     } else if (tag == "property") {
       if (elements.empty()) return parseError(origin, line_no, "property before element");
@@ -238,17 +264,23 @@ Result<geom::TriangleMesh> parsePly(std::string_view bytes, const std::string& o
       for (const auto& p : e.props) {
         if (p.is_list) {
           double count = 0;
-          if (!reader.read(p.count_type, count) || count < 0)
+          if (!reader.read(p.count_type, count) || !(count >= 0))
             return fail(ErrorCode::kParse, origin + ": truncated " + e.name + " list");
+          if (count > double(limits.face_indices))
+            return tooLarge(origin, "indices in one " + e.name + " list", limits.face_indices);
           std::vector<int> idx(static_cast<std::size_t>(count));
           for (auto& k : idx) {
             double value = 0;
             if (!reader.read(p.type, value))
               return fail(ErrorCode::kParse, origin + ": truncated " + e.name + " list");
+            if (!(value >= -1e9 && value <= 1e9))
+              return fail(ErrorCode::kParse, origin + ": " + e.name + " index out of range");
             k = static_cast<int>(value);
           }
           if (e.name == "face" && (p.name == "vertex_indices" || p.name == "vertex_index")) {
             if (idx.size() < 3) return fail(ErrorCode::kParse, origin + ": face with < 3 vertices");
+            if (mesh.faces.size() + idx.size() - 2 > limits.faces)
+              return tooLarge(origin, "triangles", limits.faces);
             for (std::size_t k = 1; k + 1 < idx.size(); ++k)
               mesh.faces.emplace_back(idx[0], idx[k], idx[k + 1]);
           }
@@ -266,17 +298,27 @@ Result<geom::TriangleMesh> parsePly(std::string_view bytes, const std::string& o
   return checked(std::move(mesh), origin);
 }
 
-Result<geom::TriangleMesh> loadMesh(const std::filesystem::path& file) {
+Result<geom::TriangleMesh> parseMesh(std::string_view bytes, const std::string& name,
+                                     const MeshLimits& limits) {
+  std::string ext = std::filesystem::path(name).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext == ".obj") return parseObj(bytes, name, limits);
+  if (ext == ".ply") return parsePly(bytes, name, limits);
+  return fail(ErrorCode::kInvalidInput, "unknown mesh format (want .obj or .ply): " + name);
+}
+
+Result<geom::TriangleMesh> loadMesh(const std::filesystem::path& file, const MeshLimits& limits) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) {
+    return fail(ErrorCode::kIo, "cannot open mesh file " + file.string() + ": not a regular file");
+  }
+  const auto size = std::filesystem::file_size(file, ec);
+  if (!ec && size > limits.file_bytes) return tooLarge(file.string(), "bytes", limits.file_bytes);
   std::ifstream in(file, std::ios::binary);
   if (!in) return fail(ErrorCode::kIo, "cannot open mesh file " + file.string());
   const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  std::string ext = file.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (ext == ".obj") return parseObj(bytes, file.string());
-  if (ext == ".ply") return parsePly(bytes, file.string());
-  return fail(ErrorCode::kInvalidInput,
-              "unknown mesh format (want .obj or .ply): " + file.string());
+  return parseMesh(bytes, file.string(), limits);
 }
 
 }  // namespace procam::sim

@@ -9,10 +9,25 @@
 
 namespace procam::sim {
 
-// Picks the reader by extension (.obj / .ply, case-insensitive).
-Result<geom::TriangleMesh> loadMesh(const std::filesystem::path& file);
+// Bounds on what a file may declare or hold; a file over one is refused with
+// kTooLarge before the memory is taken. The defaults fit any scene surface.
+struct MeshLimits {
+  std::size_t vertices = 4'000'000;
+  std::size_t faces = 4'000'000;  // triangles, after polygons are fanned
+  std::size_t face_indices = 64;  // vertices of one polygon
+  std::size_t file_bytes = std::size_t{512} << 20;
+};
 
-Result<geom::TriangleMesh> parseObj(std::string_view text, const std::string& origin);
-Result<geom::TriangleMesh> parsePly(std::string_view bytes, const std::string& origin);
+// Picks the reader by extension (.obj / .ply, case-insensitive).
+Result<geom::TriangleMesh> loadMesh(const std::filesystem::path& file,
+                                    const MeshLimits& limits = {});
+// The same from bytes already read; `name` gives the extension and the messages' origin.
+Result<geom::TriangleMesh> parseMesh(std::string_view bytes, const std::string& name,
+                                     const MeshLimits& limits = {});
+
+Result<geom::TriangleMesh> parseObj(std::string_view text, const std::string& origin,
+                                    const MeshLimits& limits = {});
+Result<geom::TriangleMesh> parsePly(std::string_view bytes, const std::string& origin,
+                                    const MeshLimits& limits = {});
 
 }  // namespace procam::sim

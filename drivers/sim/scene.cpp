@@ -86,6 +86,14 @@ SceneState Scene::at(double time) const {
 }
 
 Result<Scene> Scene::load(const std::filesystem::path& file) {
+  // A directory or FIFO would throw from the stream buffer or block; a scene is text.
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) {
+    return fail(ErrorCode::kIo, "scene file " + file.string() + " is not a regular file");
+  }
+  if (std::filesystem::file_size(file, ec) > (std::uintmax_t{16} << 20)) {
+    return fail(ErrorCode::kTooLarge, "scene file " + file.string() + " is over 16 MiB");
+  }
   std::ifstream in(file, std::ios::binary);
   if (!in) return fail(ErrorCode::kIo, "cannot open scene file " + file.string());
   const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};

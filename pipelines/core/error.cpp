@@ -34,6 +34,10 @@ const char* toString(ErrorCode code) {
       return "ended";
     case ErrorCode::kInternal:
       return "internal";
+    case ErrorCode::kTooLarge:
+      return "too-large";
+    case ErrorCode::kForbidden:
+      return "forbidden";
   }
   return "unknown";
 }

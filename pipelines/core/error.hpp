@@ -26,6 +26,8 @@ enum class ErrorCode {
   kNotSupported,  // the device or driver has no such operation or control (PROCAM_ENOTSUP)
   kEnded,         // the stream ended for good, e.g. a finished recording (PROCAM_EEND)
   kInternal,      // a driver failed where it did not expect to (PROCAM_EINTERNAL)
+  kTooLarge,      // an input over a configured bound (pixels, faces, bytes, queued work)
+  kForbidden,     // outside what the caller may reach (a file outside the content roots)
 };
 
 const char* toString(ErrorCode code);

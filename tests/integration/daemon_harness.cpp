@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/socket.h>
 #include <sys/un.h>
 #include <sys/wait.h>
@@ -33,6 +34,15 @@ void TempDir::write(const std::string& name, const std::string& text) const {
   std::ofstream(file(name), std::ios::binary) << text;
 }
 
+std::string contentFile(const TempDir& root, const std::string& name) {
+  std::filesystem::create_directories(root.file("state/content"));
+  return root.file("state/content/" + name);
+}
+
+void writeContent(const TempDir& root, const std::string& name, const std::string& text) {
+  std::ofstream(contentFile(root, name), std::ios::binary) << text;
+}
+
 DaemonProcess::DaemonProcess(const TempDir& root, Launch launch)
     : run_dir_(root.file("run")), log_path_(root.file("daemon.log")) {
   std::vector<std::string> args = {PROCAMD_BIN, "--runtime-dir", run_dir_, "--state-dir",
@@ -46,6 +56,10 @@ DaemonProcess::DaemonProcess(const TempDir& root, Launch launch)
     ::unsetenv("NOTIFY_SOCKET");
     ::unsetenv("LISTEN_FDS");
     for (const auto& e : launch.env) ::putenv(const_cast<char*>(e.c_str()));
+    if (launch.max_fds > 0) {
+      const rlimit limit{rlim_t(launch.max_fds), rlim_t(launch.max_fds)};
+      ::setrlimit(RLIMIT_NOFILE, &limit);
+    }
     if (launch.listen_fd >= 0) {
       ::dup2(launch.listen_fd, 3);
       ::setenv("LISTEN_FDS", "1", 1);

@@ -29,6 +29,11 @@ class TempDir {
   std::string path_;
 };
 
+// A file in the content root of a daemon started in `root` (its state
+// directory's content/, created here): where a client's content must lie.
+std::string contentFile(const TempDir& root, const std::string& name);
+void writeContent(const TempDir& root, const std::string& name, const std::string& text);
+
 class DaemonProcess {
  public:
   struct Launch {
@@ -36,6 +41,7 @@ class DaemonProcess {
     std::vector<std::string> env;   // NAME=value added to the environment
     int listen_fd = -1;             // passed as fd 3 with LISTEN_FDS=1
     bool wait_for_socket = true;
+    int max_fds = 0;  // RLIMIT_NOFILE of the daemon when > 0
   };
 
   // `root` holds run/, state/ and daemon.log.

@@ -161,7 +161,7 @@ TEST(Control, KeystoneSetGetClearAndUnavailableAuto) {
 TEST(Control, ContentLoadDecodesOnAWorkerAndReportsProgress) {
   Rig rig;
   ASSERT_TRUE(rig.daemon->started());
-  const std::string png = rig.dir.file("slide.png");
+  const std::string png = contentFile(rig.dir, "slide.png");
   ASSERT_TRUE(cv::imwrite(png, cv::Mat(48, 64, CV_8UC3, cv::Scalar(10, 20, 30))));
   Connection c = rig.connect();
   ASSERT_TRUE(c.send({{"cmd", "content"}, {"action", "load"}, {"path", png}, {"id", "L"}}));
@@ -181,8 +181,10 @@ TEST(Control, ContentLoadDecodesOnAWorkerAndReportsProgress) {
   EXPECT_EQ(lines[3]["id"], "L");
   EXPECT_EQ(lines[3]["content"]["size"], json({64, 48}));
 
-  auto missing = c.call(
-      {{"cmd", "content"}, {"action", "load"}, {"path", rig.dir.file("none.png")}, {"id", "M"}});
+  auto missing = c.call({{"cmd", "content"},
+                         {"action", "load"},
+                         {"path", contentFile(rig.dir, "none.png")},
+                         {"id", "M"}});
   ASSERT_TRUE(missing);
   EXPECT_EQ((*missing)["class"], "ERROR");
   EXPECT_EQ((*missing)["code"], "io-error");

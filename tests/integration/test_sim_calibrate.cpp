@@ -245,9 +245,9 @@ TEST(SimCalibrate, CamerasCoarserThanTheProjector) {
   DaemonProcess d(dir, DaemonProcess::Launch{{"--sim", scene}, {}, -1, true});
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
-  dir.write("cube.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  writeContent(dir, "cube.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
   auto before =
-      c.call({{"cmd", "content"}, {"action", "load"}, {"path", dir.file("cube.obj")}}, 30s);
+      c.call({{"cmd", "content"}, {"action", "load"}, {"path", contentFile(dir, "cube.obj")}}, 30s);
   ASSERT_TRUE(before);
   EXPECT_EQ((*before)["code"], "unavailable") << before->dump();  // no projector on 'proj' yet
   json reply;
@@ -263,8 +263,8 @@ TEST(SimCalibrate, CamerasCoarserThanTheProjector) {
   std::optional<json> after;
   ASSERT_TRUE(eventually(
       [&] {
-        after =
-            c.call({{"cmd", "content"}, {"action", "load"}, {"path", dir.file("cube.obj")}}, 30s);
+        after = c.call(
+            {{"cmd", "content"}, {"action", "load"}, {"path", contentFile(dir, "cube.obj")}}, 30s);
         return after && (*after)["class"] == "CONTENT";
       },
       10s))
@@ -540,7 +540,7 @@ TEST(SimCalibrate, ImageContentOnTheCalibratedCornerMatchesTheTrueRig) {
   constexpr int kW = 320, kH = 200;
   cv::Mat bgr(kH, kW, CV_8UC3, cv::Scalar(0, 0, 255));
   bgr(cv::Rect(kW / 2, 0, kW / 2, kH)).setTo(cv::Scalar(255, 0, 0));
-  const std::string png = dir.file("halves.png");
+  const std::string png = contentFile(dir, "halves.png");
   ASSERT_TRUE(cv::imwrite(png, bgr));
   auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", png}}, 30s);
   ASSERT_TRUE(load);
@@ -590,10 +590,10 @@ TEST(SimCalibrate, ImageContentOnTheCalibratedCornerMatchesTheTrueRig) {
 TEST(SimCalibrate, MeshContentOnTheCalibratedCornerMatchesTheTrueRig) {
   TempDir dir;
   const std::string scene = sceneFile(dir);
-  dir.write("cube.obj",
-            "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\n"
-            "v -1 1 1\nf 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 4 7 3\n"
-            "f 4 8 7\nf 1 5 8\nf 1 8 4\nf 2 3 7\nf 2 7 6\n");
+  writeContent(dir, "cube.obj",
+               "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\n"
+               "v -1 1 1\nf 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 4 7 3\n"
+               "f 4 8 7\nf 1 5 8\nf 1 8 4\nf 2 3 7\nf 2 7 6\n");
   DaemonProcess d(dir, cornerWithViewer(dir, scene));
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
@@ -601,8 +601,8 @@ TEST(SimCalibrate, MeshContentOnTheCalibratedCornerMatchesTheTrueRig) {
   std::optional<json> load;
   ASSERT_TRUE(eventually(
       [&] {
-        load =
-            c.call({{"cmd", "content"}, {"action", "load"}, {"path", dir.file("cube.obj")}}, 30s);
+        load = c.call(
+            {{"cmd", "content"}, {"action", "load"}, {"path", contentFile(dir, "cube.obj")}}, 30s);
         return load && (*load)["class"] == "CONTENT";
       },
       10s))
@@ -615,7 +615,7 @@ TEST(SimCalibrate, MeshContentOnTheCalibratedCornerMatchesTheTrueRig) {
 
   // The placement the daemon made, from what it reports (placement is the daemon's
   // choice, not a fact of the rig): the plane and the viewer's content image.
-  auto cube = content::loadMeshContent(dir.file("cube.obj"));
+  auto cube = content::loadMeshContent(contentFile(dir, "cube.obj"));
   ASSERT_TRUE(cube);
   auto vec = [](const json& j) {
     return Vec3(j[0].get<double>(), j[1].get<double>(), j[2].get<double>());

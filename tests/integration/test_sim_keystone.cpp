@@ -315,7 +315,7 @@ TEST(SimKeystone, KeystoneSetGetAndWhatTheOutputShows) {
               quadFraction(outerCorners(H, 1280, 720)), 4e-3);
 
   // Content: a red image, shown through the same warp when the pattern is off.
-  const std::string png = dir.file("red.png");
+  const std::string png = contentFile(dir, "red.png");
   cv::imwrite(png, cv::Mat(180, 320, CV_8UC3, cv::Scalar(0, 0, 255)));  // BGR
   ASSERT_EQ((*c.call({{"cmd", "pattern"}, {"name", "off"}}))["pattern"], "off");
   auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", png}});

@@ -94,11 +94,12 @@ Expected rayCast(const content::PlacedMesh& placed, const Mat34& P, cv::Size siz
 void expectCubeShown(Connection& c, const TempDir& dir, const Vec3& eye,
                      const std::string& source) {
   ASSERT_EQ((*c.call({{"cmd", "pattern"}, {"name", "off"}}))["pattern"], "off");
-  auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", dir.file("cube.obj")}}, 30s);
+  auto load =
+      c.call({{"cmd", "content"}, {"action", "load"}, {"path", contentFile(dir, "cube.obj")}}, 30s);
   ASSERT_TRUE(load);
   ASSERT_EQ((*load)["class"], "CONTENT") << load->dump();
   const json info = (*load)["content"];
-  EXPECT_EQ(info["path"], dir.file("cube.obj"));
+  EXPECT_EQ(info["path"], contentFile(dir, "cube.obj"));
   EXPECT_EQ(info["mesh"]["triangles"], 12);
   EXPECT_EQ(info["mesh"]["viewer"]["source"], source);
   const json p = info["mesh"]["viewer"]["position"];
@@ -119,7 +120,7 @@ void expectCubeShown(Connection& c, const TempDir& dir, const Vec3& eye,
   ASSERT_TRUE(scene);
   const sim::SceneState state = scene->at(0);
   const geom::CameraModel& proj = state.projector("proj")->model;
-  auto cube = content::loadMeshContent(dir.file("cube.obj"));
+  auto cube = content::loadMeshContent(contentFile(dir, "cube.obj"));
   ASSERT_TRUE(cube);
   content::PlanarView view;
   view.projector = proj.projectionMatrix();
@@ -156,7 +157,7 @@ void expectCubeShown(Connection& c, const TempDir& dir, const Vec3& eye,
 
 TEST(SimMeshContent, ObjCubeOnTheObliqueWallIsDrawnForTheSceneViewer) {
   TempDir dir;
-  dir.write("cube.obj", kCubeObj);
+  writeContent(dir, "cube.obj", kCubeObj);
   DaemonProcess d(dir, simWithTruth(dir, "wall_oblique"));
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
@@ -167,14 +168,14 @@ TEST(SimMeshContent, ObjCubeOnTheObliqueWallIsDrawnForTheSceneViewer) {
   ASSERT_TRUE(eventually([&] { return shownStats(c)["source"] == "none"; }));
   // A missing file is an I/O error, not `unavailable`.
   auto missing =
-      c.call({{"cmd", "content"}, {"action", "load"}, {"path", dir.file("none.obj")}}, 30s);
+      c.call({{"cmd", "content"}, {"action", "load"}, {"path", contentFile(dir, "none.obj")}}, 30s);
   ASSERT_TRUE(missing);
   EXPECT_EQ((*missing)["code"], "io-error") << missing->dump();
 }
 
 TEST(SimMeshContent, ConfiguredViewerWinsOverTheScenes) {
   TempDir dir;
-  dir.write("cube.obj", kCubeObj);
+  writeContent(dir, "cube.obj", kCubeObj);
   dir.write("procamd.toml",
             "[sim]\nscene = \"wall_oblique\"\n[content]\nviewer = [0.6, 0.9, 1.3]\n");
   DaemonProcess d(dir, DaemonProcess::Launch{{"--config", dir.file("procamd.toml"), "--rig",
@@ -190,11 +191,12 @@ TEST(SimMeshContent, ConfiguredViewerWinsOverTheScenes) {
 // `content load` of the cube on a daemon started with `launch`: the ERROR reply,
 // checked to be `unavailable`.
 json unavailableLoad(const TempDir& dir, DaemonProcess::Launch launch) {
-  dir.write("cube.obj", kCubeObj);
+  writeContent(dir, "cube.obj", kCubeObj);
   DaemonProcess d(dir, std::move(launch));
   EXPECT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
-  auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", dir.file("cube.obj")}}, 30s);
+  auto load =
+      c.call({{"cmd", "content"}, {"action", "load"}, {"path", contentFile(dir, "cube.obj")}}, 30s);
   if (!load) {
     ADD_FAILURE() << "no reply";
     return nullptr;
@@ -271,7 +273,7 @@ TEST(SimMeshContent, DrawingFollowsTheTrackedViewerAndNotItsNoise) {
   const Vec3 A(0.0, 0.5, 1.6), B(0.45, 0.7, 1.45);
   constexpr double kThreshold = 0.005;  // [content] viewer_threshold_m (the default)
   TempDir dir;
-  dir.write("cube.obj", kCubeObj);
+  writeContent(dir, "cube.obj", kCubeObj);
   dir.write("follow.toml", kFollowScene);
   dir.write("procamd.toml", "[sim]\nscene = \"" + dir.file("follow.toml") +
                                 "\"\n[content]\nviewer_threshold_m = 0.005\n");
@@ -284,7 +286,8 @@ TEST(SimMeshContent, DrawingFollowsTheTrackedViewerAndNotItsNoise) {
   Connection c(d.socketPath());
   ASSERT_EQ((*c.call({{"cmd", "pattern"}, {"name", "off"}}))["pattern"], "off");
   ASSERT_TRUE(eventually([&] { return (*c.call({{"cmd", "status"}}))["viewer"].is_object(); }));
-  auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", dir.file("cube.obj")}}, 30s);
+  auto load =
+      c.call({{"cmd", "content"}, {"action", "load"}, {"path", contentFile(dir, "cube.obj")}}, 30s);
   ASSERT_TRUE(load);
   ASSERT_EQ((*load)["class"], "CONTENT") << load->dump();
   const json viewer = (*load)["content"]["mesh"]["viewer"];
@@ -339,7 +342,7 @@ TEST(SimMeshContent, DrawingFollowsTheTrackedViewerAndNotItsNoise) {
   ASSERT_TRUE(scene) << scene.error().message;
   const sim::SceneState state = scene->at(0);  // by value: keep it while `proj` is used
   const geom::CameraModel& proj = state.projector("proj")->model;
-  auto cube = content::loadMeshContent(dir.file("cube.obj"));
+  auto cube = content::loadMeshContent(contentFile(dir, "cube.obj"));
   ASSERT_TRUE(cube);
   content::PlanarView view;
   view.projector = proj.projectionMatrix();

@@ -94,7 +94,7 @@ void keystoneFromTheRigMatchesTruth(Connection& c, const TempDir& dir,
   EXPECT_EQ((*status)["keystone"]["mode"], "rig");
 
   // Nothing loaded: the content is the output's 1920x1080; then a 4:3 image.
-  const std::string png = dir.file("slide.png");
+  const std::string png = contentFile(dir, "slide.png");
   cv::imwrite(png, cv::Mat(600, 800, CV_8UC3, cv::Scalar(255, 255, 255)));
   for (int round = 0; round < 2; ++round) {
     if (round == 1) {

@@ -227,7 +227,7 @@ TEST(SimTiledWall, FourProjectorsCalibratedIntoOneSeamlessDisplay) {
 
   // A 16:9 white slide on the one display.
   constexpr int kW = 1600, kH = 900;
-  const std::string png = dir.file("slide.png");
+  const std::string png = contentFile(dir, "slide.png");
   ASSERT_TRUE(cv::imwrite(png, cv::Mat(kH, kW, CV_8UC3, cv::Scalar(255, 255, 255))));
   auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", png}}, 30s);
   ASSERT_TRUE(load);

@@ -18,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "core/guarded_main.hpp"
 #include "core/units.hpp"
 #include "demo/child_process.hpp"
 #include "keystone/display_error.hpp"
@@ -119,7 +120,7 @@ void section(const char* title) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run(int argc, char** argv) {
   Options opt;
   if (!parseArgs(argc, argv, opt)) {
     usage();
@@ -287,4 +288,8 @@ int main(int argc, char** argv) {
   std::error_code ec;
   std::filesystem::remove_all(dir, ec);
   return status == 0 && updates > 0 ? 0 : 1;
+}
+
+int main(int argc, char** argv) {
+  return procam::guardedMain("procam-demo", [&] { return run(argc, argv); });
 }

@@ -190,7 +190,7 @@ TEST(ContentStream, RawFramesFromAFifo) {
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
   ASSERT_NO_FATAL_FAILURE(identityKeystone(c));
-  const std::string fifo = dir.file("frames");
+  const std::string fifo = contentFile(dir, "frames");
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   auto reply = c.call({{"cmd", "content"},
                        {"action", "stream"},
@@ -232,7 +232,7 @@ TEST(ContentStream, RawFramesFromAFifo) {
   EXPECT_EQ((*r)["code"], "bad-argument") << r->dump();
   r = c.call({{"cmd", "content"},
               {"action", "stream"},
-              {"path", dir.file("missing")},
+              {"path", contentFile(dir, "missing")},
               {"width", 64},
               {"height", 64}});
   EXPECT_EQ((*r)["code"], "io-error") << r->dump();
@@ -245,7 +245,7 @@ TEST(ContentStream, ProcamctlStreamsRawFramesFromAFile) {
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
   ASSERT_NO_FATAL_FAILURE(identityKeystone(c));
-  const std::string file = dir.file("one.rgba");
+  const std::string file = contentFile(dir, "one.rgba");
   const cv::Mat a = twoAreas({10, 20, 30, 255}, {200, 100, 50, 255}, 640);
   {
     std::ofstream out(file, std::ios::binary);
@@ -266,9 +266,13 @@ TEST(ContentStream, ProcamctlStreamsRawFramesFromAFile) {
 }
 
 #if PROCAM_HAVE_GSTREAMER
+// Raw gst-launch text where the configuration allows it (trusted set-ups).
 TEST(ContentStream, VideoPipelineFramesAreShown) {
   TempDir dir;
-  DaemonProcess d(dir, DaemonProcess::Launch{{"--sim", "handheld"}, {}, -1, true});
+  dir.write("procamd.toml", "[content]\nallow_pipeline = true\n");
+  DaemonProcess d(dir,
+                  DaemonProcess::Launch{
+                      {"--config", dir.file("procamd.toml"), "--sim", "handheld"}, {}, -1, true});
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
   ASSERT_NO_FATAL_FAILURE(identityKeystone(c));
@@ -289,9 +293,40 @@ TEST(ContentStream, VideoPipelineFramesAreShown) {
   auto bad = c.call({{"cmd", "content"}, {"action", "stream"}, {"pipeline", "no_such_element"}});
   ASSERT_TRUE(bad);
   EXPECT_EQ((*bad)["code"], "bad-argument") << bad->dump();
-  bad = c.call({{"cmd", "content"}, {"action", "stream"}, {"path", dir.file("none.mp4")}});
+  bad = c.call({{"cmd", "content"}, {"action", "stream"}, {"path", contentFile(dir, "none.mp4")}});
   ASSERT_TRUE(bad);
   EXPECT_EQ((*bad)["code"], "io-error") << bad->dump();
+}
+
+// A test video named by pattern, built into a fixed pipeline: shown at its size.
+TEST(ContentStream, TestVideoIsShown) {
+  TempDir dir;
+  DaemonProcess d(dir, DaemonProcess::Launch{{"--sim", "handheld"}, {}, -1, true});
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  ASSERT_NO_FATAL_FAILURE(identityKeystone(c));
+  auto reply = c.call({{"cmd", "content"},
+                       {"action", "stream"},
+                       {"test", "white"},
+                       {"width", kOutput.width},
+                       {"height", kOutput.height},
+                       {"fps", 30}},
+                      10s);
+  ASSERT_TRUE(reply);
+  ASSERT_EQ((*reply)["class"], "CONTENT") << reply->dump();
+  EXPECT_EQ((*reply)["content"]["stream"]["test"], "white");
+  // White through the decoder's colour conversion: within 2 DN of 255.
+  EXPECT_TRUE(eventually([&] {
+    const json s = shownStats(c);
+    return s.is_object() && s["source"] == "content" && s["mean_rgb"][0] >= 253 &&
+           s["mean_rgb"][1] >= 253 && s["mean_rgb"][2] >= 253;
+  })) << shownStats(c).dump();
+  auto bad = c.call({{"cmd", "content"}, {"action", "stream"}, {"test", "snow ! filesink"}});
+  ASSERT_TRUE(bad);
+  EXPECT_EQ((*bad)["code"], "bad-argument") << bad->dump();
+  bad = c.call({{"cmd", "content"}, {"action", "stream"}, {"v4l2", "/etc/passwd"}});
+  ASSERT_TRUE(bad);
+  EXPECT_EQ((*bad)["code"], "bad-argument") << bad->dump();
 }
 #endif
 

@@ -63,5 +63,44 @@ TEST(MeshContent, Refusals) {
   EXPECT_EQ(r.error().code, ErrorCode::kIo);
 }
 
+// What a mesh may declare or hold is bounded: refused with kTooLarge before the
+// memory is taken (a PLY's declared counts are checked against the file too).
+TEST(MeshContent, LimitsAreEnforced) {
+  sim::MeshLimits small;
+  small.vertices = 4;
+  small.faces = 2;
+  small.face_indices = 4;
+  const std::string quad = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n";
+  ASSERT_TRUE(meshContentFromBytes(quad, "q.obj", small));
+  auto r = meshContentFromBytes(quad + "v 2 2 0\n", "q.obj", small);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, ErrorCode::kTooLarge);
+  r = meshContentFromBytes("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3 1 2\n", "p.obj", small);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, ErrorCode::kTooLarge);  // 5 indices in one face
+  r = meshContentFromBytes(quad + "f 1 2 3\n", "q.obj", small);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, ErrorCode::kTooLarge);  // 3 triangles
+  const std::string ply_head =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face ";
+  const std::string ply_tail =
+      "\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  ASSERT_TRUE(meshContentFromBytes(ply_head + "1" + ply_tail, "t.ply"));
+  r = meshContentFromBytes(ply_head + "10000000000000000000" + ply_tail, "t.ply");
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, ErrorCode::kParse) << r.error().message;  // more records than bytes
+  r = meshContentFromBytes(ply_head + "3" + ply_tail, "t.ply", small);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, ErrorCode::kTooLarge);
+  const std::string long_list =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uint int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n4000000000 0 1 2\n";
+  r = meshContentFromBytes(long_list, "l.ply");
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, ErrorCode::kTooLarge);
+}
+
 }  // namespace
 }  // namespace procam::content

@@ -137,12 +137,21 @@ TEST(OutputFrames, DecodedContentIsRgba) {
   TempDir dir;
   const std::string png = (dir.path / "grey.png").string();
   cv::imwrite(png, cv::Mat(3, 5, CV_8UC1, cv::Scalar(77)));
-  auto img = decodeContent(png);
+  ContentAccess access;
+  access.roots = {dir.path.string()};
+  auto img = decodeContent(access, png);
   ASSERT_TRUE(img) << img.error().message;
-  EXPECT_EQ((*img)->type(), CV_8UC4);
-  EXPECT_EQ((*img)->size(), cv::Size(5, 3));
-  EXPECT_EQ((*img)->at<cv::Vec4b>(1, 1), cv::Vec4b(77, 77, 77, 255));
-  EXPECT_EQ(decodeContent((dir.path / "none.png").string()).error().code, ErrorCode::kIo);
+  EXPECT_EQ(img->image->type(), CV_8UC4);
+  EXPECT_EQ(img->image->size(), cv::Size(5, 3));
+  EXPECT_EQ(img->image->at<cv::Vec4b>(1, 1), cv::Vec4b(77, 77, 77, 255));
+  EXPECT_EQ(decodeContent(access, "grey.png")->path, std::filesystem::canonical(png).string());
+  EXPECT_EQ(decodeContent(access, (dir.path / "none.png").string()).error().code, ErrorCode::kIo);
+  access.limits.image_pixels = 14;  // the header says 15 pixels
+  EXPECT_EQ(decodeContent(access, png).error().code, ErrorCode::kTooLarge);
+  access.roots = {(dir.path / "sub").string()};
+  std::filesystem::create_directory(dir.path / "sub");
+  EXPECT_EQ(decodeContent(access, png).error().code, ErrorCode::kForbidden);
+  EXPECT_EQ(decodeContent(access, "../grey.png").error().code, ErrorCode::kForbidden);
 }
 
 }  // namespace

@@ -1,6 +1,11 @@
 // procamd.toml parsing: values land in the right fields, and every unknown key
 // or bad value is an error that names the file, the line and the key.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
 
 #include "config.hpp"
 
@@ -191,6 +196,61 @@ TEST(Config, MissingFileIsAnIoError) {
   auto cfg = loadConfig("/nonexistent/procamd.toml");
   ASSERT_FALSE(cfg);
   EXPECT_EQ(cfg.error().code, ErrorCode::kIo);
+}
+
+TEST(Config, ContentRootsAndLimits) {
+  auto cfg = parseConfig(
+      "[content]\nroots = [\"/srv/a\", \"/srv/b\"]\nallow_pipeline = true\n"
+      "[limits]\nfile_mib = 8\nimage_pixels = 1000000\nframe_pixels = 2000000\n"
+      "mesh_vertices = 10\nmesh_faces = 20\nface_indices = 5\nclient_jobs = 3\n",
+      "rig.toml");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_EQ(cfg->content_roots, (std::vector<std::string>{"/srv/a", "/srv/b"}));
+  EXPECT_TRUE(cfg->content_allow_pipeline);
+  EXPECT_EQ(cfg->limits.file_bytes, 8u << 20);
+  EXPECT_EQ(cfg->limits.image_pixels, 1000000u);
+  EXPECT_EQ(cfg->limits.frame_pixels, 2000000u);
+  EXPECT_EQ(cfg->limits.mesh_vertices, 10u);
+  EXPECT_EQ(cfg->limits.mesh_faces, 20u);
+  EXPECT_EQ(cfg->limits.face_indices, 5u);
+  EXPECT_EQ(cfg->limits.client_jobs, 3u);
+  auto e = parseError("[content]\nroots = [\"relative/dir\"]\n[limits]\nimage_pixels = 0\n");
+  EXPECT_TRUE(
+      contains(e.message, "rig.toml:2: content.roots[0]: 'relative/dir' is not an absolute"))
+      << e.message;
+  EXPECT_TRUE(contains(e.message, "rig.toml:4: limits.image_pixels: 0 is out of range"))
+      << e.message;
+  e = parseError("[content]\nroots = []\n");
+  EXPECT_TRUE(contains(e.message, "content.roots: expected an array of 1 to 64")) << e.message;
+}
+
+// Only a regular file of bounded size is read: a directory, a FIFO (which would
+// block until a writer came) and a device (endless) are refused at once.
+TEST(Config, OnlyARegularFileOfBoundedSizeIsRead) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("procam-config-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string fifo = (dir / "fifo.toml").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  for (const std::string& path : {dir.string(), fifo, std::string("/dev/zero")}) {
+    auto cfg = loadConfig(path);
+    ASSERT_FALSE(cfg) << path;
+    EXPECT_EQ(cfg.error().code, ErrorCode::kIo) << path;
+    EXPECT_TRUE(contains(cfg.error().message, "not a regular file")) << cfg.error().message;
+  }
+  const std::string big = (dir / "big.toml").string();
+  std::ofstream(big) << std::string(kMaxConfigBytes + 1, '#');
+  auto cfg = loadConfig(big);
+  ASSERT_FALSE(cfg);
+  EXPECT_EQ(cfg.error().code, ErrorCode::kTooLarge);
+  const std::string group = (dir / "group.toml").string();
+  std::ofstream(group) << "[daemon]\n\ngroup = \"no-such-group-procam\"\n";
+  cfg = loadConfig(group);
+  ASSERT_FALSE(cfg);
+  EXPECT_TRUE(
+      contains(cfg.error().message, group + ":3: daemon.group: no group 'no-such-group-procam'"))
+      << cfg.error().message;
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Config, ExampleConfigParses) {

@@ -5,9 +5,13 @@
 #include <sys/socket.h>
 
 #include <algorithm>
+#include <future>
+#include <mutex>
+#include <stdexcept>
 #include <thread>
 
 #include "event_loop.hpp"
+#include "log.hpp"
 #include "worker_pool.hpp"
 
 namespace procam::daemon {
@@ -99,6 +103,78 @@ TEST(WorkerPool, ResultsArePostedBackToTheLoop) {
   }
   std::sort(results.begin(), results.end());
   EXPECT_EQ(results, (std::vector<int>{0, 1, 4, 9, 16, 25, 36, 49, 64, 81}));
+}
+
+// A job that throws is answered through its failure handler, with the message,
+// and the worker goes on with the next job.
+TEST(WorkerPool, AThrowingJobIsAnsweredByItsFailureHandler) {
+  auto loop = EventLoop::create();
+  ASSERT_TRUE(loop);
+  EventLoop& l = **loop;
+  std::vector<std::string> failures;
+  int done = 0;
+  {
+    WorkerPool pool(l, 1);
+    pool.submit([]() -> WorkerPool::Completion { throw std::runtime_error("bad_alloc-like"); },
+                [&](const std::string& what) { failures.push_back(what); });
+    pool.submit([]() -> WorkerPool::Completion { throw 7; },
+                [&](const std::string& what) { failures.push_back(what); });
+    pool.submit([&l, &done] {
+      return [&l, &done] {
+        ++done;
+        l.stop();
+      };
+    });
+    l.run();
+  }
+  EXPECT_EQ(failures, (std::vector<std::string>{"bad_alloc-like", "unknown exception"}));
+  EXPECT_EQ(done, 1);
+}
+
+// Owners are served in turn: one owner's long queue delays another's job by one job.
+TEST(WorkerPool, OwnersAreServedInTurn) {
+  auto loop = EventLoop::create();
+  ASSERT_TRUE(loop);
+  EventLoop& l = **loop;
+  std::vector<int> order;  // owner of each job, in the order they ran
+  std::mutex m;
+  {
+    WorkerPool pool(l, 1);
+    std::promise<void> gate;
+    std::shared_future<void> open = gate.get_future().share();
+    pool.submit([open] {  // holds the worker while the queues fill
+      open.wait();
+      return WorkerPool::Completion();
+    });
+    auto job = [&](int owner) {
+      return [&, owner] {
+        std::lock_guard lock(m);
+        order.push_back(owner);
+        return WorkerPool::Completion();
+      };
+    };
+    for (int i = 0; i < 100; ++i) pool.submit(job(1), {}, 1);
+    pool.submit(job(2), {}, 2);
+    EXPECT_EQ(pool.queued(1), 100u);
+    EXPECT_EQ(pool.queued(2), 1u);
+    gate.set_value();
+    pool.submit([&l] { return [&l] { l.stop(); }; }, {}, 3);
+    l.run();
+  }
+  ASSERT_GE(order.size(), 2u);
+  const auto second = std::find(order.begin(), order.end(), 2);
+  ASSERT_NE(second, order.end());
+  EXPECT_LE(second - order.begin(), 1) << "owner 2 waited behind owner 1's queue";
+}
+
+TEST(LogThrottle, PassesABurstPerIntervalThenCountsWhatItHeld) {
+  LogThrottle t(std::chrono::seconds(10), 2);
+  const auto t0 = std::chrono::steady_clock::time_point{} + std::chrono::hours(1);
+  EXPECT_EQ(t.pass("x", t0), "x");
+  EXPECT_EQ(t.pass("x", t0 + std::chrono::seconds(1)), "x");
+  for (int i = 0; i < 1000; ++i) EXPECT_FALSE(t.pass("x", t0 + std::chrono::seconds(2)));
+  EXPECT_EQ(t.pass("x", t0 + std::chrono::seconds(11)), "x (1000 more like it not logged)");
+  EXPECT_EQ(t.pass("x", t0 + std::chrono::seconds(12)), "x");
 }
 
 }  // namespace
