@@ -10,6 +10,10 @@ namespace procam::daemon {
 using nlohmann::json;
 namespace code = proto::code;
 
+namespace {
+constexpr const char* kReplacedContent = "replaced by a later content request";
+}  // namespace
+
 void Daemon::cmdPattern(ClientId client, const proto::Request& req) {
   RequestArgs args(req.body);
   PROCAM_CHECK_KEYS(args, "name");
@@ -56,6 +60,7 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
     if (path)
       return errorTo(client, req, code::kBadArgument, "content " + action + " takes no path");
     if (action == "clear") {
+      ++content_requests_;
       stopLiveContent();
       settings_.content.clear();
       content_info_ = {};
@@ -96,13 +101,16 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
     const std::optional<Vec3> eye = viewer ? std::optional<Vec3>(viewer->position) : std::nullopt;
     const json eye_source = viewer ? viewer->source : json();
     server_->hold(client);
+    const uint64_t request = ++content_requests_;
     compute_worker_->submit(
-        [this, client, req, file, outputs, eye, eye_source, access = contentAccess()] {
+        [this, client, req, file, outputs, eye, eye_source, access = contentAccess(), request] {
           auto prepared = std::make_shared<tl::expected<PreparedMesh, MeshFailure>>(
               prepareMeshContent(access, file, outputs, eye, eye_source));
-          return [this, client, req, prepared] {
+          return [this, client, req, prepared, request] {
             if (!*prepared) {
               errorTo(client, req, (*prepared).error().code, (*prepared).error().message);
+            } else if (request != content_requests_) {
+              errorTo(client, req, code::kCancelled, kReplacedContent);
             } else {
               stopLiveContent();
               settings_.content.clear();
@@ -130,47 +138,52 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
   operationEvent(
       client, "progress",
       {{"operation", op_id}, {"kind", "content-load"}, {"fraction", 0.0}, {"stage", "decoding"}});
+  const uint64_t request = ++content_requests_;
   compute_worker_->submit(
-      [this, client, req, op_id, cancelled, file = *path, access = contentAccess()] {
+      [this, client, req, op_id, cancelled, file = *path, access = contentAccess(), request] {
         auto decoded = decodeContent(access, file);
         std::shared_ptr<const cv::Mat> image = decoded ? decoded->image : nullptr;
         const std::string resolved = decoded ? decoded->path : std::string();
         const std::string failure = decoded ? std::string() : decoded.error().message;
         const char* failure_code = decoded ? "" : protoCode(decoded.error().code);
-        return [this, client, req, op_id, cancelled, resolved, image, failure, failure_code] {
-          operations_.erase(op_id);
-          json finished = {{"operation", op_id}, {"kind", "content-load"}, {"ok", true}};
-          if (cancelled->load()) {
-            finished["ok"] = false;
-            finished["error"] = "cancelled";
-          } else if (!failure.empty()) {
-            finished["ok"] = false;
-            finished["error"] = failure;
-          } else {
-            operationEvent(client, "progress",
-                           {{"operation", op_id},
-                            {"kind", "content-load"},
-                            {"fraction", 1.0},
-                            {"stage", "decoded"}});
-          }
-          operationEvent(client, "finished", finished);
-          if (cancelled->load()) {
-            errorTo(client, req, code::kCancelled, "content load cancelled");
-          } else if (!failure.empty()) {
-            errorTo(client, req, failure_code, failure);
-          } else {
-            stopLiveContent();
-            settings_.content = resolved;
-            content_info_ = {image->cols, image->rows};
-            keystone_rt_.content = image;
-            keystone_rt_.meshes.clear();
-            keystone_rt_.mesh_images.clear();
-            broadcast("content", {{"content", contentJson()}});
-            refreshOutputs();
-            replyTo(client, req, "CONTENT", {{"content", contentJson()}, {"operation", op_id}});
-          }
-          server_->release(client);  // after the reply: a half-closed client may close now
-        };
+        return
+            [this, client, req, op_id, cancelled, resolved, image, failure, failure_code, request] {
+              operations_.erase(op_id);
+              json finished = {{"operation", op_id}, {"kind", "content-load"}, {"ok", true}};
+              // A later content request (another client's, queued in another lane) wins.
+              if (request != content_requests_) cancelled->store(true);
+              if (cancelled->load()) {
+                finished["ok"] = false;
+                finished["error"] = "cancelled";
+              } else if (!failure.empty()) {
+                finished["ok"] = false;
+                finished["error"] = failure;
+              } else {
+                operationEvent(client, "progress",
+                               {{"operation", op_id},
+                                {"kind", "content-load"},
+                                {"fraction", 1.0},
+                                {"stage", "decoded"}});
+              }
+              operationEvent(client, "finished", finished);
+              if (cancelled->load()) {
+                errorTo(client, req, code::kCancelled,
+                        request != content_requests_ ? kReplacedContent : "content load cancelled");
+              } else if (!failure.empty()) {
+                errorTo(client, req, failure_code, failure);
+              } else {
+                stopLiveContent();
+                settings_.content = resolved;
+                content_info_ = {image->cols, image->rows};
+                keystone_rt_.content = image;
+                keystone_rt_.meshes.clear();
+                keystone_rt_.mesh_images.clear();
+                broadcast("content", {{"content", contentJson()}});
+                refreshOutputs();
+                replyTo(client, req, "CONTENT", {{"content", contentJson()}, {"operation", op_id}});
+              }
+              server_->release(client);  // after the reply: a half-closed client may close now
+            };
       },
       [this, client, req, op_id](const std::string& what) {
         operations_.erase(op_id);

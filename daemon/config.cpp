@@ -402,10 +402,19 @@ Result<Config> loadConfig(const std::string& path) {
     struct group g {};
     struct group* found = nullptr;
     std::vector<char> buf(16384);
-    if (::getgrnam_r(cfg->group.c_str(), &g, buf.data(), buf.size(), &found) != 0 || !found) {
-      return fail(ErrorCode::kInvalidInput, path + ":" + std::to_string(cfg->group_line) +
-                                                ": daemon.group: no group '" + cfg->group +
-                                                "' on this system");
+    int rc = 0;
+    // A group with many members (a directory service) needs a larger buffer.
+    while ((rc = ::getgrnam_r(cfg->group.c_str(), &g, buf.data(), buf.size(), &found)) == ERANGE &&
+           buf.size() < (std::size_t{1} << 24)) {
+      buf.resize(buf.size() * 2);
+    }
+    const std::string where = path + ":" + std::to_string(cfg->group_line) + ": daemon.group: ";
+    if (rc != 0) {
+      return fail(ErrorCode::kIo,
+                  where + "cannot look up group '" + cfg->group + "': " + std::strerror(rc));
+    }
+    if (!found) {
+      return fail(ErrorCode::kInvalidInput, where + "no group '" + cfg->group + "' on this system");
     }
   }
   return cfg;

@@ -65,8 +65,21 @@ Result<std::string> resolveContentPath(const ContentAccess& access, const std::s
                                          "): put it there or add its folder to [content] roots");
 }
 
-Result<UniqueFd> openContentFile(const std::string& resolved, ContentKind kind) {
-  UniqueFd fd(::open(resolved.c_str(), O_RDONLY | O_NONBLOCK | O_NOFOLLOW | O_CLOEXEC));
+Result<UniqueFd> openContentFile(const ContentAccess& access, const std::string& resolved,
+                                 ContentKind kind) {
+  const fs::path file(resolved);
+  UniqueFd dir(::open(file.parent_path().c_str(), O_PATH | O_DIRECTORY | O_CLOEXEC));
+  if (!dir.valid()) return fail(ErrorCode::kIo, resolved + ": " + std::strerror(errno));
+  // The folder actually opened, whatever happened to its path meanwhile.
+  const auto opened = realPath("/proc/self/fd/" + std::to_string(dir.get()));
+  bool inside = false;
+  for (const auto& root : access.roots) {
+    const auto real_root = realPath(root);
+    inside = inside || (opened && real_root && within(*opened, *real_root));
+  }
+  if (!inside) return fail(ErrorCode::kForbidden, resolved + " is outside the content roots");
+  UniqueFd fd(
+      ::openat(dir.get(), file.filename().c_str(), O_RDONLY | O_NONBLOCK | O_NOFOLLOW | O_CLOEXEC));
   if (!fd.valid()) {
     if (errno == ELOOP) {
       return fail(ErrorCode::kForbidden, resolved + " is a symbolic link (not followed)");
@@ -90,7 +103,7 @@ Result<UniqueFd> openContentFile(const std::string& resolved, ContentKind kind) 
 Result<std::string> readContentFile(const ContentAccess& access, const std::string& path) {
   auto resolved = resolveContentPath(access, path);
   if (!resolved) return tl::unexpected(resolved.error());
-  auto fd = openContentFile(*resolved, ContentKind::kRegular);
+  auto fd = openContentFile(access, *resolved, ContentKind::kRegular);
   if (!fd) return tl::unexpected(fd.error());
   struct stat st {};
   if (::fstat(fd->get(), &st) != 0) return fail(ErrorCode::kIo, path + ": " + std::strerror(errno));

@@ -38,10 +38,13 @@ Result<std::string> resolveContentPath(const ContentAccess& access, const std::s
 
 enum class ContentKind { kRegular, kRegularOrFifo };
 
-// Opens a resolved path for reading: O_NONBLOCK|O_NOFOLLOW, then the type checked
-// on the open descriptor (a FIFO only when allowed, never a device or directory).
-// A regular file's descriptor is left blocking; a FIFO's stays non-blocking.
-Result<UniqueFd> openContentFile(const std::string& resolved, ContentKind kind);
+// Opens a resolved path for reading: its folder is opened and checked again to
+// lie under a root (a folder swapped for a symlink since it was resolved is
+// caught), the file opened in it O_NONBLOCK|O_NOFOLLOW, and its type checked on
+// the descriptor (a FIFO only when allowed, never a device or directory). A
+// regular file's descriptor is left blocking; a FIFO's stays non-blocking.
+Result<UniqueFd> openContentFile(const ContentAccess& access, const std::string& resolved,
+                                 ContentKind kind);
 
 // A regular file's bytes, at most access.limits.file_bytes of them.
 Result<std::string> readContentFile(const ContentAccess& access, const std::string& path);

@@ -72,6 +72,7 @@ void Daemon::cmdContentShare(ClientId client, const proto::Request& req) {
                    "(SCM_RIGHTS); got " +
                        std::to_string(fds.size()));
   }
+  ++content_requests_;
   auto source = content::openSharedFrames(fds.front().release(), {*width, *height}, *format);
   if (!source) return errorTo(client, req, code::kBadArgument, source.error().message);
   if (auto ok = startLiveContent(std::move(*source), {{"shared", {{"format", format_name}}}});
@@ -163,7 +164,11 @@ void Daemon::cmdContentStream(ClientId client, const proto::Request& req) {
     if (!resolved) {
       return errorTo(client, req, protoCode(resolved.error().code), resolved.error().message);
     }
-    auto source = content::openRawFrames(*resolved, {{*width, *height}, *format, fps});
+    auto fd = openContentFile(access, *resolved, ContentKind::kRegularOrFifo);
+    if (!fd) return errorTo(client, req, protoCode(fd.error().code), fd.error().message);
+    ++content_requests_;
+    auto source =
+        content::openRawFrames(std::move(*fd), *resolved, {{*width, *height}, *format, fps});
     return startStream(client, req, std::move(source),
                        {{"path", *resolved}, {"raw", {{"format", format_name}, {"fps", fps}}}});
   }
@@ -191,7 +196,7 @@ void Daemon::cmdContentStream(ClientId client, const proto::Request& req) {
     if (!resolved) {
       return errorTo(client, req, protoCode(resolved.error().code), resolved.error().message);
     }
-    if (auto fd = openContentFile(*resolved, ContentKind::kRegular); !fd) {
+    if (auto fd = openContentFile(access, *resolved, ContentKind::kRegular); !fd) {
       return errorTo(client, req, protoCode(fd.error().code), fd.error().message);
     }
     info["path"] = *resolved;
@@ -216,19 +221,26 @@ void Daemon::cmdContentStream(ClientId client, const proto::Request& req) {
   }
   if (refuseOverJobLimit(client, req)) return;
   server_->hold(client);
+  const uint64_t request = ++content_requests_;
   compute_worker_->submit(
-      [this, client, req, open, info, max_pixels = access.limits.frame_pixels] {
+      [this, client, req, open, info, max_pixels = access.limits.frame_pixels, request] {
         auto opened = std::make_shared<Result<std::unique_ptr<content::ContentSource>>>(open());
         // A source whose first frame is over the limit is closed before it plays.
-        if (*opened && std::uint64_t((**opened)->size().area()) > max_pixels) {
+        if (*opened &&
+            std::uint64_t((**opened)->size().width) * std::uint64_t((**opened)->size().height) >
+                max_pixels) {
           const cv::Size s = (**opened)->size();
           *opened = fail(ErrorCode::kTooLarge,
                          std::to_string(s.width) + "x" + std::to_string(s.height) +
                              " video frames are over the " + std::to_string(max_pixels) +
                              "-pixel limit ([limits] frame_pixels)");
         }
-        return [this, client, req, opened, info] {
-          startStream(client, req, std::move(*opened), info);
+        return [this, client, req, opened, info, request] {
+          if (request != content_requests_) {
+            errorTo(client, req, code::kCancelled, "replaced by a later content request");
+          } else {
+            startStream(client, req, std::move(*opened), info);
+          }
           server_->release(client);
         };
       },
@@ -287,6 +299,14 @@ void Daemon::pollLiveContent() {
   while ((status = live.source->read(frame)) && *status == content::ReadStatus::kFrame) {
     newest = std::move(frame);
     if (live.fd < 0) break;
+  }
+  if (!newest.pixels.empty() &&
+      std::uint64_t(newest.pixels.total()) > config_.limits.frame_pixels) {
+    // A video may change its size mid-stream: the limit holds for every frame.
+    status = fail(ErrorCode::kTooLarge, std::to_string(newest.pixels.cols) + "x" +
+                                            std::to_string(newest.pixels.rows) +
+                                            " frames are over [limits] frame_pixels");
+    newest = {};
   }
   if (!newest.pixels.empty()) {
     keystone_rt_.content = std::make_shared<const cv::Mat>(content::toRgba(newest));

@@ -15,6 +15,12 @@ namespace procam::daemon {
 
 namespace {
 constexpr size_t kReadChunk = 64 * 1024;
+
+// A warning a storm of clients could repeat thousands of times a second.
+void throttledWarning(LogThrottle& throttle, const std::string& message) {
+  if (auto line = throttle.pass(message)) logWarning(*line);
+}
+
 constexpr size_t kReadBudgetPerWakeup = 4 * kReadChunk;  // fairness between clients
 }  // namespace
 
@@ -105,12 +111,15 @@ void ControlServer::onAccept() {
     UniqueFd fd(::accept4(listen_fd_.get(), nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC));
     if (!fd.valid()) {
       const int err = errno;
-      if (err == EAGAIN || err == EWOULDBLOCK || err == EINTR) return;
+      if (err == EAGAIN || err == EWOULDBLOCK) return;
+      // One connection's failure (it went away before being accepted): the next.
+      if (err == EINTR || err == ECONNABORTED || err == EPROTO || err == EPERM) continue;
       if (auto line = accept_log_.pass(std::string("accept: ") + std::strerror(err))) {
         logWarning(*line);
       }
       if (err == EMFILE || err == ENFILE) {
         refuseWithoutDescriptors();
+        if (accept_paused_) return;
         continue;
       }
       // Anything else (ENOMEM, ENOBUFS...): give the system a moment, do not spin.
@@ -121,7 +130,7 @@ void ControlServer::onAccept() {
     ucred uc{};
     socklen_t len = sizeof uc;
     if (::getsockopt(fd.get(), SOL_SOCKET, SO_PEERCRED, &uc, &len) != 0) {
-      logWarning(std::string("SO_PEERCRED: ") + std::strerror(errno));
+      throttledWarning(watch_log_, std::string("SO_PEERCRED: ") + std::strerror(errno));
       ++stats_.refused;
       continue;
     }
@@ -133,14 +142,16 @@ void ControlServer::onAccept() {
       ++stats_.refused;
     };
     if (!peerAllowed(fd.get(), cred)) {
-      logWarning("refused client pid " + std::to_string(cred.pid) + " uid " +
-                 std::to_string(cred.uid) + ": not root and not in the procam group");
+      throttledWarning(refuse_log_, "refused client pid " + std::to_string(cred.pid) + " uid " +
+                                        std::to_string(cred.uid) +
+                                        ": not root and not in the procam group");
       refuse(proto::code::kForbidden, "not root and not in the procam group");
       continue;
     }
     if (clients_.size() >= options_.max_clients) {
-      logWarning("refused client pid " + std::to_string(cred.pid) + ": " +
-                 std::to_string(clients_.size()) + " clients connected (daemon.max_clients)");
+      throttledWarning(busy_log_, "refused client pid " + std::to_string(cred.pid) + ": " +
+                                      std::to_string(clients_.size()) +
+                                      " clients connected (daemon.max_clients)");
       refuse(proto::code::kBusy, "too many clients");
       continue;
     }
@@ -153,7 +164,7 @@ void ControlServer::onAccept() {
     if (auto ok = loop_.add(cfd, EPOLLIN | EPOLLRDHUP,
                             [this, id](uint32_t ev) { onClientEvent(id, ev); });
         !ok) {
-      logWarning("cannot watch client: " + ok.error().message);
+      throttledWarning(watch_log_, "cannot watch client: " + ok.error().message);
       continue;
     }
     Client& ref = *c;
@@ -284,8 +295,8 @@ ssize_t ControlServer::receive(Client& c, char* buf, size_t size) {
   }
   // The kernel closed descriptors beyond the control buffer.
   if (msg.msg_flags & MSG_CTRUNC) {
-    logWarning(describe(c) + " passed more than " + std::to_string(kMaxPassedFds) +
-               " descriptors; the rest were closed");
+    throttledWarning(fds_log_, describe(c) + " passed more than " + std::to_string(kMaxPassedFds) +
+                                   " descriptors; the rest were closed");
   }
   return n;
 }

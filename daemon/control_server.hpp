@@ -123,7 +123,13 @@ class ControlServer {
   UniqueFd listen_fd_;
   UniqueFd reserve_fd_;  // /dev/null, closed when accept() finds no descriptor free
   bool accept_paused_ = false;
+  // Warnings that a storm of clients could repeat without end: a few per 10 s, one
+  // throttle per kind of warning (its count of held-back lines is about that kind).
   LogThrottle accept_log_;
+  LogThrottle refuse_log_{std::chrono::seconds(10), 5};  // peer not allowed
+  LogThrottle busy_log_{std::chrono::seconds(10), 5};    // too many clients
+  LogThrottle watch_log_{std::chrono::seconds(10), 5};   // a client not set up
+  LogThrottle fds_log_{std::chrono::seconds(10), 5};     // too many passed descriptors
   ServerOptions options_;
   RequestHandler on_request_;
   DisconnectHandler on_disconnect_;

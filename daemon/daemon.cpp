@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <csignal>
+#include <cstdlib>
 #include <filesystem>
 
 #include "loader.hpp"
@@ -83,6 +84,10 @@ Result<void> Daemon::setup() {
   }
   setLogLevel(config_.log_level);
   if (options_.sim_scene.empty()) options_.sim_scene = config_.sim_scene;
+  // OpenCV's own decoder bound (read once, before any thread exists), behind the
+  // header check of content/image_header.hpp: a format whose header a decoder
+  // reads differently still cannot allocate past the configured limit.
+  ::setenv("OPENCV_IO_MAX_IMAGE_PIXELS", std::to_string(config_.limits.image_pixels).c_str(), 0);
 
   auto loop = EventLoop::create();
   if (!loop) return tl::unexpected(loop.error());
@@ -137,6 +142,7 @@ Result<void> Daemon::setup() {
   device_manager_->start({.udev = options_.sim_scene.empty()});
 
   io_worker_ = std::make_unique<WorkerPool>(*loop_, 1);
+  io_worker_->runQueuedOnStop();  // saves asked for before a stop are written
   compute_worker_ = std::make_unique<WorkerPool>(*loop_, 1);
   server_ = std::make_unique<ControlServer>(
       *loop_, std::move(sock->fd), server_options,

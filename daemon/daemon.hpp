@@ -213,6 +213,9 @@ class Daemon {
   };
   std::shared_ptr<SaveSlot> save_slot_ = std::make_shared<SaveSlot>();
   std::map<std::string, LogThrottle> warn_throttles_;  // Daemon::warn, per message
+  // Counts content requests (load, stream, share, clear): a load or stream that
+  // completes after a later request is dropped (the workers may reorder clients).
+  uint64_t content_requests_ = 0;
   rig::RigModel rig_;  // the state directory's rig.json: the only source of geometry
   // rig_'s surface meshes by projector name ("" for the unified mesh).
   std::map<std::string, std::shared_ptr<const RigSurfaceMesh>> rig_surfaces_;

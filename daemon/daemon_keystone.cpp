@@ -221,8 +221,13 @@ void Daemon::requestSolve() {
         };
       },
       [this](const std::string& what) {
-        keystone_rt_.solving = false;
+        KeystoneRuntime& k = keystone_rt_;
+        k.solving = false;
         warn("keystone solve failed: " + what);
+        if (k.solve_again) {
+          k.solve_again = false;
+          requestSolve();
+        }
       });
 }
 

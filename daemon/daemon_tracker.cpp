@@ -249,7 +249,9 @@ void Daemon::cmdTracker(ClientId client, const proto::Request& req) {
       [this, client, req](const std::string& what) {
         errorTo(client, req, code::kInternal, "tracker.json not written: " + what);
       },
-      client);
+      // The daemon's own lane, not the client's: registrations land in the order
+      // they were made, whoever made them.
+      0);
 }
 
 }  // namespace procam::daemon

@@ -9,6 +9,9 @@
 #include <thread>
 
 #include "core/guarded_main.hpp"
+#if defined(__SANITIZE_THREAD__)
+#include <opencv2/core/utility.hpp>
+#endif
 #include "daemon.hpp"
 #include "loader.hpp"
 #include "log.hpp"
@@ -126,19 +129,26 @@ static int run(int argc, char** argv) {
   }
   const int rc = (*daemon)->run();
   // Releasing devices may block in their libraries (libaravis waits on a dead
-  // camera for many seconds): the state is on disk by now (every write is
-  // atomic), so a stop never waits past the deadline for them.
-  std::thread([] {
+  // camera for many seconds): the teardown writes the queued state first (every
+  // write is atomic: one cut short leaves the previous file), and a stop never
+  // waits past the deadline for the devices.
+  std::thread([rc] {
     std::this_thread::sleep_for(kStopDeadline);
     procam::daemon::logWarning("devices not released within " +
                                std::to_string(kStopDeadline.count()) +
                                " ms of the stop: exiting without them");
-    std::_Exit(0);
+    std::_Exit(rc);
   }).detach();
   daemon->reset();
   return rc;
 }
 
 int main(int argc, char** argv) {
+#if defined(__SANITIZE_THREAD__)
+  // OpenCV runs its parallel loops on TBB's threads, whose synchronisation
+  // ThreadSanitizer cannot see (libtbb is not instrumented): in a TSan build the
+  // loops run on the calling thread, so that reports are about procamd's threads.
+  cv::setNumThreads(0);
+#endif
   return procam::guardedMain("procamd", [&] { return run(argc, argv); });
 }

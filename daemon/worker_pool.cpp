@@ -12,7 +12,8 @@ WorkerPool::WorkerPool(EventLoop& loop, int threads) : loop_(loop) {
 
 WorkerPool::~WorkerPool() {
   {
-    std::lock_guard lock(mutex_);
+    std::unique_lock lock(mutex_);
+    if (run_queued_on_stop_) idle_.wait(lock, [this] { return queued_ == 0; });
     stopping_ = true;
     lanes_.clear();
     turn_.clear();
@@ -62,6 +63,7 @@ void WorkerPool::run() {
       } else {
         turn_.push_back(owner);  // its next job after the other owners' next
       }
+      if (queued_ == 0) idle_.notify_all();
     }
     Completion done;
     std::string failure;

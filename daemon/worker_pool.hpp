@@ -33,8 +33,12 @@ class WorkerPool {
   WorkerPool(EventLoop& loop, int threads);
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
-  // Finishes running jobs, drops queued ones; completions not yet posted are lost.
+  // Finishes running jobs and drops queued ones (runs them too once
+  // runQueuedOnStop() was called); completions not yet posted are lost.
   ~WorkerPool();
+  // For a pool whose jobs must not be lost (state writes): its destructor runs the
+  // queued jobs first.
+  void runQueuedOnStop() { run_queued_on_stop_ = true; }
 
   void submit(Job job, Failure on_failure = {}, Owner owner = 0);
   size_t queued() const;
@@ -50,10 +54,12 @@ class WorkerPool {
   EventLoop& loop_;
   mutable std::mutex mutex_;
   std::condition_variable cv_;
+  std::condition_variable idle_;  // queued_ reached 0
   std::map<Owner, std::deque<Entry>> lanes_;
   std::deque<Owner> turn_;  // owners with queued jobs, next first
   size_t queued_ = 0;
   bool stopping_ = false;
+  bool run_queued_on_stop_ = false;
   std::vector<std::thread> threads_;
 };
 

@@ -122,7 +122,11 @@ Result<std::unique_ptr<ContentSource>> openGstPipeline(const std::string& descri
   // Playback drops frames the reader did not take in time (the newest is shown);
   // offline reading holds the decoder back instead, so that no frame is lost.
   const std::string launch =
-      description + " ! videoconvert ! video/x-raw,format=RGBA ! appsink name=procam_sink " +
+      description +
+      // Sizes beyond 16384 (procamd's largest side) fail to negotiate before a frame
+      // of them is allocated.
+      " ! videoconvert ! video/x-raw,format=RGBA,width=[2,16384],height=[2,16384] ! appsink "
+      "name=procam_sink " +
       (options.realtime ? "sync=true max-buffers=2 drop=true"
                         : "sync=false max-buffers=4 drop=false");
   GError* raw_error = nullptr;

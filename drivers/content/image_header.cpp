@@ -129,9 +129,13 @@ Result<ImageHeader> tiff(std::string_view b) {
   for (std::size_t i = 0; i < entries; ++i) {
     const std::size_t at = ifd + 2 + 12 * i;
     if (at + 12 > b.size()) return bad("truncated TIFF directory");
-    const uint32_t tag = u16(at), type = u16(at + 2);
+    const uint32_t tag = u16(at), type = u16(at + 2), count = u32(at + 4);
     if (tag != 256 && tag != 257) continue;
-    size[tag - 256] = type == 3 ? u16(at + 8) : u32(at + 8);  // SHORT or LONG
+    // One SHORT or LONG held in the entry, as the decoder reads it; a repeated tag
+    // or another type could make the decoder see a size other than the one checked.
+    if (size[tag - 256] != 0) return bad("TIFF directory repeats the image size");
+    if (count != 1 || (type != 3 && type != 4)) return bad("TIFF image size of an unusual type");
+    size[tag - 256] = type == 3 ? u16(at + 8) : u32(at + 8);
   }
   return sized("tiff", size[0], size[1]);
 }

@@ -81,20 +81,32 @@ class RawFrames final : public ContentSource {
   bool ended_ = false;
 };
 
-}  // namespace
-
-Result<std::unique_ptr<ContentSource>> openRawFrames(const std::string& path,
-                                                     const RawFormat& format) {
+Result<void> checkFormat(const RawFormat& format) {
   if (format.size.width < 2 || format.size.height < 2) {
     return fail(ErrorCode::kInvalidInput, "raw frames must be at least 2x2 pixels");
   }
   if (!(format.fps >= 0) || !std::isfinite(format.fps)) {
     return fail(ErrorCode::kInvalidInput, "fps must be a finite number >= 0");
   }
+  return {};
+}
+
+}  // namespace
+
+Result<std::unique_ptr<ContentSource>> openRawFrames(const std::string& path,
+                                                     const RawFormat& format) {
+  if (auto ok = checkFormat(format); !ok) return tl::unexpected(ok.error());
   // Non-blocking so that opening a FIFO does not wait for its writer.
-  // O_NOFOLLOW: a symlink put where the file was checked is refused, not followed.
-  UniqueFd fd(::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOFOLLOW | O_CLOEXEC));
+  UniqueFd fd(::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC));
   if (!fd.valid()) return fail(ErrorCode::kIo, path + ": " + std::strerror(errno));
+  return openRawFrames(std::move(fd), path, format);
+}
+
+Result<std::unique_ptr<ContentSource>> openRawFrames(UniqueFd fd, const std::string& path,
+                                                     const RawFormat& format) {
+  if (auto ok = checkFormat(format); !ok) return tl::unexpected(ok.error());
+  // A FIFO stays non-blocking (read whenever readable); a regular file reads plainly.
+  ::fcntl(fd.get(), F_SETFL, ::fcntl(fd.get(), F_GETFL) | O_NONBLOCK);
   struct stat st {};
   if (::fstat(fd.get(), &st) != 0) return fail(ErrorCode::kIo, path + ": " + std::strerror(errno));
   const bool fifo = S_ISFIFO(st.st_mode);

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "content_source.hpp"
+#include "core/unique_fd.hpp"
 
 namespace procam::content {
 
@@ -21,6 +22,9 @@ struct RawFormat {
 // kInvalidInput for sizes under 2x2 or a negative fps, kIo when the path cannot be
 // opened or is neither a regular file nor a FIFO.
 Result<std::unique_ptr<ContentSource>> openRawFrames(const std::string& path,
+                                                     const RawFormat& format);
+// The same from a descriptor already open for reading (`name` for messages).
+Result<std::unique_ptr<ContentSource>> openRawFrames(UniqueFd fd, const std::string& name,
                                                      const RawFormat& format);
 
 }  // namespace procam::content

@@ -205,6 +205,7 @@ Result<geom::TriangleMesh> parsePly(std::string_view bytes, const std::string& o
 
   std::istringstream header{std::string(bytes.substr(0, end))};
   std::vector<PlyElement> elements;
+  std::size_t declared = 0, vertices = 0, faces = 0;
   bool binary = false;
   std::string line;
   std::size_t line_no = 0;
@@ -223,17 +224,19 @@ Result<geom::TriangleMesh> parsePly(std::string_view bytes, const std::string& o
     } else if (tag == "element") {
       PlyElement e;
       if (!(f >> e.name >> e.count)) return parseError(origin, line_no, "bad element line");
-      // What an element may declare: each of its records takes at least one byte
-      // (binary) or two (ascii), so a count beyond the body is a lie.
-      if (e.count > bytes.size()) {
+      // What the elements may declare together: each record takes at least one byte
+      // (binary) or two (ascii), so records beyond the file's size are a lie (checked
+      // once the properties are known, below).
+      declared += e.count;
+      if (e.count > bytes.size() || declared > bytes.size()) {
         return parseError(origin, line_no,
-                          "element '" + e.name + "' declares " + std::to_string(e.count) +
+                          "elements declare " + std::to_string(declared) +
                               " records in a file of " + std::to_string(bytes.size()) + " bytes");
       }
-      if (e.name == "vertex" && e.count > limits.vertices)
-        return tooLarge(origin, "vertices", limits.vertices);
-      if (e.name == "face" && e.count > limits.faces)
-        return tooLarge(origin, "faces", limits.faces);
+      if (e.name == "vertex") vertices += e.count;
+      if (e.name == "face") faces += e.count;
+      if (vertices > limits.vertices) return tooLarge(origin, "vertices", limits.vertices);
+      if (faces > limits.faces) return tooLarge(origin, "faces", limits.faces);
       elements.push_back(e);
     } else if (tag == "property") {
       if (elements.empty()) return parseError(origin, line_no, "property before element");
@@ -256,6 +259,12 @@ Result<geom::TriangleMesh> parsePly(std::string_view bytes, const std::string& o
     }
   }
 
+  for (const auto& e : elements) {
+    // A record of no property reads nothing: its count would only spin.
+    if (e.props.empty() && e.count > 0) {
+      return fail(ErrorCode::kParse, origin + ": element '" + e.name + "' has no properties");
+    }
+  }
   geom::TriangleMesh mesh;
   PlyReader reader(bytes.substr(body_start + 1), binary);
   for (const auto& e : elements) {
@@ -292,7 +301,11 @@ Result<geom::TriangleMesh> parsePly(std::string_view bytes, const std::string& o
             v[p.name[0] - 'x'] = value;
         }
       }
-      if (e.name == "vertex") mesh.vertices.push_back(v);
+      if (e.name == "vertex") {
+        if (mesh.vertices.size() >= limits.vertices)
+          return tooLarge(origin, "vertices", limits.vertices);
+        mesh.vertices.push_back(v);
+      }
     }
   }
   return checked(std::move(mesh), origin);

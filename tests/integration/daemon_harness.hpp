@@ -100,11 +100,12 @@ struct RunResult {
 RunResult runProgram(const std::vector<std::string>& argv, const std::string& stdin_text = "");
 
 // The virtual cameras ray-cast every capture: about 8x slower under
-// AddressSanitizer. Tests that wait on captures scale their times by this.
-#if defined(__SANITIZE_ADDRESS__)
+// AddressSanitizer or ThreadSanitizer. Tests that wait on captures scale their
+// times by this.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 inline constexpr int kSlowdown = 8;
 #elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
 inline constexpr int kSlowdown = 8;
 #else
 inline constexpr int kSlowdown = 1;

@@ -153,6 +153,10 @@ TEST(Hardening, ContentReachesNoFileOutsideItsRoots) {
 // 2. accept() without descriptors: the clients beyond the limit hear `busy`, the
 // loop does not spin and the log does not flood; new clients get in afterwards.
 TEST(Hardening, OutOfDescriptorsRefusesWithBusyWithoutSpinning) {
+  // UBSan tests whether memory is readable through a pipe before it checks a vptr:
+  // with no descriptor left it reports every virtual call as one through a bad vptr,
+  // so under the sanitizers this case says nothing about procamd.
+  if (kSlowdown > 1) GTEST_SKIP() << "runs without sanitizers (they need descriptors too)";
   TempDir dir;
   DaemonProcess::Launch launch{{"--sim", "handheld"}, {}, -1, true};
   launch.max_fds = 64;
@@ -190,7 +194,8 @@ TEST(Hardening, OutOfDescriptorsRefusesWithBusyWithoutSpinning) {
         Connection again(d.socketPath());
         return again.ok() && again.banner().value("class", "") == "VERSION";
       },
-      3s));
+      3s))
+      << d.log();
 }
 
 // 3. Jobs that used to block the worker or go unanswered: a FIFO named like an
@@ -320,11 +325,12 @@ TEST(Hardening, OneClientsFloodDoesNotDelayAnother) {
   ASSERT_TRUE(d.started()) << d.log();
   Connection flood(d.socketPath()), other(d.socketPath());
   ASSERT_TRUE(flood.ok() && other.ok());
-  constexpr int kSaves = 20000;
+  // The probe's 20,000; a tenth under the sanitizers, whose daemon is 8x slower.
+  constexpr int kSaves = kSlowdown > 1 ? 2000 : 20000;
   std::atomic<int> answered{0}, refused{0};
-  std::thread reader([&] {
+  std::jthread reader([&] {
     while (answered < kSaves) {
-      auto line = flood.next(10s);
+      auto line = flood.next(10s * kSlowdown);
       if (!line) break;
       if ((*line)["class"] == "EVENT") continue;
       if ((*line).value("code", "") == "too-large") ++refused;
@@ -333,7 +339,7 @@ TEST(Hardening, OneClientsFloodDoesNotDelayAnother) {
   });
   std::string lines;
   for (int i = 0; i < kSaves; ++i) lines += "{\"cmd\":\"save\",\"id\":" + std::to_string(i) + "}\n";
-  std::thread writer([&] { flood.sendRaw(lines); });
+  std::jthread writer([&] { flood.sendRaw(lines); });
   ASSERT_TRUE(eventually([&] { return answered > 100; }, 10s));
   const auto asked = Clock::now();
   const json saved = answeredWithin(other, {{"cmd", "save"}});

@@ -3,6 +3,8 @@
 // over the pixel limit is refused before the decoder runs.
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cstdint>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
 
@@ -57,6 +59,29 @@ TEST(ImageHeader, TruncatedUnknownAndImpossibleHeadersAreRefused) {
   std::string zero = png;
   for (int i = 16; i < 20; ++i) zero[i] = 0;  // width 0
   EXPECT_FALSE(readImageHeader(zero));
+}
+
+// A TIFF directory read as the decoder reads it: a repeated size tag or a size of
+// another type than one SHORT or LONG is refused (the decoder might see another size).
+TEST(ImageHeader, TiffSizeMustBeUnambiguous) {
+  auto tiff = [](std::initializer_list<std::array<uint32_t, 4>> entries) {
+    std::string b("II*\0\x08\0\0\0", 8);
+    auto le = [&](uint32_t v, int bytes) {
+      for (int i = 0; i < bytes; ++i) b += char((v >> (8 * i)) & 0xFF);
+    };
+    le(uint32_t(entries.size()), 2);
+    for (const auto& [tag, type, count, value] : entries) {
+      le(tag, 2), le(type, 2), le(count, 4), le(value, 4);
+    }
+    le(0, 4);
+    return b;
+  };
+  auto ok = readImageHeader(tiff({{256, 3, 1, 640}, {257, 4, 1, 480}}));
+  ASSERT_TRUE(ok) << ok.error().message;
+  EXPECT_EQ(ok->size, cv::Size(640, 480));
+  EXPECT_FALSE(readImageHeader(tiff({{256, 4, 1, 60000}, {256, 3, 1, 2}, {257, 3, 1, 2}})));
+  EXPECT_FALSE(readImageHeader(tiff({{256, 16, 1, 8}, {257, 3, 1, 2}})));  // LONG8: an offset
+  EXPECT_FALSE(readImageHeader(tiff({{256, 3, 2, 8}, {257, 3, 1, 2}})));
 }
 
 TEST(ImageHeader, DecodeOverThePixelLimitIsRefusedFromTheHeader) {

@@ -100,6 +100,17 @@ TEST(MeshContent, LimitsAreEnforced) {
   r = meshContentFromBytes(long_list, "l.ply");
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error().code, ErrorCode::kTooLarge);
+  // Declared counts add up over repeated elements; a record of no property is refused.
+  std::string repeated = "ply\nformat ascii 1.0\n";
+  for (int i = 0; i < 3; ++i) repeated += "element vertex 2\nproperty float x\n";
+  repeated += "end_header\n" + std::string(64, ' ');
+  r = meshContentFromBytes(repeated, "r.ply", small);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, ErrorCode::kTooLarge);  // 6 vertices declared, 4 allowed
+  r = meshContentFromBytes(
+      "ply\nformat ascii 1.0\nelement junk 5\nend_header\n" + std::string(64, ' '), "j.ply");
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, ErrorCode::kParse);
 }
 
 }  // namespace
