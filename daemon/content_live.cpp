@@ -46,6 +46,14 @@ std::optional<int> sideArg(RequestArgs& args, const char* key, bool required) {
   return v->get<int>();
 }
 
+// The one check of [limits] frame_pixels for shared, streamed and test-video frames.
+Result<void> framePixels(cv::Size size, std::uint64_t limit) {
+  if (std::uint64_t(size.width) * std::uint64_t(size.height) <= limit) return {};
+  return fail(ErrorCode::kTooLarge, std::to_string(size.width) + "x" + std::to_string(size.height) +
+                                        " frames are over the " + std::to_string(limit) +
+                                        "-pixel limit ([limits] frame_pixels)");
+}
+
 }  // namespace
 
 void Daemon::cmdContentShare(ClientId client, const proto::Request& req) {
@@ -59,12 +67,8 @@ void Daemon::cmdContentShare(ClientId client, const proto::Request& req) {
   if (!args.ok()) return errorTo(client, req, code::kBadArgument, args.error());
   auto format = content::parsePixelFormat(format_name);
   if (!format) return errorTo(client, req, code::kBadArgument, format.error().message);
-  const auto max_pixels = config_.limits.frame_pixels;
-  if (std::uint64_t(*width) * std::uint64_t(*height) > max_pixels) {
-    return errorTo(client, req, code::kTooLarge,
-                   std::to_string(*width) + "x" + std::to_string(*height) +
-                       " frames are over the " + std::to_string(max_pixels) +
-                       "-pixel limit ([limits] frame_pixels)");
+  if (auto ok = framePixels({*width, *height}, config_.limits.frame_pixels); !ok) {
+    return errorTo(client, req, code::kTooLarge, ok.error().message);
   }
   if (fds.size() != 1) {
     return errorTo(client, req, code::kBadArgument,
@@ -140,12 +144,10 @@ void Daemon::cmdContentStream(ClientId client, const proto::Request& req) {
                    "(or \"pipeline\" where the configuration allows it)");
   }
   const ContentAccess access = contentAccess();
-  if (width && height &&
-      std::uint64_t(*width) * std::uint64_t(*height) > access.limits.frame_pixels) {
-    return errorTo(client, req, code::kTooLarge,
-                   std::to_string(*width) + "x" + std::to_string(*height) +
-                       " frames are over the " + std::to_string(access.limits.frame_pixels) +
-                       "-pixel limit ([limits] frame_pixels)");
+  if (width && height) {
+    if (auto ok = framePixels({*width, *height}, access.limits.frame_pixels); !ok) {
+      return errorTo(client, req, code::kTooLarge, ok.error().message);
+    }
   }
   if (pipeline && !access.allow_pipeline) {
     return errorTo(client, req, code::kForbidden,
@@ -209,8 +211,8 @@ void Daemon::cmdContentStream(ClientId client, const proto::Request& req) {
     open = [d = *v4l2] { return content::openV4l2Video(d); };
   } else if (test) {
     const cv::Size size(width.value_or(1280), height.value_or(720));
-    if (std::uint64_t(size.area()) > access.limits.frame_pixels) {
-      return errorTo(client, req, code::kTooLarge, "test video over [limits] frame_pixels");
+    if (auto ok = framePixels(size, access.limits.frame_pixels); !ok) {
+      return errorTo(client, req, code::kTooLarge, ok.error().message);
     }
     const double rate = fps > 0 ? fps : 30.0;
     info["test"] = *test;
@@ -226,14 +228,10 @@ void Daemon::cmdContentStream(ClientId client, const proto::Request& req) {
       [this, client, req, open, info, max_pixels = access.limits.frame_pixels, request] {
         auto opened = std::make_shared<Result<std::unique_ptr<content::ContentSource>>>(open());
         // A source whose first frame is over the limit is closed before it plays.
-        if (*opened &&
-            std::uint64_t((**opened)->size().width) * std::uint64_t((**opened)->size().height) >
-                max_pixels) {
-          const cv::Size s = (**opened)->size();
-          *opened = fail(ErrorCode::kTooLarge,
-                         std::to_string(s.width) + "x" + std::to_string(s.height) +
-                             " video frames are over the " + std::to_string(max_pixels) +
-                             "-pixel limit ([limits] frame_pixels)");
+        if (*opened) {
+          if (auto ok = framePixels((**opened)->size(), max_pixels); !ok) {
+            *opened = tl::unexpected(ok.error());
+          }
         }
         return [this, client, req, opened, info, request] {
           if (request != content_requests_) {
@@ -300,13 +298,12 @@ void Daemon::pollLiveContent() {
     newest = std::move(frame);
     if (live.fd < 0) break;
   }
-  if (!newest.pixels.empty() &&
-      std::uint64_t(newest.pixels.total()) > config_.limits.frame_pixels) {
+  if (!newest.pixels.empty()) {
     // A video may change its size mid-stream: the limit holds for every frame.
-    status = fail(ErrorCode::kTooLarge, std::to_string(newest.pixels.cols) + "x" +
-                                            std::to_string(newest.pixels.rows) +
-                                            " frames are over [limits] frame_pixels");
-    newest = {};
+    if (auto ok = framePixels(newest.pixels.size(), config_.limits.frame_pixels); !ok) {
+      status = tl::unexpected(ok.error());
+      newest = {};
+    }
   }
   if (!newest.pixels.empty()) {
     keystone_rt_.content = std::make_shared<const cv::Mat>(content::toRgba(newest));
