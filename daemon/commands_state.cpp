@@ -30,11 +30,13 @@ void Daemon::cmdPattern(ClientId client, const proto::Request& req) {
   settings_.pattern = *name;
   // Rendered on a worker (with the keystone warp); answered once it is shown.
   server_->hold(client);
-  refreshOutputs([this, client, req, pattern = *name](bool shown) {
-    broadcast("pattern", {{"pattern", pattern}, {"shown", shown}});
-    replyTo(client, req, "PATTERN", {{"pattern", pattern}, {"shown", shown}});
-    server_->release(client);
-  });
+  refreshOutputs(
+      [this, client, req, pattern = *name](bool shown) {
+        broadcast("pattern", {{"pattern", pattern}, {"shown", shown}});
+        replyTo(client, req, "PATTERN", {{"pattern", pattern}, {"shown", shown}});
+        server_->release(client);
+      },
+      true);
 }
 
 json Daemon::contentJson() const {
@@ -68,7 +70,7 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
       keystone_rt_.meshes.clear();
       keystone_rt_.mesh_images.clear();
       broadcast("content", {{"content", nullptr}});
-      refreshOutputs();
+      refreshOutputs({}, true);
     }
     replyTo(client, req, "CONTENT", {{"content", contentJson()}});
     return;
@@ -121,7 +123,7 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
               keystone_rt_.mesh_info = std::move((*prepared)->info);
               followMeshViewer(**prepared);
               broadcast("content", {{"content", contentJson()}});
-              refreshOutputs();
+              refreshOutputs({}, true);
               replyTo(client, req, "CONTENT", {{"content", contentJson()}});
             }
             server_->release(client);
@@ -179,7 +181,7 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
                 keystone_rt_.meshes.clear();
                 keystone_rt_.mesh_images.clear();
                 broadcast("content", {{"content", contentJson()}});
-                refreshOutputs();
+                refreshOutputs({}, true);
                 replyTo(client, req, "CONTENT", {{"content", contentJson()}, {"operation", op_id}});
               }
               server_->release(client);  // after the reply: a half-closed client may close now

@@ -221,7 +221,8 @@ void parseLimits(Checker& c, const toml::table& t, Config& cfg) {
 
 void parseKeystone(Checker& c, const toml::table& t, Config& cfg) {
   c.onlyKnown(t, "keystone.",
-              {"cutoff_hz", "hysteresis_deg", "poll_hz", "mount", "accel_offset_g", "accel_scale"});
+              {"cutoff_hz", "hysteresis_deg", "poll_hz", "mount", "accel_offset_g", "accel_scale",
+               "display_centre", "display_size"});
   KeystoneConfig& k = cfg.keystone;
   if (auto* n = t.get("cutoff_hz")) c.number(*n, "keystone.cutoff_hz", 0.01, 1000.0, k.cutoff_hz);
   if (auto* n = t.get("hysteresis_deg")) {
@@ -237,6 +238,22 @@ void parseKeystone(Checker& c, const toml::table& t, Config& cfg) {
   }
   if (auto* n = t.get("accel_scale"))
     numbers(c, *n, "keystone.accel_scale", 0.5, 2.0, k.accel_scale);
+  if (auto* n = t.get("display_centre")) {
+    std::array<double, 3> v{};
+    if (numbers(c, *n, "keystone.display_centre", -1e4, 1e4, v)) k.display_centre = v;
+  }
+  if (auto* n = t.get("display_size")) {
+    std::array<double, 2> v{};
+    if (numbers(c, *n, "keystone.display_size", 1e-3, 1e4, v)) k.display_size = v;
+  }
+  // One without the other says nothing about the rectangle.
+  const toml::node* centre = t.get("display_centre");
+  const toml::node* size = t.get("display_size");
+  if ((centre == nullptr) != (size == nullptr)) {
+    const toml::node& given = centre ? *centre : *size;
+    c.error(given.source(), centre ? "keystone.display_centre" : "keystone.display_size",
+            "display_centre and display_size go together");
+  }
 }
 
 void parseCalibration(Checker& c, const toml::table& t, Config& cfg) {

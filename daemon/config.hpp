@@ -39,6 +39,10 @@ struct KeystoneConfig {
   std::optional<std::array<double, 9>> mount;
   std::array<double, 3> accel_offset_g{0, 0, 0};
   std::array<double, 3> accel_scale{1, 1, 1};
+  // The display across several projectors on one wall: its centre (world, metres, on the
+  // wall) and size (width, height on the wall, metres) instead of the largest rectangle.
+  std::optional<std::array<double, 3>> display_centre;
+  std::optional<std::array<double, 2>> display_size;
 };
 
 // [calibration]: the settle wait of `calibrate` and the display-to-capture latency

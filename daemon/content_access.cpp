@@ -141,6 +141,8 @@ const char* protoCode(ErrorCode code) {
       return proto::code::kIo;
     case ErrorCode::kInternal:
       return proto::code::kInternal;
+    case ErrorCode::kCancelled:
+      return proto::code::kCancelled;
     default:
       return proto::code::kBadArgument;
   }

@@ -309,7 +309,7 @@ void Daemon::pollLiveContent() {
     keystone_rt_.content = std::make_shared<const cv::Mat>(content::toRgba(newest));
     content_info_ = {newest.pixels.cols, newest.pixels.rows};
     ++live.frames;
-    refreshOutputs();
+    refreshOutputs({}, live.frames == 1);  // the first frame replaces other content
   }
   if (!status || *status == content::ReadStatus::kEnd) {
     // The last frame stays shown; the source is closed.

@@ -57,6 +57,13 @@ class Daemon {
 
   int run();
 
+  // An output whose projector the rig model maps onto a display plane.
+  struct RigTile {
+    std::string output;
+    blend::DisplayTile tile;
+    std::optional<blend::ProjectorResponse> response;  // rig.json photometric, if measured
+  };
+
  private:
   explicit Daemon(DaemonOptions options);
   Result<void> setup();
@@ -134,11 +141,17 @@ class Daemon {
   Result<void> setRigKeystone(bool enable);
   nlohmann::json rigKeystoneJson(cv::Size content) const;
   // tiled_display.cpp: several projectors of the rig on one wall as one display.
-  std::vector<std::pair<std::string, const rig::RigProjector*>> rigTiles() const;
+  // Usable outputs whose projectors the rig maps onto a display plane, in device order.
+  std::vector<RigTile> rigTiles() const;
+  // [keystone] display_centre / display_size: the display rectangle the configuration gives.
+  std::optional<blend::WorldRect> displayRect() const;
   const KeystoneRuntime::Tiled* tiledDisplay(cv::Size content);
   nlohmann::json tiledDisplayJson() const;
   cv::Size currentSourceSize() const;
-  void refreshOutputs(std::function<void(bool shown)> done = {});
+  // Draws every output again on the compute worker (one frame in flight; calls made
+  // meanwhile coalesce into one frame after it). `supersede`: the state changed so that
+  // the frame in flight is obsolete (other content, a pattern a client waits for); it stops.
+  void refreshOutputs(std::function<void(bool shown)> done = {}, bool supersede = false);
   // What render::choosePath needs about an output, from the rig model and the viewer.
   render::SceneTraits sceneTraits(const std::string& output, bool mesh_content) const;
   // daemon_outputs.cpp: one output's frame planned on the loop (nullopt: nothing to draw).

@@ -165,11 +165,15 @@ std::optional<OutputDraw> Daemon::planOutput(DeviceEntry& e, const OutputDrawPol
   return job;
 }
 
-void Daemon::refreshOutputs(std::function<void(bool shown)> done) {
+void Daemon::refreshOutputs(std::function<void(bool shown)> done, bool supersede) {
   KeystoneRuntime& k = keystone_rt_;
   if (done) k.frame_waiters.push_back(std::move(done));
   if (k.rendering) {
     k.render_again = true;  // after the frame in flight: the state changed since
+    // Other content or a pattern a client waits for: the frame in flight is obsolete
+    // and stops (before the next output, or midway where the driver can), so a large
+    // mesh does not hold the new state back by a whole frame.
+    if (supersede && k.frame_stop) k.frame_stop->store(true);
     return;
   }
   auto waiters = std::move(k.frame_waiters);
@@ -206,6 +210,8 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done) {
     }
   }
   k.rendering = true;
+  k.frame_stop = std::make_shared<std::atomic<bool>>(false);
+  for (auto& job : jobs) job.stop = k.frame_stop;
   // Shared with the failure handler: the waiters are answered either way.
   auto waiting = std::make_shared<decltype(waiters)>(std::move(waiters));
   compute_worker_->submit(
@@ -215,9 +221,18 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done) {
         return [this, results, waiting] {
           KeystoneRuntime& k = keystone_rt_;
           k.rendering = false;
-          bool shown = false, drawn = false;
+          k.frame_stop.reset();
+          bool shown = false, drawn = false, stopped = false;
           for (const OutputDrawn& r : *results) {
             auto st = k.output_state.find(r.name);
+            if (r.stopped) {
+              stopped = true;
+              // A setup that never reached the output is handed over next time.
+              if (r.configure_asked && !r.configured && st != k.output_state.end()) {
+                st->second.setup.reset();
+              }
+              continue;
+            }
             if (!r.ok) {
               warn("output '" + r.name + "': " + r.error);
               // Hand the setup over again next time: the output may not hold it.
@@ -238,7 +253,16 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done) {
             }
           }
           if (drawn) ++k.frames;  // frames drawn, not statistics read again
-          for (auto& w : *waiting) w(shown);
+          if (stopped) {
+            ++k.frames_stopped;
+            // Its waiters wait for the frame that replaces it, drawn next.
+            k.frame_waiters.insert(k.frame_waiters.begin(),
+                                   std::make_move_iterator(waiting->begin()),
+                                   std::make_move_iterator(waiting->end()));
+            k.render_again = true;
+          } else {
+            for (auto& w : *waiting) w(shown);
+          }
           if (k.render_again) {
             k.render_again = false;
             refreshOutputs();
@@ -248,6 +272,7 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done) {
       [this, waiting](const std::string& what) {
         // Nothing was shown; the state that asked for the frame is answered all the same.
         keystone_rt_.rendering = false;
+        keystone_rt_.frame_stop.reset();
         warn("drawing the outputs failed: " + what);
         for (auto& w : *waiting) w(false);
         if (keystone_rt_.render_again) {
@@ -301,7 +326,9 @@ json Daemon::outputsJson() const {
     }
     list.push_back(std::move(o));
   }
-  return {{"frames", keystone_rt_.frames}, {"shown", list}};
+  return {{"frames", keystone_rt_.frames},
+          {"frames_stopped", keystone_rt_.frames_stopped},
+          {"shown", list}};
 }
 
 }  // namespace procam::daemon

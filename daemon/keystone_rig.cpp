@@ -1,9 +1,10 @@
 // Keystone from the rig model (PROTOCOL.md, "Keystone from the rig model"): on a
-// planar wall whose collineation with the projector calibrate found (route (b′),
-// rig.json's plane_homography), the content is shown in the largest upright
-// rectangle of its aspect inside the projector's image on the wall ([Raskar02]
+// planar wall whose collineation with the projector the rig model gives (route (b′)'s
+// plane_homography, or the projector's K and pose and the surface plane), the content is shown in
+// the largest upright rectangle of its aspect inside the projector's image on the wall ([Raskar02]
 // §3.2.5, §4.2.1). No sensor is read and nothing is solved in the background: the
 // solution is a small linear program, made again whenever a warp is needed.
+#include "blend/rig_tiles.hpp"
 #include "daemon.hpp"
 #include "keystone/rig_keystone.hpp"
 
@@ -20,19 +21,23 @@ Result<keystone::KeystoneSolution> Daemon::solveRigKeystone(cv::Size content) co
                 "keystone from the rig needs a projector output; none is open");
   }
   const rig::RigProjector* p = rig_.projectorForOutput(out->name);
-  if (!p || !p->plane_homography) {
+  if (!p) {
+    return fail(ErrorCode::kNotFound, "keystone from the rig needs the projector on output '" +
+                                          out->name + "' in the rig model; it has none");
+  }
+  auto tile = blend::displayTile(*p, rig_.surface);
+  if (!tile) {
     return fail(ErrorCode::kNotFound,
                 "keystone from the rig needs the projector on output '" + out->name +
-                    "' mapped onto the display plane: the rig model has no plane_homography "
-                    "for it (calibrate with one camera and the wall plane writes it)");
+                    "' mapped onto the display plane: " + tile.error().message);
   }
   if (content.width < 1 || content.height < 1) {
     return fail(ErrorCode::kInvalidInput, "nothing to show: the content has no size");
   }
   keystone::RigKeystoneProblem problem;
-  problem.projector_to_plane = *p->plane_homography;
-  problem.width = p->width;
-  problem.height = p->height;
+  problem.projector_to_plane = tile->projector_to_plane;
+  problem.width = tile->width;
+  problem.height = tile->height;
   problem.content_width = content.width;
   problem.content_height = content.height;
   auto s = keystone::solveRigKeystone(problem);

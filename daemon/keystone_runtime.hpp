@@ -1,6 +1,7 @@
 #pragma once
 // The daemon's state for automatic keystone and for what the outputs show
 // (daemon_keystone.cpp). Touched on the loop thread only.
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -13,17 +14,13 @@
 #include <vector>
 
 #include "auto_keystone.hpp"
-#include "blend/tiled_display.hpp"
+#include "blend/tiled_blend.hpp"
 #include "content_mesh.hpp"
 #include "driver.hpp"
 #include "output_frames.hpp"
 #include "render/cpu_renderer.hpp"
 
 namespace procam::daemon {
-
-// The response assumed for blending until the projectors' responses are measured:
-// light ~ code^2.2, the sRGB-like curve most projectors ship with.
-inline constexpr double kAssumedGamma = 2.2;
 
 struct KeystoneRuntime {
   // Auto keystone inputs; `unavailable` says why it cannot run (empty: it can).
@@ -76,22 +73,21 @@ struct KeystoneRuntime {
   nlohmann::json mesh_info;  // `content` in replies while meshes are shown
   bool rendering = false;
   bool render_again = false;
+  // The frame in flight's stop flag: set when a newer request made it obsolete.
+  std::shared_ptr<std::atomic<bool>> frame_stop;
   std::vector<std::function<void(bool shown)>> frame_waiters;
   uint64_t frames = 0;
+  uint64_t frames_stopped = 0;              // frames stopped midway: newer state replaced them
   std::map<std::string, FrameStats> shown;  // output name -> what it shows
 
   // Several projectors on one wall plane as one display (tiled_display.cpp): made on
   // the compute worker for a content size and set of outputs, used by every output.
-  struct Tiled {
+  // The display, the 8-bit alpha masks (eq. 4.3 weights; `weights` is left empty) and
+  // per tile the weight table through its response and brightness gain: measured
+  // (rig.json photometric, every tile) or the assumed gamma and no gain.
+  struct Tiled : blend::TiledBlend {
     cv::Size content;
     std::vector<std::string> outputs;  // in tile order
-    blend::TiledDisplay display;
-    std::vector<cv::Mat> alpha;  // per tile, CV_8UC1 (eq. 4.3 weights)
-    // Per tile, the weight table through its response and brightness gain: measured
-    // (rig.json photometric, every tile) or the assumed gamma and no gain.
-    std::vector<render::Lut> weight_lut;
-    std::vector<double> gamma, gain;
-    bool measured = false;
     int index(const std::string& output) const;
   };
   std::shared_ptr<const Tiled> tiled;  // the display in use, if any

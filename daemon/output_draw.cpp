@@ -13,6 +13,11 @@ std::string reason(const std::array<char, 512>& err, int rc) {
   return err[0] ? std::string(err.data()) : "driver status " + std::to_string(rc);
 }
 
+// The plugin's stop callback: the job's flag, set by the loop.
+int stopRequested(void* flag) {
+  return static_cast<const std::atomic<bool>*>(flag)->load(std::memory_order_relaxed) ? 1 : 0;
+}
+
 // Outputs with operations version 1 show RGB8 frames drawn here.
 void drawFallback(const OutputDraw& j, OutputDrawn& r) {
   render::CpuRenderer& cpu = *j.fallback;
@@ -23,8 +28,11 @@ void drawFallback(const OutputDraw& j, OutputDrawn& r) {
     }
     r.configured = true;
   }
-  auto drawn = cpu.render({j.image.get(), j.mesh.get(), j.version});
+  render::Content content{j.image.get(), j.mesh.get(), j.version, {}};
+  if (j.stop) content.stop = [stop = j.stop] { return stop->load(std::memory_order_relaxed); };
+  auto drawn = cpu.render(content);
   if (!drawn) {
+    r.stopped = drawn.error().code == ErrorCode::kCancelled;
     r.error = drawn.error().message;
     return;
   }
@@ -61,9 +69,15 @@ OutputDrawn drawOutput(const OutputDraw& j) {
   r.viewer = j.viewer;
   r.homography = j.homography;
   r.tile = j.tile;
+  r.configure_asked = j.configure;
   try {
     if (!j.device || !j.device->valid() || !j.setup) {
       r.error = "no device or setup";
+      return r;
+    }
+    if (j.stop && j.stop->load()) {
+      r.stopped = true;
+      r.error = "stopped before drawing";
       return r;
     }
     if (j.fallback) {
@@ -84,8 +98,17 @@ OutputDrawn drawOutput(const OutputDraw& j) {
     const plugins::ContentView content(j.image.get(), j.mesh.get(), j.version);
     int drawn = 0;
     procam_frame_stats stats{};
-    r.rc = raw.ops.output->render(raw.self, &content.get(), &drawn, j.want_stats ? &stats : nullptr,
-                                  err.data(), err.size() - 1);
+    procam_frame_stats* want = j.want_stats ? &stats : nullptr;
+    if (j.stop && plugins::outputStops(raw)) {
+      // The flag outlives the call: the job holds it.
+      auto* flag = const_cast<std::atomic<bool>*>(j.stop.get());
+      r.rc = raw.ops.output->render_stoppable(raw.self, &content.get(), &stopRequested, flag,
+                                              &drawn, want, err.data(), err.size() - 1);
+    } else {
+      r.rc = raw.ops.output->render(raw.self, &content.get(), &drawn, want, err.data(),
+                                    err.size() - 1);
+    }
+    r.stopped = r.rc == PROCAM_ECANCELED;
     if (r.rc != PROCAM_OK) {
       r.error = reason(err, r.rc);
       return r;

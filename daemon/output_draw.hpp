@@ -1,10 +1,11 @@
 #pragma once
 // Drawing the outputs. Each output renders its own frame from a render setup and content
-// (procam_plugin.h, output operations version 2): the setup is handed over only when the
-// geometry changed, the content with a version that changes only when the content does.
-// An output whose driver lacks those operations gets its frame from a CPU reference
-// renderer kept for it (its warp map built once per setup) through `show`. The daemon plans
-// on the loop (daemon_keystone.cpp) and draws on its compute worker.
+// (procam_plugin.h, output operations version 2; 3 to stop midway): the setup is handed over only
+// when the geometry changed, the content with a version that changes only when the content does. An
+// output whose driver lacks those operations gets its frame from a CPU reference renderer kept for
+// it (its warp map built once per setup) through `show`. The daemon plans on the loop
+// (daemon_keystone.cpp) and draws on its compute worker.
+#include <atomic>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <optional>
@@ -33,6 +34,9 @@ struct OutputDraw {
   std::optional<Mat3> homography;                 // content -> framebuffer (homography path)
   int tile = -1;                                  // of a display across outputs
   std::shared_ptr<render::CpuRenderer> fallback;  // set: the output does not render itself
+  // Set by the loop when a newer request made this frame obsolete: the draw stops before
+  // the output or, where the driver can (output operations version 3), midway.
+  std::shared_ptr<const std::atomic<bool>> stop;
 };
 
 struct OutputDrawn {
@@ -43,9 +47,11 @@ struct OutputDrawn {
   std::optional<Mat3> homography;
   int tile = -1;
   bool ok = false;
-  bool drawn = false;       // a new frame is shown
-  bool configured = false;  // the setup was handed over and taken
-  int rc = 0;               // the driver's status when !ok (PROCAM_ENODEV: gone)
+  bool drawn = false;            // a new frame is shown
+  bool configured = false;       // the setup was handed over and taken
+  bool stopped = false;          // stopped by `stop`: nothing shown, the frame before stays
+  bool configure_asked = false;  // the job was to hand the setup over
+  int rc = 0;                    // the driver's status when !ok (PROCAM_ENODEV: gone)
   std::string error;
   std::optional<render::FrameStats> stats;
 };

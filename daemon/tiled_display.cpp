@@ -10,8 +10,8 @@
 #include <cmath>
 #include <sstream>
 
-#include "blend/feather.hpp"
-#include "blend/response.hpp"
+#include "blend/rig_tiles.hpp"
+#include "blend/tiled_blend.hpp"
 #include "daemon.hpp"
 #include "log.hpp"
 
@@ -26,49 +26,47 @@ int KeystoneRuntime::Tiled::index(const std::string& output) const {
   return -1;
 }
 
-std::vector<std::pair<std::string, const rig::RigProjector*>> Daemon::rigTiles() const {
-  std::vector<std::pair<std::string, const rig::RigProjector*>> tiles;
+std::vector<Daemon::RigTile> Daemon::rigTiles() const {
+  std::vector<RigTile> tiles;
   for (const auto& e : devices_.entries()) {
     if (e.description.family != PROCAM_FAMILY_OUTPUT || !e.usable()) continue;
     const rig::RigProjector* p = rig_.projectorForOutput(e.name);
-    if (p && p->plane_homography && p->width > 1 && p->height > 1) tiles.emplace_back(e.name, p);
+    if (!p) continue;
+    if (auto tile = blend::displayTile(*p, rig_.surface)) {
+      tiles.push_back({e.name, *tile, blend::responseFromPhotometric(p->photometric)});
+    }
   }
   return tiles;
 }
 
-namespace {
-
-// A projector's measured response (rig.json photometric), if it has one.
-std::optional<blend::ProjectorResponse> responseOf(const rig::RigProjector& p) {
-  const json& ph = p.photometric;
-  if (!ph.is_object()) return std::nullopt;
-  const auto number = [&](const char* key) {
-    const auto it = ph.find(key);
-    return it != ph.end() && it->is_number() ? it->get<double>() : std::nan("");
-  };
-  blend::ProjectorResponse r;
-  r.gamma = number("response_gamma");
-  r.black = number("black");
-  r.white = number("white");
-  if (!(r.gamma >= 1 && r.gamma <= 4) || !std::isfinite(r.black) || !(r.white > r.black)) {
-    return std::nullopt;
-  }
-  return r;
+std::optional<blend::WorldRect> Daemon::displayRect() const {
+  const KeystoneConfig& k = config_.keystone;
+  if (!k.display_centre || !k.display_size) return std::nullopt;
+  const auto& c = *k.display_centre;
+  return blend::WorldRect{Vec3(c[0], c[1], c[2]), (*k.display_size)[0], (*k.display_size)[1]};
 }
 
-// What a display is made for: the content's size and every tile's mapping.
-std::string tiledKey(cv::Size content,
-                     const std::vector<std::pair<std::string, const rig::RigProjector*>>& tiles) {
+namespace {
+
+// What a display is made for: the content's size, every tile's mapping and response,
+// and the rectangle the configuration gives.
+std::string tiledKey(cv::Size content, const std::vector<Daemon::RigTile>& tiles,
+                     const std::optional<blend::WorldRect>& rect) {
   std::ostringstream key;
   key.precision(17);
   key << content.width << 'x' << content.height;
-  for (const auto& [name, p] : tiles) {
-    key << ' ' << name << ' ' << p->width << 'x' << p->height;
-    const auto& ph = *p->plane_homography;
+  for (const auto& t : tiles) {
+    key << ' ' << t.output << ' ' << t.tile.width << 'x' << t.tile.height;
+    const auto& ph = t.tile.projector_to_plane;
     for (int i = 0; i < 9; ++i) key << ' ' << ph.H(i / 3, i % 3);
     key << ' ' << ph.basis.origin.transpose() << ' ' << ph.basis.u.transpose() << ' '
-        << ph.basis.v.transpose() << ' ' << p->photometric.dump();
+        << ph.basis.v.transpose();
+    if (t.response) {
+      key << " r " << t.response->gamma << ' ' << t.response->black << ' ' << t.response->white;
+    }
   }
+  if (rect)
+    key << " rect " << rect->centre.transpose() << ' ' << rect->width << ' ' << rect->height;
   return key.str();
 }
 
@@ -83,7 +81,7 @@ const KeystoneRuntime::Tiled* Daemon::tiledDisplay(cv::Size content) {
     k.tiled_error.clear();
     return nullptr;
   }
-  const std::string key = tiledKey(content, tiles);
+  const std::string key = tiledKey(content, tiles, displayRect());
   if (key == k.tiled_key) return k.tiled.get();  // made, failed, or on its way
   k.tiled_key = key;
   k.tiled_error.clear();
@@ -92,52 +90,29 @@ const KeystoneRuntime::Tiled* Daemon::tiledDisplay(cv::Size content) {
   k.tiling = true;
   std::vector<std::string> names;
   std::vector<blend::DisplayTile> input;
-  std::vector<blend::ProjectorResponse> responses;
-  for (const auto& [name, p] : tiles) {
-    names.push_back(name);
-    input.push_back({*p->plane_homography, p->width, p->height});
-    if (auto r = responseOf(*p)) responses.push_back(*r);
+  std::vector<std::optional<blend::ProjectorResponse>> responses;
+  for (const auto& t : tiles) {
+    names.push_back(t.output);
+    input.push_back(t.tile);
+    responses.push_back(t.response);
   }
+  blend::TiledDisplayOptions options;
+  options.world_rect = displayRect();
   logInfo("display across " + std::to_string(names.size()) + " outputs: solving");
   compute_worker_->submit(
-      [this, key, content, names, input, responses] {
+      [this, key, content, names, input, responses, options] {
         auto made = std::make_shared<KeystoneRuntime::Tiled>();
         std::string error;
-        auto display = blend::solveTiledDisplay(input, content.width, content.height);
-        if (display) {
-          std::vector<blend::FeatherTile> feather;
-          for (std::size_t t = 0; t < input.size(); ++t) {
-            feather.push_back({display->footprints[t], display->plane_to_framebuffer[t],
-                               input[t].width, input[t].height});
-          }
-          auto weights = blend::featherWeights(feather);
-          if (weights) {
-            for (const cv::Mat& w : *weights) made->alpha.push_back(blend::alphaMask(w));
-            // Brightness matched to the dimmest projector and weights in linear light, when
-            // every projector's response is measured; the assumed gamma otherwise.
-            made->measured = responses.size() == input.size();
-            const std::vector<double> gains = made->measured
-                                                  ? blend::matchedGains(responses)
-                                                  : std::vector<double>(input.size(), 1.0);
-            for (std::size_t t = 0; t < input.size(); ++t) {
-              const double gamma = made->measured ? responses[t].gamma : kAssumedGamma;
-              made->gamma.push_back(gamma);
-              made->gain.push_back(gains[t]);
-              auto lut = blend::weightLut(gamma, gains[t]);
-              if (!lut) {
-                error = lut.error().message;
-                break;
-              }
-              made->weight_lut.push_back(*lut);
-            }
-            made->content = content;
-            made->outputs = names;
-            made->display = std::move(*display);
-          } else {
-            error = weights.error().message;
-          }
+        // Brightness matched to the dimmest projector and weights in linear light when
+        // every projector's response is measured; the assumed gamma otherwise.
+        auto blended = blend::makeTiledBlend(input, responses, content, options);
+        if (blended) {
+          static_cast<blend::TiledBlend&>(*made) = std::move(*blended);
+          made->weights.clear();  // the outputs take the 8-bit mask
+          made->content = content;
+          made->outputs = names;
         } else {
-          error = display.error().message;
+          error = blended.error().message;
         }
         return [this, key, made, error] {
           KeystoneRuntime& k = keystone_rt_;
@@ -196,6 +171,7 @@ json Daemon::tiledDisplayJson() const {
           {"rect_m",
            {{"centre", {d.rect.centre.x(), d.rect.centre.y()}},
             {"size", {2 * d.rect.half_width, 2 * d.rect.half_height}}}},
+          {"rect_source", displayRect() ? "config" : "largest"},
           {"union_area_m2", d.union_area_m2},
           {"cell_m", d.cell_m},
           {"basis",

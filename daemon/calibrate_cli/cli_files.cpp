@@ -1,10 +1,11 @@
 #include "cli_files.hpp"
 
 #include <algorithm>
-#include <bit>
 #include <cstring>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
+
+#include "core/pfm.hpp"
 
 namespace procam::cli {
 namespace {
@@ -134,24 +135,11 @@ Result<std::vector<cv::Mat>> readCaptures(const sl::PatternSet& set, const fs::p
 }
 
 Result<void> writeCorrespondencePfm(const sl::Decoded& d, const fs::path& file) {
-  const int w = d.u.cols, h = d.u.rows;
-  std::string data = "PF\n" + std::to_string(w) + " " + std::to_string(h) + "\n-1.0\n";
-  const std::size_t header = data.size();
-  data.resize(header + static_cast<std::size_t>(w) * h * 3 * sizeof(float));
-  char* p = data.data() + header;
-  for (int row = h - 1; row >= 0; --row) {  // PFM stores the bottom row first
-    const float* u = d.u.ptr<float>(row);
-    const float* v = d.v.ptr<float>(row);
-    const float* c = d.confidence.ptr<float>(row);
-    for (int x = 0; x < w; ++x)
-      for (float value : {u[x], v[x], c[x]}) {
-        auto bits = std::bit_cast<std::uint32_t>(value);
-        if constexpr (std::endian::native == std::endian::big) bits = __builtin_bswap32(bits);
-        std::memcpy(p, &bits, 4);
-        p += 4;
-      }
-  }
-  return writeText(file, data);
+  cv::Mat uvc;
+  cv::merge(std::vector<cv::Mat>{d.u, d.v, d.confidence}, uvc);
+  auto data = encodePfm(uvc);
+  if (!data) return tl::unexpected(data.error());
+  return writeText(file, *data);
 }
 
 Result<std::vector<NamedCamera>> readCameras(const fs::path& file) {

@@ -182,8 +182,22 @@ Result<TiledDisplay> solveTiledDisplay(std::span<const DisplayTile> tiles, int c
   const double coarse = (hi - lo).maxCoeff() / options.raster_cells;
   const Raster whole = rasterize(out.footprints, lo, hi, coarse);
   out.union_area_m2 = whole.at(whole.rows, whole.cols) * coarse * coarse;
-  if (options.rect) {
-    const keystone::AxisRect& r = *options.rect;
+  std::optional<keystone::AxisRect> given = options.rect;
+  if (options.world_rect) {
+    const WorldRect& w = *options.world_rect;
+    if (options.rect)
+      return fail(ErrorCode::kInvalidInput, "a display rectangle given twice (rect, world_rect)");
+    if (!w.centre.allFinite() || !std::isfinite(w.width) || !std::isfinite(w.height))
+      return fail(ErrorCode::kInvalidInput, "the given display rectangle is not finite");
+    if (std::abs(plane.signedDistance(w.centre)) > 0.01)
+      return fail(ErrorCode::kInvalidInput,
+                  "the given display centre is " +
+                      std::to_string(std::abs(plane.signedDistance(w.centre))) +
+                      " m off the wall plane (at most 0.01)");
+    given = keystone::AxisRect{out.basis.toPlane(w.centre), 0.5 * w.width, 0.5 * w.height};
+  }
+  if (given) {
+    const keystone::AxisRect& r = *given;
     if (!r.centre.allFinite() || !(r.half_width > 0) || !(r.half_height > 0))
       return fail(ErrorCode::kInvalidInput, "the given display rectangle is empty");
     // Inside the union: every point of a fine lattice over it is covered.
@@ -223,7 +237,7 @@ Result<TiledDisplay> solveTiledDisplay(std::span<const DisplayTile> tiles, int c
   }
   // Coverage was sampled at cell centres: half a cell in from every side, the rectangle
   // is inside the union; then exactly the content's aspect, about the chosen centre.
-  if (!options.rect) {
+  if (!given) {
     out.rect.half_width -= 0.5 * out.cell_m;
     out.rect.half_height -= 0.5 * out.cell_m;
   }

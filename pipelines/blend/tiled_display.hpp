@@ -25,11 +25,21 @@ struct DisplayTile {
   int width = 0, height = 0;                 // framebuffer size
 };
 
+// An upright display rectangle in world coordinates: its centre (a point on the wall,
+// metres; within 1 cm of the plane) and its width and height on the wall (metres).
+struct WorldRect {
+  Vec3 centre = Vec3::Zero();
+  double width = 0, height = 0;
+};
+
 struct TiledDisplayOptions {
   int raster_cells = 512;  // cells along the union's longer side, coarse pass
   // A display rectangle given by the user (wall metres in the display basis, x right,
   // y up) instead of the largest one; it must lie inside the union.
   std::optional<keystone::AxisRect> rect;
+  // The same given in world coordinates (the basis is only known once solved); not
+  // with `rect`. Shrunk about its centre to the content's aspect, as `rect` is.
+  std::optional<WorldRect> world_rect;
 };
 
 struct TiledDisplay {
@@ -44,8 +54,9 @@ struct TiledDisplay {
 
 // kInvalidInput for no tiles, bad sizes, a non-orthonormal basis, a singular
 // collineation, tiles on different planes (more than 1 mm or 1e-6 of normal apart) or a
-// given rectangle outside the union; kDegenerate for a horizontal wall or a framebuffer
-// corner beyond the wall's horizon; kNotFound when no rectangle of one fine cell fits.
+// given rectangle outside the union (or a world one off the wall plane); kDegenerate for a
+// horizontal wall or a framebuffer corner beyond the wall's horizon; kNotFound when no rectangle of
+// one fine cell fits.
 Result<TiledDisplay> solveTiledDisplay(std::span<const DisplayTile> tiles, int content_width,
                                        int content_height, const TiledDisplayOptions& options = {});
 

@@ -38,6 +38,8 @@ const char* toString(ErrorCode code) {
       return "too-large";
     case ErrorCode::kForbidden:
       return "forbidden";
+    case ErrorCode::kCancelled:
+      return "cancelled";
   }
   return "unknown";
 }

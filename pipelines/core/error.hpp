@@ -28,6 +28,7 @@ enum class ErrorCode {
   kInternal,      // a driver failed where it did not expect to (PROCAM_EINTERNAL)
   kTooLarge,      // an input over a configured bound (pixels, faces, bytes, queued work)
   kForbidden,     // outside what the caller may reach (a file outside the content roots)
+  kCancelled,     // the caller asked the work to stop (PROCAM_ECANCELED)
 };
 
 const char* toString(ErrorCode code);

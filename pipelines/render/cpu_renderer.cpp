@@ -53,9 +53,13 @@ Result<bool> CpuRenderer::render(const Content& content) {
   if (!gate_.needsRender(content.version)) return false;
   cv::Mat& main_out = setup_.post_warp ? stage_ : frame_;
   if (is3d) {
-    auto ok =
-        rasterizeColoredMesh(*content.mesh, setup_.planar3d, setup_.output_size, main_out, depth_);
-    if (!ok) return tl::unexpected(ok.error());
+    auto ok = rasterizeColoredMesh(*content.mesh, setup_.planar3d, setup_.output_size, main_out,
+                                   depth_, content.stop);
+    if (!ok) {
+      // A stopped drawing left a partial frame: the next render draws in full.
+      if (ok.error().code == ErrorCode::kCancelled) redraw();
+      return tl::unexpected(ok.error());
+    }
     return finish(content.version);
   }
   if (static_cast<int>(content.image->step) != packed_.source_step) {

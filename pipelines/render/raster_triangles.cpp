@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 
 #include "render/raster.hpp"
@@ -98,7 +99,8 @@ uint8_t toUnorm8(float v) {
 }  // namespace
 
 Result<void> rasterizeColoredMesh(const ColoredMesh& mesh, const Mat4& pixel3d, cv::Size size,
-                                  cv::Mat& color, cv::Mat& depth) {
+                                  cv::Mat& color, cv::Mat& depth,
+                                  const std::function<bool()>& stop) {
   if (mesh.colors.size() != mesh.vertices.size()) {
     return fail(ErrorCode::kInvalidInput, "raster: one colour per vertex required");
   }
@@ -113,7 +115,12 @@ Result<void> rasterizeColoredMesh(const ColoredMesh& mesh, const Mat4& pixel3d, 
   }
   std::vector<ScreenTriangle> tris;
   tris.reserve(mesh.triangles.size());
+  size_t until_check = kStopCheckTriangles;
   for (const auto& t : mesh.triangles) {
+    if (stop && --until_check == 0) {
+      if (stop()) return fail(ErrorCode::kCancelled, "raster: stopped");
+      until_check = kStopCheckTriangles;
+    }
     for (int i : t) {
       if (i < 0 || i >= nv)
         return fail(ErrorCode::kInvalidInput, "raster: vertex index out of range");
@@ -128,10 +135,19 @@ Result<void> rasterizeColoredMesh(const ColoredMesh& mesh, const Mat4& pixel3d, 
   depth.setTo(cv::Scalar::all(1.0));
   // Stripes of rows on all cores; each stripe draws every triangle in submission order,
   // so equal depths resolve as in GL (the first fragment stays under GL_LESS).
+  std::atomic<bool> stopped{false};
   cv::parallel_for_(
       cv::Range(0, size.height),
       [&](const cv::Range& rows) {
+        size_t stripe_check = kStopCheckTriangles;
         for (const ScreenTriangle& s : tris) {
+          if (stop && --stripe_check == 0) {
+            if (stopped.load(std::memory_order_relaxed) || stop()) {
+              stopped.store(true, std::memory_order_relaxed);
+              return;
+            }
+            stripe_check = kStopCheckTriangles;
+          }
           if (s.row_max < rows.start || s.row_min >= rows.end) continue;
           rasterizeTriangleRows(
               s.p[0], s.p[1], s.p[2], size.width, rows.start, rows.end,
@@ -151,6 +167,7 @@ Result<void> rasterizeColoredMesh(const ColoredMesh& mesh, const Mat4& pixel3d, 
         }
       },
       16);
+  if (stopped.load()) return fail(ErrorCode::kCancelled, "raster: stopped");
   return {};
 }
 

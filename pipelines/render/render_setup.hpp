@@ -3,6 +3,7 @@
 // (this struct) changes rarely; content changes every frame.
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <vector>
@@ -53,9 +54,17 @@ Result<void> validateSetup(const RenderSetup& setup);
 bool sameSetup(const RenderSetup& a, const RenderSetup& b);
 
 struct Content {
+  Content() = default;
+  Content(const cv::Mat* image_in, const ColoredMesh* mesh_in, uint64_t version_in,
+          std::function<bool()> stop_in = {})
+      : image(image_in), mesh(mesh_in), version(version_in), stop(std::move(stop_in)) {}
+
   const cv::Mat* image = nullptr;     // CV_8UC4 of content_size (image paths)
   const ColoredMesh* mesh = nullptr;  // kPlanar3d
   uint64_t version = 0;               // changes whenever the content changes
+  // Asked between steps of a long drawing (a large mesh); true stops it with kCancelled.
+  // Called from the drawing threads: must be thread-safe. Empty: never stop.
+  std::function<bool()> stop;
 };
 
 // Skips frames that would come out identical: nothing re-renders unless the geometry

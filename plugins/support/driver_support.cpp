@@ -24,7 +24,8 @@ constexpr std::pair<ErrorCode, int> kStatuses[] = {{ErrorCode::kInvalidInput, PR
                                                    {ErrorCode::kAgain, PROCAM_EAGAIN},
                                                    {ErrorCode::kNotSupported, PROCAM_ENOTSUP},
                                                    {ErrorCode::kEnded, PROCAM_EEND},
-                                                   {ErrorCode::kInternal, PROCAM_EINTERNAL}};
+                                                   {ErrorCode::kInternal, PROCAM_EINTERNAL},
+                                                   {ErrorCode::kCancelled, PROCAM_ECANCELED}};
 
 }  // namespace
 

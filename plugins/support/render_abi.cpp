@@ -276,4 +276,8 @@ bool outputRenders(const procam_device& d) {
          d.ops.output->configure && d.ops.output->render;
 }
 
+bool outputStops(const procam_device& d) {
+  return outputRenders(d) && d.ops.output->version >= 3 && d.ops.output->render_stoppable;
+}
+
 }  // namespace procam::plugins

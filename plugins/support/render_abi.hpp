@@ -70,5 +70,7 @@ Result<procam_frame_stats> abiFrameStats(const cv::Mat& frame);
 
 // Whether an output device renders by itself (output operations version 2).
 bool outputRenders(const procam_device& device);
+// True when the output's render can be stopped midway (output operations version 3).
+bool outputStops(const procam_device& device);
 
 }  // namespace procam::plugins

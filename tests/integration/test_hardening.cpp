@@ -9,8 +9,10 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <array>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -220,6 +222,64 @@ TEST(Hardening, EveryContentJobIsAnswered) {
   EXPECT_EQ(lie.value("class", ""), "ERROR") << lie.dump();
   pattern = answeredWithin(c, {{"cmd", "pattern"}, {"name", "black"}}, 2.0);
   EXPECT_EQ(pattern.value("class", ""), "PATTERN") << pattern.dump();
+}
+
+// A binary PLY sheet of n x n quads (2 n^2 triangles), rippled so that its shading varies.
+std::string plySheet(int n) {
+  std::string b =
+      "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string((n + 1) * (n + 1)) +
+      "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
+      std::to_string(2 * n * n) + "\nproperty list uchar int vertex_indices\nend_header\n";
+  auto put = [&](auto v) { b.append(reinterpret_cast<const char*>(&v), sizeof v); };
+  for (int j = 0; j <= n; ++j) {
+    for (int i = 0; i <= n; ++i) {
+      const float x = float(i) / float(n) - 0.5f, y = float(j) / float(n) - 0.5f;
+      put(x);
+      put(y);
+      put(0.05f * std::sin(20 * x) * std::cos(20 * y));
+    }
+  }
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      const int32_t a = j * (n + 1) + i, c = a + n + 1;
+      for (const std::array<int32_t, 3> t :
+           {std::array<int32_t, 3>{a, a + 1, c + 1}, std::array<int32_t, 3>{a, c + 1, c}}) {
+        put(uint8_t(3));
+        for (int32_t v : t) put(v);
+      }
+    }
+  }
+  return b;
+}
+
+// 3b. A frame of a large mesh does not hold a newer request back by a whole frame:
+// a `pattern` a client waits for stops the frame in flight midway, and the mesh is
+// drawn in full again afterwards.
+TEST(Hardening, AnObsoleteFrameStopsMidway) {
+  TempDir dir;
+  DaemonProcess d(dir, onTheTrueObliqueWall(dir));
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  writeContent(dir, "sheet.ply", plySheet(500));  // 500,000 triangles
+  auto loaded = c.call(loadRequest(contentFile(dir, "sheet.ply")), std::chrono::seconds(120));
+  ASSERT_TRUE(loaded && (*loaded)["class"] == "CONTENT") << (loaded ? loaded->dump() : "none");
+  // The mesh's first frame is in flight now (the reply follows its submission).
+  const json pattern = answeredWithin(c, {{"cmd", "pattern"}, {"name", "grid"}});
+  EXPECT_EQ(pattern.value("class", ""), "PATTERN") << pattern.dump();
+  auto status = c.call({{"cmd", "status"}});
+  ASSERT_TRUE(status);
+  std::printf("obsolete frame: pattern answered, %d frame(s) stopped\n",
+              (*status)["outputs"]["frames_stopped"].get<int>());
+  EXPECT_GE((*status)["outputs"]["frames_stopped"].get<int>(), 1) << status->dump();
+  // Back to the mesh: drawn in full, as a frame never stopped would be.
+  auto off = c.call({{"cmd", "pattern"}, {"name", "off"}}, std::chrono::seconds(60));
+  ASSERT_TRUE(off && (*off)["shown"] == true) << (off ? off->dump() : "none");
+  status = c.call({{"cmd", "status"}});
+  ASSERT_TRUE(status);
+  const json shown = (*status)["outputs"]["shown"][0];
+  EXPECT_EQ(shown.value("source", ""), "content") << shown.dump();
+  EXPECT_EQ(shown.value("path", ""), "planar-3d") << shown.dump();
+  EXPECT_GT(shown.value("lit_fraction", 0.0), 0.01) << shown.dump();
 }
 
 // 4. Sizes a client controls are refused with `too-large` before the memory is

@@ -328,7 +328,8 @@ TEST(SimTiledWall, FourProjectorsCalibratedIntoOneSeamlessDisplay) {
     ASSERT_TRUE(to_image);
     tiles.push_back({{*basis, to_image->inverse()}, truth[a].width, truth[a].height});
   }
-  auto optimum = blend::solveTiledDisplay(tiles, kW, kH, {.raster_cells = 2048, .rect = {}});
+  auto optimum =
+      blend::solveTiledDisplay(tiles, kW, kH, {.raster_cells = 2048, .rect = {}, .world_rect = {}});
   ASSERT_TRUE(optimum) << optimum.error().message;
   const double of_optimum = area / optimum->rect.area();
   std::printf(
@@ -352,6 +353,49 @@ TEST(SimTiledWall, FourProjectorsCalibratedIntoOneSeamlessDisplay) {
       before.uniformity);
   EXPECT_LE(after.step, 0.02);
   EXPECT_LE(of_optimum, 1.0 + 2 * 4 * optimum->cell_m / left.norm());
+}
+
+// A display rectangle from the configuration ([keystone] display_centre, display_size:
+// world metres) instead of the largest one, on the true rig handed over explicitly (its
+// projectors have intrinsics and poses and the wall is a plane: each one's collineation
+// with the wall follows from them).
+TEST(SimTiledWall, ConfiguredDisplayRectangleIsUsed) {
+  TempDir dir;
+  dir.write("procamd.toml",
+            "[keystone]\ndisplay_centre = [0.1, 3.0, 1.45]\ndisplay_size = [1.6, 0.9]\n");
+  auto launch = simWithTruth(dir, "tiled_wall");
+  launch.args.insert(launch.args.end(), {"--config", dir.file("procamd.toml")});
+  DaemonProcess d(dir, launch);
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  const std::string png = contentFile(dir, "slide.png");
+  ASSERT_TRUE(cv::imwrite(png, cv::Mat(450, 800, CV_8UC3, cv::Scalar(255, 255, 255))));
+  auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", png}}, 30s);
+  ASSERT_TRUE(load && (*load)["class"] == "CONTENT") << (load ? load->dump() : "none");
+  auto on = c.call({{"cmd", "keystone"}, {"action", "rig"}, {"enable", true}});
+  ASSERT_TRUE(on && (*on)["class"] == "KEYSTONE") << (on ? on->dump() : "none");
+  json display;
+  ASSERT_TRUE(eventually(
+      [&] {
+        auto s = c.call({{"cmd", "status"}});
+        display = s ? (*s)["keystone"].value("display", json()) : json();
+        return display.is_object() && display.value("state", "") == "ready";
+      },
+      30s))
+      << display.dump() << "\n"
+      << d.log();
+  EXPECT_EQ(display["rect_source"], "config");
+  EXPECT_EQ(display["outputs"].size(), 4u);
+  EXPECT_NEAR(display["rect_m"]["size"][0].get<double>(), 1.6, 1e-9);
+  EXPECT_NEAR(display["rect_m"]["size"][1].get<double>(), 0.9, 1e-9);
+  const json& b = display["basis"];
+  Vec3 centre = Vec3::Zero();
+  for (int i = 0; i < 3; ++i) {
+    centre[i] = b["origin"][i].get<double>() +
+                display["rect_m"]["centre"][0].get<double>() * b["u"][i].get<double>() +
+                display["rect_m"]["centre"][1].get<double>() * b["v"][i].get<double>();
+  }
+  EXPECT_NEAR((centre - Vec3(0.1, 3.0, 1.45)).norm(), 0, 1e-9) << centre.transpose();
 }
 
 }  // namespace

@@ -438,6 +438,8 @@ Result<bool> GlRenderer::render(const render::Content& content) {
     last_upload_ = renders_;
     ++uploads_;
   }
+  // A large mesh's upload is the long CPU step before the draw: ask once more here.
+  if (content.stop && content.stop()) return fail(ErrorCode::kCancelled, "gl renderer: stopped");
   const cv::Size out = setup_.output_size;
   // Without blending, LUTs or a post-render warp the final stage is the identity: the main
   // pass draws straight into the frame, one full-frame pass instead of two (a GPU with few

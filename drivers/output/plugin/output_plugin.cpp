@@ -106,8 +106,8 @@ int configure(void* self, const procam_render_setup* setup, char* err, size_t er
   }
 }
 
-int render(void* self, const procam_content* content, int* out_drawn, procam_frame_stats* stats,
-           char* err, size_t err_len) {
+int renderStoppable(void* self, const procam_content* content, int (*stop)(void*), void* stop_ctx,
+                    int* out_drawn, procam_frame_stats* stats, char* err, size_t err_len) {
   try {
     auto* d = static_cast<Device*>(self);
     if (out_drawn) *out_drawn = 0;
@@ -124,6 +124,7 @@ int render(void* self, const procam_content* content, int* out_drawn, procam_fra
     cv::Mat header;
     auto c = plugins::contentFromAbi(*content, *d->setup, header, d->mesh);
     if (!c) return plugins::report(err, err_len, c.error());
+    if (stop) c->stop = [stop, stop_ctx] { return stop(stop_ctx) != 0; };
     auto drawn = d->out->show(*c);
     if (!drawn) return plugins::report(err, err_len, drawn.error());
     if (out_drawn) *out_drawn = *drawn ? 1 : 0;
@@ -147,7 +148,13 @@ void destroy(void* self) {
   delete static_cast<Device*>(self);
 }
 
-const procam_output_ops kOps = {PROCAM_OUTPUT_OPS_VERSION, &getMode, &show, &configure, &render};
+int render(void* self, const procam_content* content, int* out_drawn, procam_frame_stats* stats,
+           char* err, size_t err_len) {
+  return renderStoppable(self, content, nullptr, nullptr, out_drawn, stats, err, err_len);
+}
+
+const procam_output_ops kOps = {PROCAM_OUTPUT_OPS_VERSION, &getMode, &show, &configure, &render,
+                                &renderStoppable};
 
 int finish(std::unique_ptr<Device> d, procam_device* out, char* err, size_t err_len) {
   if (auto ok = configureOneToOne(*d); !ok) return plugins::report(err, err_len, ok.error());

@@ -161,8 +161,9 @@ int outputConfigure(void* self, const procam_render_setup* setup, char* err, siz
   }
 }
 
-int outputRender(void* self, const procam_content* content, int* drawn, procam_frame_stats* stats,
-                 char* err, size_t len) {
+int outputRenderStoppable(void* self, const procam_content* content, int (*stop)(void*),
+                          void* stop_ctx, int* drawn, procam_frame_stats* stats, char* err,
+                          size_t len) {
   auto* dev = static_cast<Device*>(self);
   if (drawn) *drawn = 0;
   if (int rc = presence(dev->name, err, len); rc != PROCAM_OK) return rc;
@@ -173,9 +174,13 @@ int outputRender(void* self, const procam_content* content, int* drawn, procam_f
     cv::Mat header;
     auto c = plugins::contentFromAbi(*content, *o->setup, header, o->mesh);
     if (!c) return report(err, len, c.error().message, PROCAM_EINVAL);
+    if (stop) c->stop = [stop, stop_ctx] { return stop(stop_ctx) != 0; };
     if (o->showing) o->renderer.redraw();
     auto rendered = o->renderer.render(*c);
-    if (!rendered) return report(err, len, rendered.error().message, PROCAM_EINVAL);
+    if (!rendered) {
+      const bool stopped = rendered.error().code == ErrorCode::kCancelled;
+      return report(err, len, rendered.error().message, stopped ? PROCAM_ECANCELED : PROCAM_EINVAL);
+    }
     if (*rendered || o->showing) {
       // The simulated projector lights the world with a BGR frame.
       cv::Mat bgr;
@@ -195,8 +200,14 @@ int outputRender(void* self, const procam_content* content, int* drawn, procam_f
   }
 }
 
-const procam_output_ops kOutputOps = {PROCAM_OUTPUT_OPS_VERSION, outputMode, outputShow,
-                                      outputConfigure, outputRender};
+int outputRender(void* self, const procam_content* content, int* drawn, procam_frame_stats* stats,
+                 char* err, size_t len) {
+  return outputRenderStoppable(self, content, nullptr, nullptr, drawn, stats, err, len);
+}
+
+const procam_output_ops kOutputOps = {
+    PROCAM_OUTPUT_OPS_VERSION, outputMode,   outputShow,
+    outputConfigure,           outputRender, outputRenderStoppable};
 
 // --- camera ---
 const CameraSpec* cameraSpec(const Device* dev) {

@@ -40,7 +40,7 @@ extern "C" {
 #define PROCAM_CAMERA_OPS_VERSION 1u
 #define PROCAM_TILT_OPS_VERSION 2u
 #define PROCAM_TRACKER_OPS_VERSION 1u
-#define PROCAM_OUTPUT_OPS_VERSION 2u
+#define PROCAM_OUTPUT_OPS_VERSION 3u
 
 #define PROCAM_PLUGIN_ABI_SYMBOL "procam_plugin_abi_version"
 #define PROCAM_PLUGIN_ENTRY_SYMBOL "procam_plugin_entry"
@@ -54,7 +54,8 @@ extern "C" {
 #define PROCAM_EAGAIN (-5)  /* no data yet; poll the device fd */
 #define PROCAM_ENOTSUP (-6) /* operation not supported by this driver */
 #define PROCAM_EINTERNAL (-7)
-#define PROCAM_EEND (-8) /* the stream ended for good (a finished recording) */
+#define PROCAM_EEND (-8)      /* the stream ended for good (a finished recording) */
+#define PROCAM_ECANCELED (-9) /* the caller asked the operation to stop */
 
 typedef enum procam_family {
   PROCAM_FAMILY_CAMERA = 1,
@@ -253,6 +254,15 @@ typedef struct procam_output_ops {
    * (drawn or not), which may cost a GPU read-back. */
   int (*render)(void* self, const procam_content* content, int* out_drawn,
                 procam_frame_stats* stats, char* err, size_t err_len);
+  /* Version 3. As `render`, but the plugin calls `stop(stop_ctx)` between the steps
+   * of its drawing (on the rendering thread; for a mesh, every few thousand
+   * triangles) and, once it returns nonzero, stops: PROCAM_ECANCELED, nothing
+   * presented, the frame shown before stays, and the next render draws in full.
+   * `stop` may be NULL (never stop). The daemon stops a frame that a newer request
+   * (other content, a pattern a client waits for) has made obsolete. */
+  int (*render_stoppable)(void* self, const procam_content* content, int (*stop)(void* stop_ctx),
+                          void* stop_ctx, int* out_drawn, procam_frame_stats* stats, char* err,
+                          size_t err_len);
 } procam_output_ops;
 
 /* A created device. `poll_fd` returns a file descriptor the daemon may watch

@@ -77,7 +77,8 @@ TEST(TiledDisplay, TwoByTwoWallIsOneRectangle) {
       d->union_area_m2, d->rect.area() / largest_single);
   EXPECT_GT(d->rect.area(), 2.5 * largest_single);
   // A finer raster finds no rectangle larger by more than a cell per side.
-  auto finer = solveTiledDisplay(tiles, 1920, 1080, {.raster_cells = 2048, .rect = std::nullopt});
+  auto finer = solveTiledDisplay(
+      tiles, 1920, 1080, {.raster_cells = 2048, .rect = std::nullopt, .world_rect = std::nullopt});
   ASSERT_TRUE(finer);
   EXPECT_LT(finer->rect.area() / d->rect.area(), 1 + 4 * d->cell_m / (2 * d->rect.half_height));
   // Content corners -> framebuffer -> wall: the rectangle's corners.
@@ -104,14 +105,42 @@ TEST(TiledDisplay, GivenRectangleIsUsedWhenInside) {
   r.centre = Vec2(0.1, 0.0);
   r.half_width = 0.8;
   r.half_height = 0.45;
-  auto d = solveTiledDisplay(tiles, 1600, 900, {.raster_cells = 512, .rect = r});
+  auto d = solveTiledDisplay(tiles, 1600, 900,
+                             {.raster_cells = 512, .rect = r, .world_rect = std::nullopt});
   ASSERT_TRUE(d) << d.error().message;
   EXPECT_NEAR(d->rect.half_width, 0.8, 1e-12);
   r.half_width = 5;
   r.half_height = 5 * 9.0 / 16;
-  auto outside = solveTiledDisplay(tiles, 1600, 900, {.raster_cells = 512, .rect = r});
+  auto outside = solveTiledDisplay(tiles, 1600, 900,
+                                   {.raster_cells = 512, .rect = r, .world_rect = std::nullopt});
   ASSERT_FALSE(outside);
   EXPECT_EQ(outside.error().code, ErrorCode::kInvalidInput);
+}
+
+// The same rectangle given in world coordinates: its centre a wall point, its size in
+// metres; off the wall plane, or together with a basis rectangle, it is refused.
+TEST(TiledDisplay, GivenWorldRectangleIsTheSameRectangle) {
+  const auto tiles = testing::tilesOf(twoByTwo());
+  auto largest = solveTiledDisplay(tiles, 1600, 900);
+  ASSERT_TRUE(largest) << largest.error().message;
+  const geom::PlaneBasis& b = largest->basis;
+  const Vec2 centre(0.1, 0.0);
+  WorldRect w{b.toWorld(centre), 1.6, 0.9};
+  auto d = solveTiledDisplay(tiles, 1600, 900,
+                             {.raster_cells = 512, .rect = std::nullopt, .world_rect = w});
+  ASSERT_TRUE(d) << d.error().message;
+  EXPECT_NEAR((d->rect.centre - centre).norm(), 0, 1e-12);
+  EXPECT_NEAR(d->rect.half_width, 0.8, 1e-12);
+  EXPECT_NEAR(d->rect.half_height, 0.45, 1e-12);
+  w.centre += 0.02 * b.normal();  // 2 cm in front of the wall
+  auto off = solveTiledDisplay(tiles, 1600, 900,
+                               {.raster_cells = 512, .rect = std::nullopt, .world_rect = w});
+  ASSERT_FALSE(off);
+  EXPECT_EQ(off.error().code, ErrorCode::kInvalidInput);
+  auto twice = solveTiledDisplay(
+      tiles, 1600, 900,
+      {.raster_cells = 512, .rect = keystone::AxisRect{centre, 0.8, 0.45}, .world_rect = w});
+  EXPECT_FALSE(twice);
 }
 
 TEST(TiledDisplay, BadTilesAreRefused) {

@@ -224,6 +224,22 @@ TEST(Config, ContentRootsAndLimits) {
   EXPECT_TRUE(contains(e.message, "content.roots: expected an array of 1 to 64")) << e.message;
 }
 
+TEST(Config, DisplayRectangle) {
+  auto cfg = parseConfig("[keystone]\ndisplay_centre = [0.1, 3, 1.45]\ndisplay_size = [1.6, 0.9]\n",
+                         "rig.toml");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  ASSERT_TRUE(cfg->keystone.display_centre && cfg->keystone.display_size);
+  EXPECT_EQ((*cfg->keystone.display_centre)[2], 1.45);
+  EXPECT_EQ((*cfg->keystone.display_size)[0], 1.6);
+  auto e = parseError("[keystone]\ndisplay_centre = [0, 3, 1.5]\n");
+  EXPECT_TRUE(contains(e.message,
+                       "rig.toml:2: keystone.display_centre: display_centre and display_size go "
+                       "together"))
+      << e.message;
+  e = parseError("[keystone]\ndisplay_size = [1.6, 0]\ndisplay_centre = [0, 3, 1.5]\n");
+  EXPECT_TRUE(contains(e.message, "rig.toml:2: keystone.display_size[1]")) << e.message;
+}
+
 // Only a regular file of bounded size is read: a directory, a FIFO (which would
 // block until a writer came) and a device (endless) are refused at once.
 TEST(Config, OnlyARegularFileOfBoundedSizeIsRead) {

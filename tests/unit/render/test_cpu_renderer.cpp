@@ -1,8 +1,11 @@
 // Render-path choice and the CPU renderer's behaviour as one interface.
 #include <gtest/gtest.h>
 
+#include <atomic>
+
 #include "render/bilinear.hpp"
 #include "render/cpu_renderer.hpp"
+#include "render/raster_triangles.hpp"
 #include "render/render_path.hpp"
 #include "render_test_images.hpp"
 #include "render_test_rig.hpp"
@@ -145,6 +148,47 @@ TEST(CpuRenderer, PlanarPath3dTakesMeshesAndBadSetupsAreRejected) {
   EXPECT_EQ(r.configure(s).error().code, ErrorCode::kInvalidInput);
   cv::Mat img(8, 8, CV_8UC4);
   EXPECT_EQ(r.render({&img, nullptr, 1}).error().code, ErrorCode::kInvalidInput);
+}
+
+// A stop that answers true ends a mesh frame with kCancelled; the next render draws the
+// frame in full although the content version did not change, and a stop that never
+// answers true leaves the frame as drawn without one.
+TEST(CpuRenderer, AStoppedMeshFrameIsDrawnInFullNextTime) {
+  RenderSetup s;
+  s.output_size = {64, 48};
+  s.path = RenderPath::kPlanar3d;
+  s.planar3d = Mat4::Identity();  // pixel coordinates at depth 0, w = 1
+  ColoredMesh mesh;
+  for (int i = 0; i < 30000; ++i) {  // enough triangles for several stop checks
+    const double x = i % 60, y = (i / 60) % 44;
+    const int v = int(mesh.vertices.size());
+    mesh.vertices.insert(mesh.vertices.end(),
+                         {Vec3(x, y, 0), Vec3(x + 3, y, 0), Vec3(x, y + 3, 0)});
+    mesh.colors.insert(mesh.colors.end(), 3, cv::Vec4b(uint8_t(i % 251), 40, 200, 255));
+    mesh.triangles.push_back({v, v + 1, v + 2});
+  }
+  CpuRenderer plain;
+  ASSERT_TRUE(plain.configure(s));
+  ASSERT_TRUE(*plain.render({nullptr, &mesh, 1}));
+
+  CpuRenderer r;
+  ASSERT_TRUE(r.configure(s));
+  std::atomic<int> asked{0};
+  auto stopped = r.render({nullptr, &mesh, 1, [&] { return ++asked >= 3; }});
+  ASSERT_FALSE(stopped);
+  EXPECT_EQ(stopped.error().code, ErrorCode::kCancelled);
+  EXPECT_GE(asked.load(), 3);
+  auto again = r.render({nullptr, &mesh, 1});  // same version: drawn all the same
+  ASSERT_TRUE(again);
+  EXPECT_TRUE(*again);
+  EXPECT_EQ(cv::norm(r.frame(), plain.frame(), cv::NORM_INF), 0.0);
+
+  CpuRenderer never;
+  ASSERT_TRUE(never.configure(s));
+  asked = 0;
+  ASSERT_TRUE(*never.render({nullptr, &mesh, 1, [&] { return ++asked < 0; }}));
+  EXPECT_GE(asked.load(), int(mesh.triangles.size() / kStopCheckTriangles));
+  EXPECT_EQ(cv::norm(never.frame(), plain.frame(), cv::NORM_INF), 0.0);
 }
 
 }  // namespace

@@ -1,0 +1,55 @@
+#pragma once
+// procam-render: a planar rig's projector framebuffers drawn offline from rig.json and
+// one content image, as the daemon would show them (see kUsage).
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "blend/tiled_display.hpp"
+#include "core/error.hpp"
+
+namespace procam::render_cli {
+
+inline constexpr const char* kUsage =
+    "usage: procam-render --rig RIG.json --content IMAGE (--out DIR | --mpcdi FILE) [options]\n"
+    "  Draws the framebuffer of every projector of a planar display that rig.json\n"
+    "  describes: the content in the largest upright rectangle of its aspect inside the\n"
+    "  union of the projectors' images on the wall (or the --rect given), through each\n"
+    "  projector's homography, blended in the overlaps in linear light through each\n"
+    "  projector's measured response (rig.json photometric; gamma 2.2 otherwise). Writes\n"
+    "  DIR/NAME.png per projector and DIR/display.json (the display rectangle, and per\n"
+    "  projector its homography, footprint, response and gain).\n"
+    "options:\n"
+    "  --rect X,Y,Z,W,H   the display rectangle: centre (world, metres, on the wall),\n"
+    "                     width and height (metres); shrunk to the content's aspect\n"
+    "  --bit-depth 8|16   PNG depth (default 8: exactly the daemon's frames; 16: drawn in\n"
+    "                     double precision, content ramps keep their codes)\n"
+    "  --geometry-only    no blending and no response correction: the geometry alone\n"
+    "  --projector NAME   only this projector of the rig (repeatable; default all that\n"
+    "                     map onto the display plane)\n"
+    "  --mpcdi FILE       also (or, without --out, only) export the display as VESA MPCDI,\n"
+    "                     2D media profile: a zip of mpcdi.xml and per projector a warp\n"
+    "                     (PFM), an alpha map (16-bit PNG, gamma embedded) and a beta map;\n"
+    "                     the content image gives the buffer's size\n"
+    "  --help             this text\n"
+    "Exit status: 0 success, 1 failure, 2 bad command line.\n";
+
+struct RenderArgs {
+  std::filesystem::path rig, content, out;
+  std::optional<blend::WorldRect> rect;
+  int bit_depth = 8;
+  bool geometry_only = false;
+  std::vector<std::string> projectors;
+  std::filesystem::path mpcdi;  // empty: no MPCDI export
+};
+
+// kInvalidInput (with the reason) for a bad command line.
+Result<RenderArgs> parseRenderArgs(const std::vector<std::string>& args);
+
+// Reads the rig and the content, draws and writes every framebuffer and display.json
+// (with --out) and the MPCDI package (with --mpcdi). Returns display.json's document.
+Result<nlohmann::json> runRender(const RenderArgs& args);
+
+}  // namespace procam::render_cli

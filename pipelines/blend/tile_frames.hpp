@@ -1,0 +1,38 @@
+#pragma once
+// The framebuffer each projector of a planar display shows, drawn offline
+// (procam-render): the content through the projector's homography, blended
+// ([Raskar02] eq. 4.3 weights in linear light, §4.1.2) or geometry only.
+//  - 8 bit, blended: the daemon's own frame, drawn by the CPU reference renderer with the
+//    same render setup (homography, 8-bit alpha mask, weight table).
+//  - 16 bit, or geometry only: every framebuffer pixel's centre mapped into the content
+//    and sampled bilinearly in double precision (render/bilinear.hpp's convention), so a
+//    16-bit ramp keeps its codes; blended, each channel is scaled by
+//    (gain weight)^(1 / gamma) with the unquantized weight.
+#include <opencv2/core.hpp>
+
+#include "blend/tiled_blend.hpp"
+#include "core/error.hpp"
+
+namespace procam::blend {
+
+struct TileFrameOptions {
+  int bit_depth = 8;           // 8 or 16
+  bool geometry_only = false;  // no weights, no response correction
+};
+
+// `content`: CV_8U or CV_16U with 1, 3 or 4 channels (OpenCV's BGR(A) order). Returns a
+// CV_8U or CV_16U image of the tile's framebuffer size with 1 channel for grey content,
+// else 3 (BGR); black outside the content's image. kInvalidInput for other content, a
+// tile index out of range, a blend made without weights, or a bit depth other than 8 or 16.
+Result<cv::Mat> tileFrame(const cv::Mat& content, const TiledBlend& blend, std::size_t tile,
+                          const TileFrameOptions& options);
+
+// `content` (as above) as CV_64FC1 or CV_64FC3 in [0, 1], alpha dropped.
+Result<cv::Mat> unitContent(const cv::Mat& content);
+
+// Channel values of a unitContent image at content pixel (x, y) (centres at integers),
+// bilinear with the outer half pixel clamped to the edge; false outside the image's
+// footprint ([-0.5, W - 0.5) x [-0.5, H - 0.5), render/bilinear.hpp).
+bool sampleContent(const cv::Mat& unit, double x, double y, double* out);
+
+}  // namespace procam::blend
