@@ -253,18 +253,7 @@ void plot(const std::filesystem::path& out) {
 int main(int argc, char** argv) {
   std::filesystem::path out = ".";
   int runs = 15;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc) {
-      out = argv[++i];
-    } else if (a == "--runs" && i + 1 < argc) {
-      runs = std::max(3, std::atoi(argv[++i]));
-    } else {
-      std::fprintf(stderr, "usage: bench_multi_projector [--out DIR] [--runs N]\n");
-      return 2;
-    }
-  }
-  std::filesystem::create_directories(out);
+  if (!bench::benchOptions(argc, argv, "bench_multi_projector", out, runs, 3)) return 2;
   cv::setNumThreads(static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
 
   sl::PatternOptions pattern;

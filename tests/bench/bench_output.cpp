@@ -33,6 +33,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_timing.hpp"
 #include "render/cpu_renderer.hpp"
 #include "render/frame_stats.hpp"
 #include "support/render_abi.hpp"
@@ -189,18 +190,7 @@ void benchOutput(const char* backend, OutputDevice& out, int rounds, int batch,
 int main(int argc, char** argv) {
   std::filesystem::path out = ".";
   int rounds = 7, batch = 10;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc) {
-      out = argv[++i];
-    } else if (a == "--runs" && i + 1 < argc) {
-      rounds = std::max(3, std::atoi(argv[++i]));
-    } else {
-      std::fprintf(stderr, "usage: bench_output [--out DIR] [--runs N]\n");
-      return 2;
-    }
-  }
-  std::filesystem::create_directories(out);
+  if (!bench::benchOptions(argc, argv, "bench_output", out, rounds, 3)) return 2;
   std::ofstream csv(out / "output_frames.csv");
   csv << "backend,before_ms,unchanged_ms,geometry_ms,content_ms,geometry_stats_ms\n";
   std::printf("Output frame time, 1920x1080 RGBA, median of %d batches\n", rounds);

@@ -265,18 +265,7 @@ void benchGles(const std::filesystem::path& out, cv::Size size, const cv::Mat& s
 int main(int argc, char** argv) {
   std::filesystem::path out = ".";
   int runs = 30;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc) {
-      out = argv[++i];
-    } else if (a == "--runs" && i + 1 < argc) {
-      runs = std::max(3, std::atoi(argv[++i]));
-    } else {
-      std::fprintf(stderr, "usage: bench_render [--out DIR] [--runs N]\n");
-      return 2;
-    }
-  }
-  std::filesystem::create_directories(out);
+  if (!bench::benchOptions(argc, argv, "bench_render", out, runs, 3)) return 2;
   const int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   cv::setNumThreads(threads);
   const cv::Size size(1920, 1080);

@@ -40,18 +40,7 @@ cv::Mat checkerboard(int width, int height, int square) {
 int main(int argc, char** argv) {
   std::filesystem::path out = ".";
   int runs = 5;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc) {
-      out = argv[++i];
-    } else if (a == "--runs" && i + 1 < argc) {
-      runs = std::max(1, std::stoi(argv[++i]));
-    } else {
-      std::fprintf(stderr, "usage: bench_sim_render [--out DIR] [--runs N]\n");
-      return 2;
-    }
-  }
-  std::filesystem::create_directories(out);
+  if (!bench::benchOptions(argc, argv, "bench_sim_render", out, runs, 1)) return 2;
   cv::setNumThreads(1);  // single core, OpenCV's own filters included
 
   auto scene = resolveScene("wall_oblique");

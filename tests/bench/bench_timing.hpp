@@ -4,7 +4,11 @@
 // the median and fastest of them.
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <functional>
+#include <string>
 #include <vector>
 
 namespace procam::bench {
@@ -45,6 +49,25 @@ inline std::vector<Timing> measureInterleaved(int runs,
     out.push_back({m[m.size() / 2], m.front()});
   }
   return out;
+}
+
+// The options every bench takes, `--out DIR` (made when missing) and `--runs N` (at least
+// `min_runs`); false, with the usage on stderr, for anything else.
+inline bool benchOptions(int argc, char** argv, const char* name, std::filesystem::path& out,
+                         int& runs, int min_runs = 3) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--out" && i + 1 < argc) {
+      out = argv[++i];
+    } else if (a == "--runs" && i + 1 < argc) {
+      runs = std::max(min_runs, std::atoi(argv[++i]));
+    } else {
+      std::fprintf(stderr, "usage: %s [--out DIR] [--runs N]\n", name);
+      return false;
+    }
+  }
+  std::filesystem::create_directories(out);
+  return true;
 }
 
 }  // namespace procam::bench
