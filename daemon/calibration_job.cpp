@@ -301,6 +301,17 @@ tl::expected<void, CalibrationFailure> blankOutput(const CalibrationPlan& plan) 
   return {};
 }
 
+tl::expected<void, CalibrationFailure> blankOutput(const IdleOutput& idle) {
+  const cv::Mat black(idle.height, idle.width, CV_8UC3, cv::Scalar::all(0));
+  procam_image frame = rgbImage(black);
+  char err[256] = {0};
+  const auto& raw = idle.output.device->raw();
+  if (int rc = raw.ops.output->show(raw.self, &frame, err, sizeof err - 1); rc != PROCAM_OK) {
+    return tl::unexpected(deviceFailure("output", idle.output.name, rc, "show black", err));
+  }
+  return {};
+}
+
 tl::expected<CalibrationOutcome, CalibrationFailure> runCalibration(const CalibrationPlan& plan,
                                                                     const CalibrationHooks& hooks) {
   const CalibrationFailure cancelled{code::kCancelled, "calibration cancelled"};

@@ -132,6 +132,14 @@ bool waitCancellable(double seconds, const CalibrationHooks& hooks);
 // another projector's scan; on a worker.
 tl::expected<void, CalibrationFailure> blankOutput(const CalibrationPlan& plan);
 
+// An output that takes no part in a calibration, and the frame size that blanks it.
+struct IdleOutput {
+  CalibrationDevice output;
+  int width = 0, height = 0;  // its mode
+};
+// Shows black on it (on a worker, as the output frames are drawn).
+tl::expected<void, CalibrationFailure> blankOutput(const IdleOutput& idle);
+
 // Runs on a worker: blocks on the devices; never touches daemon state.
 tl::expected<CalibrationOutcome, CalibrationFailure> runCalibration(const CalibrationPlan& plan,
                                                                     const CalibrationHooks& hooks);

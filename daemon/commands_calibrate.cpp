@@ -304,6 +304,16 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
     plans.push_back(std::make_shared<const CalibrationPlan>(std::move(*made)));
   }
   const auto& plan = plans.front();
+  // Every other usable output shows black during the scans: its light would fall into
+  // the captures where it overlaps a scanned projector.
+  std::vector<IdleOutput> idle;
+  for (auto& e : devices_.entries()) {
+    if (e.description.family != PROCAM_FAMILY_OUTPUT || !e.usable()) continue;
+    if (std::find(outputs.begin(), outputs.end(), e.name) != outputs.end()) continue;
+    if (auto mode = outputMode(e.device.raw())) {
+      idle.push_back({{e.name, e.device.share()}, mode->width, mode->height});
+    }
+  }
 
   const std::string op_id = "op-" + std::to_string(next_operation_++);
   auto cancelled = std::make_shared<std::atomic<bool>>(false);
@@ -348,10 +358,13 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
   const CalibrationHooks hooks = operationHooks(client, op_id, cancelled, progress);
   using Outcomes = tl::expected<std::vector<CalibrationOutcome>, Failure>;
   compute_worker_->submit(
-      [this, client, req, op_id, cancelled, plans, progress, hooks, fence, captures] {
+      [this, client, req, op_id, cancelled, plans, idle, progress, hooks, fence, captures] {
         fence.wait();
         // The projectors one after the other; progress over the whole run.
         Outcomes result = std::vector<CalibrationOutcome>{};
+        // An output that cannot show black is left as it is (the device manager hears of
+        // it from its own checks); the scan goes on.
+        for (const IdleOutput& o : idle) (void)blankOutput(o);
         // Projectors of the run that are not being scanned show black: their light would
         // fall into the overlaps of the one that is.
         if (plans.size() > 1) {

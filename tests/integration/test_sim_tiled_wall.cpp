@@ -355,6 +355,43 @@ TEST(SimTiledWall, FourProjectorsCalibratedIntoOneSeamlessDisplay) {
   EXPECT_LE(of_optimum, 1.0 + 2 * 4 * optimum->cell_m / left.norm());
 }
 
+// While one projector is calibrated every other output shows black: with all four
+// showing white before, a neighbour left white would saturate the camera where it
+// overlaps the scanned image (~20-25 % of it) and those nodes would not decode. The
+// camera sees the whole wall, so all but the frame's edge nodes decode (95 % of the
+// 160 x 100 nodes of an 8 px grid asked), and the response ramp at level 0 sees only
+// the ambient light (the scene's 0.02 against a projector's 9-13 at 2 m: under 1 % of
+// its white).
+TEST(SimTiledWall, OtherOutputsAreBlackWhileOneIsCalibrated) {
+  TempDir dir;
+  DaemonProcess d(dir, simWithTruth(dir, "tiled_wall", TruthParts::kCamerasOnly));
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  auto white = c.call({{"cmd", "pattern"}, {"name", "white"}});
+  ASSERT_TRUE(white && (*white)["shown"] == true) << (white ? white->dump() : "none");
+  const json request = {{"cmd", "calibrate"},  {"id", 1},
+                        {"output", "proj_tl"}, {"cameras", {"cam_a"}},
+                        {"plane", kWallPlane}, {"mode", "gray+phase"},
+                        {"phase_steps", 3},    {"grid", 8},
+                        {"settle_frames", 0},  {"response", true}};
+  auto started = c.call(request);
+  ASSERT_TRUE(started && (*started)["class"] == "CALIBRATE")
+      << (started ? started->dump() : "none");
+  auto done = finalReply(c, 1, 600s);
+  ASSERT_TRUE(done) << d.log();
+  ASSERT_EQ((*done)["class"], "CALIBRATE") << done->dump();
+  const double black = (*done)["response"]["black"].get<double>();
+  const double level = (*done)["response"]["white"].get<double>();
+  std::printf(
+      "[ figures  ] proj_tl alone, the others black: response black %.2f, white %.1f "
+      "(%.2f %%); %d of %d nodes, collineation RMS %.4f px\n",
+      black, level, 100 * black / level, (*done)["homography"]["inliers"].get<int>(),
+      (*done)["homography"]["samples"].get<int>(),
+      (*done)["homography"]["rms_projector_px"].get<double>());
+  EXPECT_LT(black, 0.02 * level);
+  EXPECT_GE((*done)["homography"]["samples"].get<int>(), 0.95 * (1280 / 8) * (800 / 8));
+}
+
 // A display rectangle from the configuration ([keystone] display_centre, display_size:
 // world metres) instead of the largest one, on the true rig handed over explicitly (its
 // projectors have intrinsics and poses and the wall is a plane: each one's collineation
