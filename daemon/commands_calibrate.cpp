@@ -309,7 +309,9 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
   std::vector<IdleOutput> idle;
   for (auto& e : devices_.entries()) {
     if (e.description.family != PROCAM_FAMILY_OUTPUT || !e.usable()) continue;
-    if (std::find(outputs.begin(), outputs.end(), e.name) != outputs.end()) continue;
+    const bool scanned = std::any_of(plans.begin(), plans.end(),
+                                     [&](const auto& p) { return p->output.name == e.name; });
+    if (scanned) continue;
     if (auto mode = outputMode(e.device.raw())) {
       idle.push_back({{e.name, e.device.share()}, mode->width, mode->height});
     }

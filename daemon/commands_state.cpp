@@ -31,7 +31,9 @@ void Daemon::cmdPattern(ClientId client, const proto::Request& req) {
   // Rendered on a worker (with the keystone warp); answered once it is shown.
   server_->hold(client);
   refreshOutputs(
-      [this, client, req, pattern = *name](bool shown) {
+      [this, client, req, pattern = *name](bool drawn) {
+        // A later `pattern` may have replaced this one before its frame was drawn.
+        const bool shown = drawn && settings_.pattern == pattern;
         broadcast("pattern", {{"pattern", pattern}, {"shown", shown}});
         replyTo(client, req, "PATTERN", {{"pattern", pattern}, {"shown", shown}});
         server_->release(client);

@@ -108,7 +108,9 @@ OutputDrawn drawOutput(const OutputDraw& j) {
       r.rc = raw.ops.output->render(raw.self, &content.get(), &drawn, want, err.data(),
                                     err.size() - 1);
     }
-    r.stopped = r.rc == PROCAM_ECANCELED;
+    // Only a stop the daemon asked for: a driver answering PROCAM_ECANCELED by itself
+    // is an error like any other (its frame is not drawn again at once).
+    r.stopped = r.rc == PROCAM_ECANCELED && j.stop && j.stop->load();
     if (r.rc != PROCAM_OK) {
       r.error = reason(err, r.rc);
       return r;

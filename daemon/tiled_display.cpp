@@ -1,8 +1,9 @@
 // Several projectors on one planar wall shown as one display ([Raskar02] §4.2.4,
 // PROTOCOL.md "Keystone from the rig model"): with `keystone rig on` and two or more
-// usable outputs whose projectors the rig maps onto the same display plane (route (b′)
-// plane_homography), the content fills the largest upright rectangle of its aspect
-// inside the union of their images (blend/tiled_display.hpp) and every output shows
+// usable outputs whose projectors the rig maps onto the same display plane
+// (blend/rig_tiles.hpp), the content fills the largest upright rectangle of its aspect
+// inside the union of their images, or the rectangle [keystone] display_centre and
+// display_size give (blend/tiled_display.hpp), and every output shows
 // its share through its own homography, feathered in the overlaps (eq. 4.3,
 // blend/feather.hpp). The display is made on the compute worker (the feathering
 // takes about half a second for four 1280x800 outputs) and kept until the content's

@@ -6,9 +6,11 @@
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
+#include "blend/mpcdi.hpp"
 #include "blend/rig_tiles.hpp"
 #include "blend/tile_frames.hpp"
 #include "blend/tiled_blend.hpp"
+#include "content/image_header.hpp"
 #include "mpcdi_zip.hpp"
 #include "replace_file.hpp"
 #include "rig/rig_model.hpp"
@@ -140,6 +142,11 @@ Result<json> runRender(const RenderArgs& args) {
     const bool asked =
         std::find(args.projectors.begin(), args.projectors.end(), p.name) != args.projectors.end();
     if (!args.projectors.empty() && !asked) continue;
+    // Names become file names in --out and the package: nothing that leaves the folder.
+    if (!blend::isSafeRegionId(p.name))
+      return fail(
+          ErrorCode::kInvalidInput,
+          "projector name '" + p.name + "' cannot name a file (1-128 of A-Z a-z 0-9 . _ -)");
     auto tile = blend::displayTile(p, rig->surface);
     if (!tile) {
       if (asked) return tl::unexpected(tile.error());
@@ -159,6 +166,11 @@ Result<json> runRender(const RenderArgs& args) {
 
   auto bytes = readSmallFile(args.content, kMaxContentBytes);
   if (!bytes) return tl::unexpected(bytes.error());
+  // The header's size is checked before decoding: a small file may declare a huge image.
+  auto header = content::readImageHeader(*bytes);
+  if (!header) return fail(ErrorCode::kIo, args.content.string() + ": " + header.error().message);
+  if (double(header->size.area()) > kMaxContentPixels)
+    return fail(ErrorCode::kTooLarge, args.content.string() + " is over 33554432 pixels");
   cv::Mat content;
   try {
     content =

@@ -5,20 +5,23 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <opencv2/imgcodecs.hpp>
+#include <optional>
 
 #include "blend/tile_frames.hpp"
 #include "core/pfm.hpp"
 
 namespace procam::blend {
-namespace {
 
-bool safeId(const std::string& id) {
+bool isSafeRegionId(const std::string& id) {
   return !id.empty() && id.size() <= 128 && id.front() != '.' &&
          std::all_of(id.begin(), id.end(), [](char c) {
            return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-';
          });
 }
+
+namespace {
 
 // <name>text</name> under `parent`.
 void child(tinyxml2::XMLDocument& doc, tinyxml2::XMLElement* parent, const char* name,
@@ -41,6 +44,21 @@ const std::string* fileNamed(const std::vector<MpcdiFile>& files, const std::str
   return nullptr;
 }
 
+// The width and height a PNG's IHDR declares, read before anything is decoded.
+std::optional<cv::Size> pngSize(const std::string& bytes) {
+  if (bytes.size() < 24 || bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") != 0 ||
+      bytes.compare(12, 4, "IHDR") != 0)
+    return std::nullopt;
+  auto be32 = [&](std::size_t at) {
+    uint32_t v = 0;
+    for (std::size_t i = 0; i < 4; ++i) v = (v << 8) | static_cast<unsigned char>(bytes[at + i]);
+    return v;
+  };
+  const uint32_t w = be32(16), h = be32(20);
+  if (w == 0 || h == 0 || w > 65536 || h > 65536) return std::nullopt;
+  return cv::Size(int(w), int(h));
+}
+
 const char* textOf(const tinyxml2::XMLElement* parent, const char* name) {
   const tinyxml2::XMLElement* e = parent ? parent->FirstChildElement(name) : nullptr;
   return e && e->GetText() ? e->GetText() : nullptr;
@@ -58,7 +76,7 @@ Result<std::vector<MpcdiFile>> mpcdi2d(const TiledBlend& blend,
   if (content.width < 1 || content.height < 1)
     return fail(ErrorCode::kInvalidInput, "MPCDI: empty content size");
   for (const auto& id : names) {
-    if (!safeId(id)) return fail(ErrorCode::kInvalidInput, "MPCDI: region id '" + id + "'");
+    if (!isSafeRegionId(id)) return fail(ErrorCode::kInvalidInput, "MPCDI: region id '" + id + "'");
   }
   tinyxml2::XMLDocument doc;
   doc.InsertEndChild(doc.NewDeclaration("xml version=\"1.0\" encoding=\"utf-8\""));
@@ -66,7 +84,8 @@ Result<std::vector<MpcdiFile>> mpcdi2d(const TiledBlend& blend,
   root->SetAttribute("profile", "2d");
   root->SetAttribute("geometry", "1");
   root->SetAttribute("color", "1");
-  root->SetAttribute("version", "2.0");
+  // 1.0: the 2D media profile is defined since MPCDI 1.0, which every reader takes.
+  root->SetAttribute("version", "1.0");
   root->SetAttribute("date", date.c_str());
   doc.InsertEndChild(root);
   tinyxml2::XMLElement* display = doc.NewElement("display");
@@ -102,8 +121,11 @@ Result<std::vector<MpcdiFile>> mpcdi2d(const TiledBlend& blend,
         const double cx = p.x() / p.z(), cy = p.y() / p.z();
         const bool shown = p.z() > 0 && cx >= -0.5 && cy >= -0.5 && cx < content.width - 0.5 &&
                            cy < content.height - 0.5;
-        warp.at<cv::Vec3f>(y, x) = {float((cx + 0.5) / content.width),
-                                    float((cy + 0.5) / content.height), 0.0f};
+        // Outside the content: a fixed position off the buffer, never a mirrored one
+        // from behind the wall's horizon or a value too large for a float.
+        warp.at<cv::Vec3f>(y, x) = shown ? cv::Vec3f(float((cx + 0.5) / content.width),
+                                                     float((cy + 0.5) / content.height), 0.0f)
+                                         : cv::Vec3f(-1.0f, -1.0f, 0.0f);
         const double a =
             shown ? std::pow(blend.gain[t] * weights.at<float>(y, x), 1.0 / blend.gamma[t]) : 0.0;
         alpha.at<uint16_t>(y, x) = uint16_t(std::lround(std::clamp(a, 0.0, 1.0) * 65535));
@@ -127,8 +149,11 @@ Result<std::vector<MpcdiFile>> mpcdi2d(const TiledBlend& blend,
     tinyxml2::XMLElement* g = doc.NewElement("geometryWarpFile");
     fileset->InsertEndChild(g);
     child(doc, g, "path", warp_name);
+    // geometricUnit and originOf3DData are required of every warp by MPCDI readers;
+    // a 2D warp's values are normalized buffer positions, origin top left.
+    child(doc, g, "geometricUnit", "m");
     child(doc, g, "interpolation", "linear");
-    child(doc, g, "originOf2DData", "topLeft");
+    child(doc, g, "originOf3DData", "idealEyePoint");
     child(doc, g, "componentDepth", "2");
     child(doc, g, "bitDepth", "32");
     child(doc, g, "xSamples", std::to_string(size.width));
@@ -173,6 +198,9 @@ Result<MpcdiDisplay> readMpcdi2d(const std::vector<MpcdiFile>& files) {
     MpcdiRegion region;
     region.id = r->Attribute("id") ? r->Attribute("id") : "";
     region.size = {r->IntAttribute("xResolution"), r->IntAttribute("yResolution")};
+    if (region.size.width < 1 || region.size.height < 1 || region.size.width > 16384 ||
+        region.size.height > 16384)
+      return fail(ErrorCode::kParse, "MPCDI: region '" + region.id + "': resolution out of range");
     if (r->DoubleAttribute("x", -1) != 0 || r->DoubleAttribute("y", -1) != 0 ||
         r->DoubleAttribute("xsize") != 1 || r->DoubleAttribute("ysize") != 1)
       return fail(ErrorCode::kParse, "MPCDI: region '" + region.id + "' is not the whole buffer");
@@ -186,19 +214,22 @@ Result<MpcdiDisplay> readMpcdi2d(const std::vector<MpcdiFile>& files) {
     const char* warp_path = textOf(g, "path");
     const char* alpha_path = textOf(am, "path");
     const char* gamma = textOf(am, "gammaEmbedded");
-    const char* origin = textOf(g, "originOf2DData");
-    if (!warp_path || !alpha_path || !gamma || !origin || std::string(origin) != "topLeft")
+    if (!warp_path || !alpha_path || !gamma)
       return fail(ErrorCode::kParse, "MPCDI: region '" + region.id + "': incomplete fileset");
     region.gamma_embedded = std::atof(gamma);
     const std::string* warp = fileNamed(files, warp_path);
     const std::string* alpha = fileNamed(files, alpha_path);
     if (!warp || !alpha)
       return fail(ErrorCode::kParse, "MPCDI: region '" + region.id + "': a file is missing");
-    auto w = decodePfm(*warp);
+    auto w = decodePfm(*warp, double(region.size.area()));
     if (!w) return tl::unexpected(w.error());
     if (w->type() != CV_32FC3 || w->size() != region.size)
       return fail(ErrorCode::kParse, "MPCDI: region '" + region.id + "': warp size differs");
     region.warp = *w;
+    // The alpha map's size is checked before it is decoded: a small file may declare a
+    // huge image.
+    if (pngSize(*alpha) != std::optional<cv::Size>(region.size))
+      return fail(ErrorCode::kParse, "MPCDI: region '" + region.id + "': alpha map differs");
     const cv::Mat a =
         cv::imdecode(cv::Mat(1, int(alpha->size()), CV_8U, const_cast<char*>(alpha->data())),
                      cv::IMREAD_UNCHANGED);

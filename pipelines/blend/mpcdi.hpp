@@ -3,13 +3,12 @@
 // (the content, its pixel size) and one region per projector covering all of it, each
 // with its files — a geometry warp (PFM, one sample per framebuffer pixel centre: the
 // content position it shows, normalized to [0, 1] from the content's top-left outer
-// corner), an alpha map (16-bit PNG: a = (gain w)^(1/gamma), the eq. 4.3 weight w and
-// brightness gain in the projector's own gamma, which the map declares as
-// gammaEmbedded; 0 where the content does not reach) and a beta map (8-bit PNG, all 0:
-// no black-level offset). A player that multiplies the content's codes by a, or one
-// that linearizes with gammaEmbedded and re-applies the projector's gamma, draws the
-// frames procam-render draws. In memory: the caller writes the package (a zip with
-// mpcdi.xml first).
+// corner; (-1, -1) where the content does not reach), an alpha map (16-bit PNG: a = (gain
+// w)^(1/gamma), the eq. 4.3 weight w and brightness gain in the projector's own gamma, which the
+// map declares as gammaEmbedded; 0 where the content does not reach) and a beta map (8-bit PNG, all
+// 0: no black-level offset). A player that multiplies the content's codes by a, or one that
+// linearizes with gammaEmbedded and re-applies the projector's gamma, draws the frames
+// procam-render draws. In memory: the caller writes the package (a zip with mpcdi.xml first).
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -18,6 +17,9 @@
 #include "core/error.hpp"
 
 namespace procam::blend {
+
+// A region id that is also a safe file stem: 1-128 of [A-Za-z0-9._-], not starting with '.'.
+bool isSafeRegionId(const std::string& id);
 
 struct MpcdiFile {
   std::string name;  // path inside the package

@@ -1,6 +1,7 @@
 #include "core/pfm.hpp"
 
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <sstream>
@@ -44,7 +45,9 @@ Result<cv::Mat> decodePfm(std::string_view bytes, double max_pixels) {
       scale == 0)
     return fail(ErrorCode::kParse, "PFM: malformed header");
   if (double(w) * double(h) > max_pixels) return fail(ErrorCode::kTooLarge, "PFM: too many pixels");
-  const std::size_t header = std::size_t(in.tellg()) + 1;
+  const std::streamoff end_of_scale = in.tellg();
+  if (end_of_scale < 0) return fail(ErrorCode::kParse, "PFM: no data after the header");
+  const std::size_t header = std::size_t(end_of_scale) + 1;
   const int n = magic == "PF" ? 3 : 1;
   const std::size_t need = std::size_t(w) * std::size_t(h) * n * 4;
   if (bytes.size() < header + need) return fail(ErrorCode::kParse, "PFM: body shorter than header");
@@ -58,6 +61,7 @@ Result<cv::Mat> decodePfm(std::string_view bytes, double max_pixels) {
       std::memcpy(&bits, p, 4);
       if (little != (std::endian::native == std::endian::little)) bits = __builtin_bswap32(bits);
       dst[i] = std::bit_cast<float>(bits);
+      if (!std::isfinite(dst[i])) return fail(ErrorCode::kParse, "PFM: a sample is not finite");
     }
   }
   return out;

@@ -13,8 +13,9 @@ namespace procam {
 // `image`: CV_32FC1 or CV_32FC3, rows top to bottom; written little-endian.
 Result<std::string> encodePfm(const cv::Mat& image);
 
-// CV_32FC1 or CV_32FC3, rows top to bottom. kParse for a malformed header or a body
-// shorter than the header says; kTooLarge above `max_pixels`.
+// CV_32FC1 or CV_32FC3, rows top to bottom. kParse for a malformed header, a body
+// shorter than the header says or a sample that is not finite; kTooLarge above
+// `max_pixels`.
 Result<cv::Mat> decodePfm(std::string_view bytes, double max_pixels = 1 << 26);
 
 }  // namespace procam

@@ -55,11 +55,9 @@ Result<bool> CpuRenderer::render(const Content& content) {
   if (is3d) {
     auto ok = rasterizeColoredMesh(*content.mesh, setup_.planar3d, setup_.output_size, main_out,
                                    depth_, content.stop);
-    if (!ok) {
-      // A stopped drawing left a partial frame: the next render draws in full.
-      if (ok.error().code == ErrorCode::kCancelled) redraw();
-      return tl::unexpected(ok.error());
-    }
+    // A stopped drawing leaves a partial frame and the gate unchanged (it records only a
+    // finished frame): the next render draws in full.
+    if (!ok) return tl::unexpected(ok.error());
     return finish(content.version);
   }
   if (static_cast<int>(content.image->step) != packed_.source_step) {

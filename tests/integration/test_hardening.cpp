@@ -271,7 +271,7 @@ TEST(Hardening, AnObsoleteFrameStopsMidway) {
   std::printf("obsolete frame: pattern answered, %d frame(s) stopped\n",
               (*status)["outputs"]["frames_stopped"].get<int>());
   EXPECT_GE((*status)["outputs"]["frames_stopped"].get<int>(), 1) << status->dump();
-  // Back to the mesh: drawn in full, as a frame never stopped would be.
+  // Back to the mesh: drawn in full, the same frame as one never stopped.
   auto off = c.call({{"cmd", "pattern"}, {"name", "off"}}, std::chrono::seconds(60));
   ASSERT_TRUE(off && (*off)["shown"] == true) << (off ? off->dump() : "none");
   status = c.call({{"cmd", "status"}});
@@ -280,6 +280,25 @@ TEST(Hardening, AnObsoleteFrameStopsMidway) {
   EXPECT_EQ(shown.value("source", ""), "content") << shown.dump();
   EXPECT_EQ(shown.value("path", ""), "planar-3d") << shown.dump();
   EXPECT_GT(shown.value("lit_fraction", 0.0), 0.01) << shown.dump();
+  // The reference: the mesh loaded again and left alone.
+  ASSERT_TRUE(c.call({{"cmd", "content"}, {"action", "clear"}}));
+  ASSERT_TRUE(eventually([&] {  // the cleared frame's statistics first
+    auto s = c.call({{"cmd", "status"}});
+    return s && (*s)["outputs"]["shown"][0].value("source", "") == "none";
+  }));
+  loaded = c.call(loadRequest(contentFile(dir, "sheet.ply")), std::chrono::seconds(120));
+  ASSERT_TRUE(loaded && (*loaded)["class"] == "CONTENT");
+  json reference;
+  ASSERT_TRUE(eventually(
+      [&] {
+        auto s = c.call({{"cmd", "status"}});
+        if (!s) return false;
+        reference = (*s)["outputs"]["shown"][0];
+        return reference.value("source", "") == "content";
+      },
+      std::chrono::seconds(60)));
+  EXPECT_EQ(reference.value("lit_fraction", -1.0), shown.value("lit_fraction", -2.0));
+  EXPECT_EQ(reference["mean_rgb"], shown["mean_rgb"]);
 }
 
 // 4. Sizes a client controls are refused with `too-large` before the memory is

@@ -20,6 +20,7 @@
 #include <optional>
 
 #include "blend/mpcdi.hpp"
+#include "core/pfm.hpp"
 #include "daemon_harness.hpp"
 #include "mpcdi_zip.hpp"
 #include "render_command.hpp"
@@ -267,6 +268,12 @@ TEST(RenderCli, MpcdiPackageRebuildsTheSameFramebuffers) {
   auto without_warp = *files;
   without_warp.erase(without_warp.begin() + 1);
   EXPECT_EQ(blend::readMpcdi2d(without_warp).error().code, ErrorCode::kParse);
+  // A PFM that ends at its header, or holds a NaN, is refused.
+  EXPECT_FALSE(decodePfm("Pf\n1 1\n-1"));
+  std::string nan_pfm = "Pf\n1 1\n-1\n";
+  const float nan = std::nanf("");
+  nan_pfm.append(reinterpret_cast<const char*>(&nan), 4);
+  EXPECT_FALSE(decodePfm(nan_pfm));
 }
 
 TEST(RenderCli, BadInputIsRefusedWithAReason) {
@@ -280,12 +287,33 @@ TEST(RenderCli, BadInputIsRefusedWithAReason) {
     auto parsed = render_cli::parseRenderArgs(a);
     if (!parsed) return parsed.error();
     auto done = render_cli::runRender(*parsed);
-    return done ? Error{ErrorCode::kInvalidInput, "no error"} : done.error();
+    // A run that succeeds is no error of any kind.
+    return done ? Error{ErrorCode::kInternal, "ran without an error"} : done.error();
   };
   EXPECT_EQ(run({"--bit-depth", "12"}).code, ErrorCode::kInvalidInput);
   EXPECT_EQ(run({"--rect", "1,2,3"}).code, ErrorCode::kInvalidInput);
   EXPECT_EQ(run({"--rect", "0,3,1.5,-1,1"}).code, ErrorCode::kInvalidInput);
   EXPECT_EQ(run({"--projector", "nobody"}).code, ErrorCode::kNotFound);
+  EXPECT_EQ(run({}).message, "ran without an error");
+  std::filesystem::remove_all(out);
+  // A projector name is a file name: one that would leave --out is refused before
+  // anything is written.
+  {
+    std::ifstream in(rig.file);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string from = "\"name\": \"proj_tl\"";
+    ASSERT_NE(text.find(from), std::string::npos);
+    text.replace(text.find(from), from.size(), "\"name\": \"../escaped\"");
+    dir.write("hostile.json", text);
+    auto parsed = render_cli::parseRenderArgs({"--rig", dir.file("hostile.json"), "--content",
+                                               dir.file("c.png"), "--out", dir.file("h/out")});
+    ASSERT_TRUE(parsed);
+    auto done = render_cli::runRender(*parsed);
+    ASSERT_FALSE(done);
+    EXPECT_EQ(done.error().code, ErrorCode::kInvalidInput) << done.error().message;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("h"))) << "nothing written";
+    EXPECT_FALSE(std::filesystem::exists(dir.file("escaped.png")));
+  }
   const Error off_wall = run({"--rect", "0,2.5,1.5,1,0.6"});  // 0.5 m in front of the wall
   EXPECT_EQ(off_wall.code, ErrorCode::kInvalidInput);
   EXPECT_NE(off_wall.message.find("off the wall plane"), std::string::npos) << off_wall.message;

@@ -1,6 +1,6 @@
 // The projector outputs behind the driver plugin ABI (plugins/include/procamd/
 // procam_plugin.h): "headless" (EGL surfaceless, frames kept on the GPU) and, when built,
-// "kms" (DRM/KMS scan-out). Both render by themselves (output operations version 2): the
+// "kms" (DRM/KMS scan-out). Both render by themselves (output operations version 3): the
 // daemon's render setup is drawn by the GLES renderer, content is uploaded only when its
 // version changes. A frame handed over with `show` is shown 1:1 (identity homography).
 #include <procamd/procam_plugin.h>

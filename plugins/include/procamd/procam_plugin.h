@@ -255,8 +255,9 @@ typedef struct procam_output_ops {
   int (*render)(void* self, const procam_content* content, int* out_drawn,
                 procam_frame_stats* stats, char* err, size_t err_len);
   /* Version 3. As `render`, but the plugin calls `stop(stop_ctx)` between the steps
-   * of its drawing (on the rendering thread; for a mesh, every few thousand
-   * triangles) and, once it returns nonzero, stops: PROCAM_ECANCELED, nothing
+   * of its drawing (from any of the threads it draws with, possibly at once: `stop`
+   * must be thread-safe; for a mesh, every few thousand triangles) and, once it
+   * returns nonzero, stops: PROCAM_ECANCELED, nothing
    * presented, the frame shown before stays, and the next render draws in full.
    * `stop` may be NULL (never stop). The daemon stops a frame that a newer request
    * (other content, a pattern a client waits for) has made obsolete. */
