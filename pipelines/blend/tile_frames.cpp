@@ -82,7 +82,7 @@ Result<cv::Mat> tileFrame(const cv::Mat& content, const TiledBlend& blend, std::
   if (options.bit_depth != 8 && options.bit_depth != 16)
     return fail(ErrorCode::kInvalidInput, "bit depth must be 8 or 16");
   if (t >= blend.display.content_to_framebuffer.size() || t >= blend.alpha.size() ||
-      t >= blend.weight_lut.size())
+      t >= blend.weight_lut.size() || t >= blend.gamma.size() || t >= blend.gain.size())
     return fail(ErrorCode::kInvalidInput, "tile index out of range");
   if (options.bit_depth == 8 && content.depth() == CV_8U) {
     return rendererFrame(content, blend, t, options.geometry_only);
@@ -100,8 +100,7 @@ Result<cv::Mat> tileFrame(const cv::Mat& content, const TiledBlend& blend, std::
   const double top = options.bit_depth == 8 ? 255 : 65535;
   cv::Mat out(size, CV_MAKETYPE(options.bit_depth == 8 ? CV_8U : CV_16U, channels),
               cv::Scalar::all(0));
-  const double gamma = t < blend.gamma.size() ? blend.gamma[t] : kAssumedGamma;
-  const double gain = t < blend.gain.size() ? blend.gain[t] : 1.0;
+  const double gamma = blend.gamma[t], gain = blend.gain[t];
   cv::parallel_for_(cv::Range(0, size.height), [&](const cv::Range& rows) {
     double v[3];
     for (int y = rows.start; y < rows.end; ++y) {
