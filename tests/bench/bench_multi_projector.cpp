@@ -34,6 +34,7 @@
 
 #include "../unit/render/render_test_rig.hpp"  // test camera rigs and surfaces
 #include "bench_timing.hpp"
+#include "bench_warps.hpp"
 #include "blend/rig_tiles.hpp"
 #include "blend/tiled_blend.hpp"
 #include "geometry/homography.hpp"
@@ -204,16 +205,7 @@ std::vector<FrameCase> frameCases(cv::Size size) {
   std::vector<FrameCase> cases = {{"homography", base}};
   render::RenderSetup lookup = base;
   lookup.path = render::RenderPath::kLookupWarp;
-  lookup.lookup.step = Vec2(16, 16);
-  lookup.lookup.cols = size.width / 16 + 2;
-  lookup.lookup.rows = size.height / 16 + 2;
-  for (int j = 0; j < lookup.lookup.rows; ++j) {
-    for (int i = 0; i < lookup.lookup.cols; ++i) {
-      const Vec2 n = lookup.lookup.node(i, j);
-      lookup.lookup.source.push_back(
-          n + Vec2(14 * std::sin(n.y() / 230.0), 11 * std::cos(n.x() / 270.0)));
-    }
-  }
+  lookup.lookup = bench::lookupGrid(size);
   cases.push_back({"lookup", lookup});
   render::RenderSetup mesh = base;
   mesh.path = render::RenderPath::kTwoPassMesh;

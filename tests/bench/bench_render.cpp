@@ -35,6 +35,7 @@
 #include <vector>
 
 #include "bench_timing.hpp"
+#include "bench_warps.hpp"
 #include "render/bilinear.hpp"
 #include "render/cpu_renderer.hpp"
 #include "render/packed_map.hpp"
@@ -122,22 +123,6 @@ cv::Mat toCv(const Mat3& m) {
   return out;
 }
 
-// A smooth lookup warp over the whole frame: nodes every 16 px, displaced by up to ~20 px.
-render::WarpGrid lookupGrid(cv::Size size) {
-  render::WarpGrid g;
-  g.step = Vec2(16, 16);
-  g.cols = size.width / 16 + 2;
-  g.rows = size.height / 16 + 2;
-  for (int j = 0; j < g.rows; ++j) {
-    for (int i = 0; i < g.cols; ++i) {
-      const Vec2 n = g.node(i, j);
-      g.source.push_back(n + Vec2(14 * std::sin(n.y() / 230.0) + 6 * std::cos(n.x() / 310.0),
-                                  11 * std::cos(n.x() / 270.0) - 5 * std::sin(n.y() / 190.0)));
-    }
-  }
-  return g;
-}
-
 void printCpu(const Row& r, double copy_warm, double copy_cold, double ref_warm, double ref_cold) {
   std::printf(
       "  %-9s %-24s warm %7.3f ms (%5.2fx copy %5.2fx cv)  cold %7.3f ms (%5.2fx copy %5.2fx cv)",
@@ -196,10 +181,10 @@ void benchGles(const std::filesystem::path& out, cv::Size size, const cv::Mat& s
   cases.push_back({"homography", base});
   render::RenderSetup lookup = base;
   lookup.path = render::RenderPath::kLookupWarp;
-  lookup.lookup = lookupGrid(size);
+  lookup.lookup = bench::lookupGrid(size);
   cases.push_back({"lookup", lookup});
   render::RenderSetup post = base;
-  post.post_warp = lookupGrid(size);
+  post.post_warp = bench::lookupGrid(size);
   cases.push_back({"homography+post_warp", post});
   render::RenderSetup mesh = base;
   mesh.path = render::RenderPath::kTwoPassMesh;
@@ -276,7 +261,7 @@ int main(int argc, char** argv) {
   const Mat3 Hinv = H.inverse();
 
   auto hmap = render::homographyMap(H, size);
-  auto lmap = render::gridMap(lookupGrid(size), size);
+  auto lmap = render::gridMap(bench::lookupGrid(size), size);
   if (!hmap || !lmap) {
     std::fprintf(stderr, "bench_render: cannot build the maps\n");
     return 1;
