@@ -10,24 +10,14 @@
 #include <span>
 #include <vector>
 
-#include "blend/response.hpp"
+#include "blend/blend_tables.hpp"
 #include "blend/tiled_display.hpp"
 #include "core/error.hpp"
-#include "render/final_stage.hpp"
 
 namespace procam::blend {
 
-// The response assumed for blending until the projectors' responses are measured:
-// light ~ code^2.2, the sRGB-like curve most projectors ship with.
-inline constexpr double kAssumedGamma = 2.2;
-
-struct TiledBlend {
+struct TiledBlend : BlendTables {
   TiledDisplay display;
-  std::vector<cv::Mat> weights;         // per tile, CV_32FC1 eq. 4.3 weights in [0, 1]
-  std::vector<cv::Mat> alpha;           // per tile, CV_8UC1: round(255 weight)
-  std::vector<render::Lut> weight_lut;  // per tile: weight code -> code
-  std::vector<double> gamma, gain;      // per tile, what the tables were made with
-  bool measured = false;                // every tile's response was measured
 };
 
 // `responses` has one entry per tile (or none): when every tile's response is known the

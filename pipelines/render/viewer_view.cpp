@@ -6,47 +6,22 @@
 #include <string>
 #include <vector>
 
-#include "keystone/inscribed_rect.hpp"
-
 namespace procam::render {
-namespace {
+namespace {}  // namespace
 
-struct ProjectorRays {
-  Mat3 Minv;
-  Vec3 centre;
-  geom::Ray through(double x, double y) const {
-    return {centre, (Minv * Vec3(x, y, 1)).normalized()};
-  }
-};
-
-Result<ProjectorRays> raysOf(const Mat34& P) {
+Result<PixelRays> pixelRays(const Mat34& P) {
   const Mat3 M = P.leftCols<3>();
   if (!P.allFinite() || std::abs(M.determinant()) < 1e-300) {
     return fail(ErrorCode::kInvalidInput, "viewer view: singular projector matrix");
   }
   const Mat3 Minv = M.inverse();
-  return ProjectorRays{Minv, -Minv * P.col(3)};
+  return PixelRays{Minv, -Minv * P.col(3)};
 }
 
-}  // namespace
-
-Result<Mat34> viewerContentMatrix(const geom::MeshIntersector& surface, const Mat34& projector,
-                                  cv::Size size, const Vec3& eye, cv::Size content) {
-  if (size.width < 2 || size.height < 2 || content.width < 2 || content.height < 2 ||
-      !eye.allFinite()) {
-    return fail(ErrorCode::kInvalidInput, "viewer view: bad sizes or eye");
-  }
-  auto rays = raysOf(projector);
-  if (!rays) return tl::unexpected(rays.error());
-  const auto centre_hit =
-      surface.intersect(rays->through(0.5 * (size.width - 1), 0.5 * (size.height - 1)));
-  if (!centre_hit) {
-    return fail(ErrorCode::kDegenerate, "viewer view: the projector's centre misses the surface");
-  }
-  // Eye frame: x right, y down, z towards the footprint's centre; world +Z up.
-  const Vec3 f = (centre_hit->point - eye).normalized();
+Result<Mat3> uprightEyeRotation(const Vec3& forward) {
+  const Vec3 f = forward.normalized();
   Vec3 r = f.cross(Vec3::UnitZ());
-  if (r.norm() < 1e-6) {
+  if (!f.allFinite() || r.norm() < 1e-6) {
     return fail(ErrorCode::kDegenerate, "viewer view: the eye looks straight up or down");
   }
   r.normalize();
@@ -55,6 +30,40 @@ Result<Mat34> viewerContentMatrix(const geom::MeshIntersector& surface, const Ma
   R.row(0) = r.transpose();
   R.row(1) = d.transpose();
   R.row(2) = f.transpose();
+  return R;
+}
+
+Mat34 contentViewMatrix(const Mat3& R, const Vec3& eye, const keystone::AxisRect& rect,
+                        cv::Size content) {
+  // u + 0.5 = (x - left) * W / width, and v + 0.5 = (top - y_up) * H / height; the
+  // plane's y down is the content's v down (y_up = -y).
+  const double s = content.width / (2 * rect.half_width);
+  const double left = rect.centre.x() - rect.half_width, top = rect.centre.y() + rect.half_height;
+  Mat3 K;
+  K << s, 0, -left * s - 0.5, 0, s, top * s - 0.5, 0, 0, 1;
+  Mat34 Rt;
+  Rt.leftCols<3>() = R;
+  Rt.col(3) = -R * eye;
+  return K * Rt;
+}
+
+Result<Mat34> viewerContentMatrix(const geom::MeshIntersector& surface, const Mat34& projector,
+                                  cv::Size size, const Vec3& eye, cv::Size content) {
+  if (size.width < 2 || size.height < 2 || content.width < 2 || content.height < 2 ||
+      !eye.allFinite()) {
+    return fail(ErrorCode::kInvalidInput, "viewer view: bad sizes or eye");
+  }
+  auto rays = pixelRays(projector);
+  if (!rays) return tl::unexpected(rays.error());
+  const auto centre_hit =
+      surface.intersect(rays->through(0.5 * (size.width - 1), 0.5 * (size.height - 1)));
+  if (!centre_hit) {
+    return fail(ErrorCode::kDegenerate, "viewer view: the projector's centre misses the surface");
+  }
+  // Eye frame: x right, y down, z towards the footprint's centre; world +Z up.
+  auto turned = uprightEyeRotation(centre_hit->point - eye);
+  if (!turned) return tl::unexpected(turned.error());
+  const Mat3& R = *turned;
   // The footprint's border as the eye sees it, on the plane z = 1 (y up for the
   // rectangle solver).
   constexpr int kPerSide = 48;
@@ -126,17 +135,7 @@ Result<Mat34> viewerContentMatrix(const geom::MeshIntersector& surface, const Ma
     fit.half_width *= 0.98;
     fit.half_height *= 0.98;
   }
-  // Content pixel edges on the rectangle's edges: u + 0.5 = (x - left) * W / width, and
-  // v + 0.5 = (top - y_up) * H / height.
-  const double s = content.width / (2 * fit.half_width);
-  const double left = fit.centre.x() - fit.half_width, top = fit.centre.y() + fit.half_height;
-  Mat3 K;
-  K << s, 0, -left * s - 0.5, 0, s, top * s - 0.5, 0, 0, 1;
-  // y_up = -y: the plane's y down is the content's v down.
-  Mat34 Rt;
-  Rt.leftCols<3>() = R;
-  Rt.col(3) = -R * eye;
-  const Mat34 V = K * Rt;
+  const Mat34 V = contentViewMatrix(R, eye, fit, content);
   if (!V.allFinite()) return fail(ErrorCode::kDegenerate, "viewer view: degenerate rectangle");
   return V;
 }
@@ -146,7 +145,7 @@ Result<WarpGrid> lookupGridForViewer(const geom::MeshIntersector& surface, const
   if (size.width < 2 || size.height < 2 || step < 1 || !viewer.allFinite()) {
     return fail(ErrorCode::kInvalidInput, "lookup grid: bad size, step or viewer");
   }
-  auto rays = raysOf(projector);
+  auto rays = pixelRays(projector);
   if (!rays) return tl::unexpected(rays.error());
   WarpGrid g;
   g.cols = (size.width - 1 + step - 1) / step + 1;

@@ -12,9 +12,32 @@
 #include "core/error.hpp"
 #include "core/types.hpp"
 #include "geometry/intersect.hpp"
+#include "keystone/inscribed_rect.hpp"
 #include "render/warp_map.hpp"
 
 namespace procam::render {
+
+// The rays of a projector's pixels: centre of projection and world directions.
+struct PixelRays {
+  Mat3 Minv;  // inverse of the matrix's left 3x3
+  Vec3 centre;
+  geom::Ray through(double x, double y) const {
+    return {centre, (Minv * Vec3(x, y, 1)).normalized()};
+  }
+};
+
+// kInvalidInput for a non-finite or singular projector matrix.
+Result<PixelRays> pixelRays(const Mat34& projector);
+
+// The eye's frame looking along `forward`: rows x right, y down, z forward, world +Z
+// up. kDegenerate when `forward` is (nearly) vertical.
+Result<Mat3> uprightEyeRotation(const Vec3& forward);
+
+// World -> content pixels for an eye at `eye` turned by `R` (uprightEyeRotation) whose
+// content fills `rect` on the plane z = 1 (x right, y up): content pixel edges on the
+// rectangle's edges.
+Mat34 contentViewMatrix(const Mat3& R, const Vec3& eye, const keystone::AxisRect& rect,
+                        cv::Size content);
 
 // projector: world -> projector pixels (third row positive in front). Returns the
 // world -> content pixel matrix (RenderSetup::viewer). kDegenerate when the centre ray

@@ -241,6 +241,15 @@ TEST(SimSceneFile, ShippedScenesMatchTheIssue) {
   ASSERT_TRUE(dome);
   EXPECT_EQ(dome->projectors().size(), 3u);
 
+  // The curved panoramic wall: three projectors, two cameras, a cylinder.
+  auto cylinder = resolveScene("cylinder3");
+  ASSERT_TRUE(cylinder) << cylinder.error().message;
+  EXPECT_EQ(cylinder->projectors().size(), 3u);
+  EXPECT_EQ(cylinder->cameras().size(), 2u);
+  bool has_cylinder = false;
+  for (const auto& s : cylinder->world().surfaces()) has_cylinder |= s.type == "cylinder";
+  EXPECT_TRUE(has_cylinder);
+
   auto box = resolveScene("object_box");
   ASSERT_TRUE(box);
   bool has_box = false;

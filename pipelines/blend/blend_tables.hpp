@@ -1,0 +1,35 @@
+#pragma once
+// What an output needs to blend ([Raskar02] §4.1.2): per projector its eq. 4.3 weights
+// as an 8-bit alpha mask and the table that turns a weight into a code value through the
+// projector's response and its brightness gain (response.hpp). Shared by the planar
+// tiled display and the curved one.
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "blend/response.hpp"
+#include "core/error.hpp"
+#include "render/final_stage.hpp"
+
+namespace procam::blend {
+
+// The response assumed for blending until the projectors' responses are measured:
+// light ~ code^2.2, the sRGB-like curve most projectors ship with.
+inline constexpr double kAssumedGamma = 2.2;
+
+struct BlendTables {
+  std::vector<cv::Mat> weights;         // per projector, CV_32FC1 eq. 4.3 weights in [0, 1]
+  std::vector<cv::Mat> alpha;           // per projector, CV_8UC1: round(255 weight)
+  std::vector<render::Lut> weight_lut;  // per projector: weight code -> code
+  std::vector<double> gamma, gain;      // per projector, what the tables were made with
+  bool measured = false;                // every projector's response was measured
+};
+
+// `responses` has one entry per weight image (or none): when every projector's response
+// is known the projectors are matched to the dimmest one's white in linear light;
+// otherwise every one gets the assumed gamma and no gain. kInvalidInput for a responses
+// count other than 0 or one per weight image, or weights that are not CV_32FC1.
+Result<BlendTables> blendTables(std::vector<cv::Mat> weights,
+                                std::span<const std::optional<ProjectorResponse>> responses);
+
+}  // namespace procam::blend

@@ -1,0 +1,117 @@
+#include "blend/curved_display.hpp"
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "blend/coverage_raster.hpp"
+#include "render/viewer_view.hpp"
+
+namespace procam::blend {
+
+Result<CurvedDisplay> solveCurvedDisplay(std::span<const SurfaceProjector> projectors,
+                                         const Vec3& eye, cv::Size content,
+                                         const CurvedDisplayOptions& options) {
+  if (projectors.empty()) return fail(ErrorCode::kInvalidInput, "a display needs a projector");
+  if (content.width < 1 || content.height < 1 || content.width > 65536 || content.height > 65536)
+    return fail(ErrorCode::kInvalidInput, "content size out of range");
+  if (!eye.allFinite()) return fail(ErrorCode::kInvalidInput, "the eye is not finite");
+  if (options.lookup_step < 1 || options.lookup_step > 64)
+    return fail(ErrorCode::kInvalidInput, "lookup step outside [1, 64]");
+  auto found = surfaceProjectorRays(projectors);
+  if (!found) return tl::unexpected(found.error());
+  const std::vector<render::PixelRays>& rays = *found;
+  // Surface points of every image: a lattice and every frame edge, where the surface is.
+  std::vector<std::vector<Vec3>> points(projectors.size());
+  Vec3 sum = Vec3::Zero();
+  std::size_t count = 0;
+  for (std::size_t m = 0; m < projectors.size(); ++m) {
+    const cv::Size s = projectors[m].size;
+    constexpr int kN = 48;
+    for (int j = 0; j <= kN; ++j) {
+      for (int i = 0; i <= kN; ++i) {
+        const double x = -0.5 + s.width * double(i) / kN, y = -0.5 + s.height * double(j) / kN;
+        if (auto hit = projectors[m].surface->intersect(rays[m].through(x, y))) {
+          points[m].push_back(hit->point);
+          sum += hit->point;
+          ++count;
+        }
+      }
+    }
+  }
+  if (count == 0) return fail(ErrorCode::kDegenerate, "no projector's image is on the surface");
+  auto turned = render::uprightEyeRotation(sum / double(count) - eye);
+  if (!turned) return tl::unexpected(turned.error());
+  const Mat3 R = *turned;
+  Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (std::size_t m = 0; m < projectors.size(); ++m) {
+    for (const Vec3& X : points[m]) {
+      const Vec3 q = R * (X - eye);
+      if (!(q.z() > 1e-9))
+        return fail(ErrorCode::kDegenerate,
+                    "part of projector " + std::to_string(m) + "'s image is behind the eye");
+      const Vec2 p(q.x() / q.z(), -q.y() / q.z());
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+  }
+  // A lattice cell's worth of margin: the images' edges may lie past the outer samples.
+  const Vec2 pad = 0.05 * (hi - lo);
+  lo -= pad;
+  hi += pad;
+  // Shown: the eye's ray through p meets a surface at a point some projector lights.
+  const auto shown = [&](const Vec2& p) {
+    const geom::Ray ray{eye, (R.transpose() * Vec3(p.x(), -p.y(), 1)).normalized()};
+    for (std::size_t m = 0; m < projectors.size(); ++m) {
+      const auto hit = projectors[m].surface->intersect(ray);
+      if (!hit) continue;
+      const Vec3 x = projectors[m].projector * hit->point.homogeneous();
+      if (!(x.z() > 0)) continue;
+      const Vec2 u = x.hnormalized();
+      const cv::Size s = projectors[m].size;
+      if (u.x() >= -0.5 && u.y() >= -0.5 && u.x() <= s.width - 0.5 && u.y() <= s.height - 0.5)
+        return true;
+    }
+    return false;
+  };
+  const double aspect = double(content.width) / content.height;
+  auto largest = largestRectInRegion(lo, hi, aspect, options.raster_cells, shown);
+  if (!largest) {
+    return fail(largest.error().code,
+                "no display rectangle fits the projectors' images: " + largest.error().message);
+  }
+  CurvedDisplay out;
+  out.eye = eye;
+  out.rect = largest->rect;
+  out.cell = largest->cell;
+  out.union_area = largest->region_area;
+  out.viewer = render::contentViewMatrix(R, eye, out.rect, content);
+  if (!out.viewer.allFinite()) return fail(ErrorCode::kDegenerate, "degenerate display rectangle");
+  for (std::size_t m = 0; m < projectors.size(); ++m) {
+    auto grid = render::lookupGridForViewer(*projectors[m].surface, projectors[m].projector,
+                                            projectors[m].size, out.viewer, options.lookup_step);
+    if (!grid) return tl::unexpected(grid.error());
+    out.lookup.push_back(std::move(*grid));
+  }
+  return out;
+}
+
+Result<CurvedBlend> makeCurvedBlend(std::span<const SurfaceProjector> projectors,
+                                    std::span<const std::optional<ProjectorResponse>> responses,
+                                    const Vec3& eye, cv::Size content,
+                                    const CurvedDisplayOptions& options) {
+  if (!responses.empty() && responses.size() != projectors.size())
+    return fail(ErrorCode::kInvalidInput, "one response per projector, or none");
+  auto display = solveCurvedDisplay(projectors, eye, content, options);
+  if (!display) return tl::unexpected(display.error());
+  auto weights = curvedFeatherWeights(projectors, options.feather);
+  if (!weights) return tl::unexpected(weights.error());
+  auto tables = blendTables(std::move(*weights), responses);
+  if (!tables) return tl::unexpected(tables.error());
+  CurvedBlend out;
+  static_cast<BlendTables&>(out) = std::move(*tables);
+  out.display = std::move(*display);
+  return out;
+}
+
+}  // namespace procam::blend
