@@ -104,7 +104,7 @@ Result<CurvedBlend> makeCurvedBlend(std::span<const SurfaceProjector> projectors
     return fail(ErrorCode::kInvalidInput, "one response per projector, or none");
   auto display = solveCurvedDisplay(projectors, eye, content, options);
   if (!display) return tl::unexpected(display.error());
-  auto weights = curvedFeatherWeights(projectors, options.feather);
+  auto weights = curvedFeatherWeights(projectors, options.feather, display->lookup);
   if (!weights) return tl::unexpected(weights.error());
   auto tables = blendTables(std::move(*weights), responses);
   if (!tables) return tl::unexpected(tables.error());

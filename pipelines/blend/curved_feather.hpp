@@ -2,7 +2,9 @@
 // Intensity feathering of projectors overlapping on a surface of any shape ([Raskar02]
 // §4.1.2, eq. 4.3): the weight of projector m at a surface point is its distance d_m to
 // the nearest edge of its own image that another image continues past, over the sum of
-// those distances of every projector lighting the point, A_m = d_m / sum_i d_i. On a
+// those distances of every projector lighting the point, A_m = d_m / sum_i d_i. A
+// projector's image is the part of its frame whose rays meet its surface: a measured
+// surface ends short of the frame's edge, and there the image ends. On a
 // curved surface there is no common plane, so each distance is taken in its own
 // projector's pixels (eq. 4.3 only needs the weights of a point to sum to one and to
 // fall to zero at the edge they are measured from); a projector lights a point when the
@@ -36,9 +38,13 @@ Result<std::vector<render::PixelRays>> surfaceProjectorRays(
     std::span<const SurfaceProjector> projectors);
 
 // Per projector, the weight of every framebuffer pixel (its centre's surface point) as a
-// CV_32FC1 image in [0, 1]; 0 where the pixel's ray misses the surface. kInvalidInput for
-// no projectors, a missing surface, bad sizes, step outside [1, 64] or a singular matrix.
+// CV_32FC1 image in [0, 1]; 0 where the pixel's ray misses the surface. `drawn`: each
+// projector's lookup warp (or none): its image is then also only where the warp draws
+// (render::gridSource), so that the weights fall to zero where the frame's content ends.
+// kInvalidInput for no projectors, a missing surface, bad sizes, step outside [1, 64], a
+// singular matrix or a `drawn` count other than 0 or one per projector.
 Result<std::vector<cv::Mat>> curvedFeatherWeights(std::span<const SurfaceProjector> projectors,
-                                                  const CurvedFeatherOptions& options = {});
+                                                  const CurvedFeatherOptions& options = {},
+                                                  std::span<const render::WarpGrid> drawn = {});
 
 }  // namespace procam::blend

@@ -78,27 +78,30 @@ Result<WarpMap> gridMap(const WarpGrid& grid, cv::Size output_size) {
   WarpMap map{cv::Mat(output_size, CV_32FC2)};
   for (int y = 0; y < output_size.height; ++y) {
     auto* row = map.xy.ptr<cv::Vec2f>(y);
-    const double gv = (y - grid.origin.y()) / grid.step.y();
     for (int x = 0; x < output_size.width; ++x) {
-      const double gu = (x - grid.origin.x()) / grid.step.x();
-      if (gu < 0 || gv < 0 || gu > grid.cols - 1 || gv > grid.rows - 1) {
-        row[x] = outside();
-        continue;
-      }
-      const int i = std::min(static_cast<int>(gu), grid.cols - 2);
-      const int j = std::min(static_cast<int>(gv), grid.rows - 2);
-      const double u = gu - i, v = gv - j;
-      const Vec2& s00 = grid.at(i, j);
-      const Vec2& s10 = grid.at(i + 1, j);
-      const Vec2& s01 = grid.at(i, j + 1);
-      const Vec2& s11 = grid.at(i + 1, j + 1);
-      // Two triangles per cell split along (i,j)-(i+1,j+1): affine inside each.
-      const Vec2 s = u >= v ? Vec2(s00 + u * (s10 - s00) + v * (s11 - s10))
-                            : Vec2(s00 + v * (s01 - s00) + u * (s11 - s01));
-      row[x] = cv::Vec2f(float(s.x()), float(s.y()));
+      const auto s = gridSource(grid, Vec2(x, y));
+      row[x] = s ? cv::Vec2f(float(s->x()), float(s->y())) : outside();
     }
   }
   return map;
+}
+
+std::optional<Vec2> gridSource(const WarpGrid& grid, const Vec2& pixel) {
+  const double gu = (pixel.x() - grid.origin.x()) / grid.step.x();
+  const double gv = (pixel.y() - grid.origin.y()) / grid.step.y();
+  if (!(gu >= 0 && gv >= 0 && gu <= grid.cols - 1 && gv <= grid.rows - 1)) return std::nullopt;
+  const int i = std::min(static_cast<int>(gu), grid.cols - 2);
+  const int j = std::min(static_cast<int>(gv), grid.rows - 2);
+  const double u = gu - i, v = gv - j;
+  const Vec2& s00 = grid.at(i, j);
+  const Vec2& s11 = grid.at(i + 1, j + 1);
+  // Two triangles per cell split along (i,j)-(i+1,j+1): affine inside each; a triangle
+  // with a node no source reaches is not drawn (interpolating towards kOutside would
+  // put far-off content next to the footprint's edge).
+  const Vec2& s_mid = u >= v ? grid.at(i + 1, j) : grid.at(i, j + 1);
+  if (s00.x() == kOutside || s11.x() == kOutside || s_mid.x() == kOutside) return std::nullopt;
+  return u >= v ? Vec2(s00 + u * (s_mid - s00) + v * (s11 - s_mid))
+                : Vec2(s00 + v * (s_mid - s00) + u * (s11 - s_mid));
 }
 
 Result<WarpMap> composeMaps(const WarpMap& first, const WarpMap& second) {

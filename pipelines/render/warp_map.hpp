@@ -5,6 +5,7 @@
 // kOutside marks pixels that no source pixel reaches. Maps hold float32 coordinates:
 // per-pixel render data, with the error against double bounded in tests.
 #include <opencv2/core.hpp>
+#include <optional>
 
 #include "core/error.hpp"
 #include "core/types.hpp"
@@ -36,8 +37,13 @@ struct WarpGrid {
 // kInvalidInput for non-finite H or empty size, kDegenerate when H is singular.
 Result<WarpMap> homographyMap(const Mat3& H, cv::Size output_size);
 
-// Dense map of a warp grid over an output image; pixels outside the grid are kOutside.
+// Dense map of a warp grid over an output image; pixels outside the grid, or in a
+// triangle with a kOutside node, are kOutside.
 Result<WarpMap> gridMap(const WarpGrid& grid, cv::Size output_size);
+
+// The grid's source coordinate at an output pixel (gridMap's, in double precision);
+// nullopt where gridMap gives kOutside.
+std::optional<Vec2> gridSource(const WarpGrid& grid, const Vec2& pixel);
 
 // The map of applying `first` then `second`: result(m) = first(second(m)), `first`
 // sampled bilinearly (nearest valid entry next to a kOutside region).

@@ -16,7 +16,7 @@ namespace procam::surface {
 struct SampleOptions {
   int step = 8;  // projector pixels between nodes
   // Neighbourhood half-width in projector pixels; at least step/2 and 1.5 times the
-  // projector pixels one camera pixel spans (measured from the map), so that every
+  // projector pixels one camera pixel spans (measured from the map, 90th percentile), so that every
   // neighbourhood holds several camera pixels. With Gray codes of cell k (pattern
   // step k) use at least k, so that the neighbourhood spans several decoded cells.
   double radius = 2.0;

@@ -2,7 +2,9 @@
 // Display-surface model from triangulated points ([Raskar02] §4.1.1: a mesh in projector
 // image space; §4.2: planar surfaces need only a plane). A RANSAC plane test picks
 // the cheaper model: planar -> plane; otherwise a mesh over the projector grid with
-// holes where nothing was decoded, simplified where the surface is flat.
+// holes where nothing was decoded (single lost nodes and small clusters between decoded
+// ones are decoding dropouts and are closed), simplified where the surface is flat (without
+// T-junctions: a simplified quad is a fan to every node of its border).
 #include <string>
 #include <vector>
 

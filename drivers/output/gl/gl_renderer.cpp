@@ -100,7 +100,10 @@ void gridGeometry(const render::WarpGrid& g, std::vector<float>& v, std::vector<
     for (int i = 0; i + 1 < g.cols; ++i) {
       const GLuint a = static_cast<GLuint>(j * g.cols + i), b = a + 1;
       const GLuint c = a + static_cast<GLuint>(g.cols), d = c + 1;
-      idx.insert(idx.end(), {a, b, d, a, d, c});
+      // A triangle with a node no source reaches is not drawn, as on the CPU.
+      auto reached = [&](GLuint k) { return g.source[k].x() != render::kOutside; };
+      if (reached(a) && reached(b) && reached(d)) idx.insert(idx.end(), {a, b, d});
+      if (reached(a) && reached(d) && reached(c)) idx.insert(idx.end(), {a, d, c});
     }
   }
 }

@@ -185,6 +185,27 @@ TEST(GridMap, IsPiecewiseLinearAlongTheCellDiagonal) {
   EXPECT_NEAR(map->xy.at<cv::Vec2f>(2, 8)[1], 0.2 * 12, 1e-5);
 }
 
+TEST(GridMap, TrianglesWithANodeNoSourceReachesAreNotDrawn) {
+  // Node (1,0) of one cell is kOutside (its ray missed the surface): the upper triangle
+  // (00, 10, 11) is outside; the lower one (00, 11, 01) is drawn as before. Interpolating
+  // towards kOutside would have put content from -65536 next to the footprint's edge.
+  WarpGrid g;
+  g.cols = 2;
+  g.rows = 2;
+  g.step = Vec2(10, 10);
+  g.source = {Vec2(0, 0), Vec2(kOutside, kOutside), Vec2(0, 10), Vec2(10, 10)};
+  auto map = gridMap(g, {11, 11});
+  ASSERT_TRUE(map);
+  EXPECT_EQ(map->xy.at<cv::Vec2f>(2, 8)[0], kOutside);  // upper: x 8 >= y 2
+  EXPECT_FALSE(gridSource(g, Vec2(8, 2)));
+  EXPECT_NEAR(map->xy.at<cv::Vec2f>(8, 2)[0], 2.0, 1e-5);  // lower: x 2 < y 8
+  EXPECT_NEAR(map->xy.at<cv::Vec2f>(8, 2)[1], 8.0, 1e-5);
+  const auto s = gridSource(g, Vec2(2.5, 7.25));
+  ASSERT_TRUE(s);
+  EXPECT_NEAR(s->x(), 2.5, 1e-12);
+  EXPECT_NEAR(s->y(), 7.25, 1e-12);
+}
+
 TEST(ComposeMaps, EqualsTheAnalyticComposition) {
   Mat3 H;
   H << 1.1, 0.05, 12, -0.03, 0.95, 7, 1e-4, -5e-5, 1;
