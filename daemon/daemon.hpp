@@ -180,9 +180,16 @@ class Daemon {
   std::optional<ViewerEye> staticEye() const;
   // `fixed_viewer`: content drawn for that world -> image matrix (3D content), shown by
   // the lookup warp with it whatever the viewer does since.
+  // `share`: set to the output's index in the display across outputs it draws a share
+  // of, -1 when it draws alone.
   Result<std::shared_ptr<const render::RenderSetup>> nonPlanarSetup(
       const std::string& output, const render::SceneTraits& traits, cv::Size mode, cv::Size content,
-      const Mat34* fixed_viewer = nullptr);
+      const Mat34* fixed_viewer = nullptr, int* share = nullptr);
+  // curved_display.cpp: usable outputs whose calibrated projectors light the rig's
+  // surface meshes, as one display for the static viewer (null until made, or with
+  // fewer than two such outputs).
+  const KeystoneRuntime::Curved* curvedDisplay(cv::Size content, const ViewerEye& eye);
+  nlohmann::json curvedDisplayJson() const;
   bool calibrating() const;
   // Marks `op_id` as the calibration operation using `devices` (commands_calibrate.cpp).
   void beginCalibrationOp(const std::string& op_id, std::vector<std::string> devices);

@@ -83,7 +83,7 @@ std::optional<OutputDraw> Daemon::planOutput(DeviceEntry& e, const OutputDrawPol
   // Several projectors on one wall: this output's share of the one display.
   const bool rig_mode = settings_.rig_keystone && !(settings_.auto_keystone && k.estimate);
   const KeystoneRuntime::Tiled* tiled = rig_mode ? tiledDisplay(sourceSize(r)) : nullptr;
-  const int tile = tiled ? tiled->index(e.name) : -1;
+  int tile = tiled ? tiled->index(e.name) : -1;
   r.homography = tile >= 0 ? std::optional<Mat3>(tiled->display.content_to_framebuffer[tile])
                            : currentWarp(sourceSize(r));
   auto plan = planFrame(r);
@@ -106,11 +106,13 @@ std::optional<OutputDraw> Daemon::planOutput(DeviceEntry& e, const OutputDrawPol
     // Image content on a non-planar surface: what the viewer should see, drawn by the
     // two-pass path or the lookup warp; a keystone homography when the rig or the viewer
     // do not allow it.
+    int share = -1;
     auto np = nonPlanarSetup(e.name, traits, *mode, plan->image->size(),
-                             mesh_image ? &mesh_image->viewer : nullptr);
+                             mesh_image ? &mesh_image->viewer : nullptr, &share);
     if (np) {
       plan->setup = **np;
       st.viewer = (*np)->viewer;
+      tile = share;
     } else {
       np_note = "non-planar surface, drawn by homography: " + np.error().message;
     }
@@ -314,9 +316,18 @@ json Daemon::outputsJson() const {
     if (!st.path.empty()) o["path"] = st.path;
     if (st.viewer) o["viewer_matrix"] = rowMajor(*st.viewer);
     if (st.homography) o["homography"] = rowMajor(*st.homography);
-    if (st.tile >= 0 && keystone_rt_.tiled) {
-      o["display"] = {
-          {"tile", st.tile}, {"tiles", keystone_rt_.tiled->outputs.size()}, {"blend", "feathered"}};
+    // Its share of a display across outputs: on a curved surface (lookup warp) or a wall.
+    const bool on_surface = st.path == render::toString(render::RenderPath::kLookupWarp);
+    if (st.tile >= 0 && on_surface && keystone_rt_.curved) {
+      o["display"] = {{"tile", st.tile},
+                      {"tiles", keystone_rt_.curved->outputs.size()},
+                      {"surface", "mesh"},
+                      {"blend", "feathered"}};
+    } else if (st.tile >= 0 && keystone_rt_.tiled) {
+      o["display"] = {{"tile", st.tile},
+                      {"tiles", keystone_rt_.tiled->outputs.size()},
+                      {"surface", "plane"},
+                      {"blend", "feathered"}};
     }
     if (auto it = keystone_rt_.output_state.find(name); it != keystone_rt_.output_state.end()) {
       const auto& os = it->second;
@@ -326,9 +337,12 @@ json Daemon::outputsJson() const {
     }
     list.push_back(std::move(o));
   }
-  return {{"frames", keystone_rt_.frames},
-          {"frames_stopped", keystone_rt_.frames_stopped},
-          {"shown", list}};
+  json out = {{"frames", keystone_rt_.frames},
+              {"frames_stopped", keystone_rt_.frames_stopped},
+              {"shown", list}};
+  // Several projectors on a curved surface as one display for the static viewer.
+  if (json display = curvedDisplayJson(); !display.is_null()) out["display"] = std::move(display);
+  return out;
 }
 
 }  // namespace procam::daemon

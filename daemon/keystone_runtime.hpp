@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "auto_keystone.hpp"
+#include "blend/curved_display.hpp"
 #include "blend/tiled_blend.hpp"
 #include "content_mesh.hpp"
 #include "driver.hpp"
@@ -61,7 +62,8 @@ struct KeystoneRuntime {
     Mat34 np_projector = Mat34::Zero();
     bool np_tracked = false;
     std::optional<Mat34> np_fixed;
-    std::optional<Mat34> viewer;  // world -> content pixels of the frame drawn
+    std::shared_ptr<const void> np_curved;  // the display across outputs it is a share of
+    std::optional<Mat34> viewer;            // world -> content pixels of the frame drawn
   };
   std::map<std::string, OutputState> output_state;
   std::map<std::string, std::shared_ptr<const cv::Mat>> patterns;  // "name WxH" -> RGBA
@@ -85,15 +87,29 @@ struct KeystoneRuntime {
   // The display, the 8-bit alpha masks (eq. 4.3 weights; `weights` is left empty) and
   // per tile the weight table through its response and brightness gain: measured
   // (rig.json photometric, every tile) or the assumed gamma and no gain.
-  struct Tiled : blend::TiledBlend {
+  struct DisplayShares {
     cv::Size content;
     std::vector<std::string> outputs;  // in tile order
     int index(const std::string& output) const;
   };
+  struct Tiled : blend::TiledBlend, DisplayShares {};
   std::shared_ptr<const Tiled> tiled;  // the display in use, if any
   std::string tiled_key;               // what `tiled` (or the job running) was made for
   std::string tiled_error;             // why there is none for tiled_key
   bool tiling = false;                 // a job runs
+
+  // Several projectors on one non-planar surface as one display for the static viewer
+  // (curved_display.cpp): the viewer's content plane, each output's lookup warp and
+  // its weights and tables, as for the tiled display. The surface meshes it was made
+  // from are held while it is in use.
+  struct Curved : blend::CurvedBlend, DisplayShares {
+    std::vector<std::shared_ptr<const void>> surfaces;
+    nlohmann::json eye_source;  // where the eye came from (config, rig)
+  };
+  std::shared_ptr<const Curved> curved;
+  std::string curved_key;
+  std::string curved_error;
+  bool curving = false;
 };
 
 }  // namespace procam::daemon

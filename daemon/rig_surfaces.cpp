@@ -92,7 +92,8 @@ std::shared_ptr<const Daemon::RigSurfaceMesh> Daemon::rigSurfaceFor(
 
 Result<std::shared_ptr<const render::RenderSetup>> Daemon::nonPlanarSetup(
     const std::string& output, const render::SceneTraits& traits, cv::Size mode, cv::Size content,
-    const Mat34* fixed_viewer) {
+    const Mat34* fixed_viewer, int* share) {
+  if (share) *share = -1;
   const rig::RigProjector* p = rig_.projectorForOutput(output);
   if (!p || !p->pose_known) return fail(ErrorCode::kNotFound, "the projector has no pose");
   if (p->width != mode.width || p->height != mode.height) {
@@ -117,9 +118,45 @@ Result<std::shared_ptr<const render::RenderSetup>> Daemon::nonPlanarSetup(
   auto& st = keystone_rt_.output_state[output];
   const std::optional<Mat34> fixed =
       fixed_viewer ? std::optional<Mat34>(*fixed_viewer) : std::nullopt;
+  // The static viewer of several projectors: this output's share of one display.
+  std::shared_ptr<const KeystoneRuntime::Curved> curved;
+  int index = -1;
+  if (!tracked && !fixed) {
+    if (auto e = staticEye(); e && curvedDisplay(content, *e)) {
+      index = keystone_rt_.curved->index(output);
+      if (index >= 0) curved = keystone_rt_.curved;
+    }
+  }
+  if (share) *share = index;
   if (st.np_setup && st.np_surface == surface && st.np_eye == *eye && st.np_content == content &&
-      st.np_projector == P && st.np_tracked == tracked && st.np_fixed == fixed) {
+      st.np_projector == P && st.np_tracked == tracked && st.np_fixed == fixed &&
+      st.np_curved == curved) {
     return st.np_setup;
+  }
+  // The setup made, and what it was made for.
+  auto remember = [&](render::RenderSetup setup) {
+    st.np_setup = std::make_shared<const render::RenderSetup>(std::move(setup));
+    st.np_surface = surface;
+    st.np_eye = *eye;
+    st.np_content = content;
+    st.np_projector = P;
+    st.np_tracked = tracked;
+    st.np_fixed = fixed;
+    st.np_curved = curved;
+    return st.np_setup;
+  };
+  if (curved) {
+    render::RenderSetup setup;
+    setup.output_size = mode;
+    setup.content_size = content;
+    setup.path = render::RenderPath::kLookupWarp;
+    setup.lookup = curved->display.lookup[index];
+    setup.viewer = curved->display.viewer;
+    // Eq. 4.3 weights in linear light, through the projector's response and its
+    // brightness gain ([Raskar02] §4.1.2).
+    setup.final_stage.alpha = curved->alpha[index];
+    setup.final_stage.weight_lut = curved->weight_lut[index];
+    return remember(std::move(setup));
   }
   auto V = fixed ? Result<Mat34>(*fixed)
                  : render::viewerContentMatrix(surface->intersector, P, mode, *eye, content);
@@ -139,14 +176,7 @@ Result<std::shared_ptr<const render::RenderSetup>> Daemon::nonPlanarSetup(
     setup.lookup = std::move(*grid);
     setup.viewer = *V;  // reported in status; the grid is what is drawn
   }
-  st.np_setup = std::make_shared<const render::RenderSetup>(std::move(setup));
-  st.np_surface = surface;
-  st.np_eye = *eye;
-  st.np_content = content;
-  st.np_projector = P;
-  st.np_tracked = tracked;
-  st.np_fixed = fixed;
-  return st.np_setup;
+  return remember(std::move(setup));
 }
 
 }  // namespace procam::daemon

@@ -20,7 +20,7 @@ namespace procam::daemon {
 
 using nlohmann::json;
 
-int KeystoneRuntime::Tiled::index(const std::string& output) const {
+int KeystoneRuntime::DisplayShares::index(const std::string& output) const {
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     if (outputs[i] == output) return static_cast<int>(i);
   }

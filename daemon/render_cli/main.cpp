@@ -1,4 +1,4 @@
-// procam-render: a planar rig's framebuffers drawn offline (see kUsage).
+// procam-render: a rig's framebuffers drawn offline (see kUsage).
 #include <cstdio>
 #include <string>
 #include <vector>

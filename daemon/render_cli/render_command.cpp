@@ -11,6 +11,7 @@
 #include "blend/tile_frames.hpp"
 #include "blend/tiled_blend.hpp"
 #include "content/image_header.hpp"
+#include "curved_render.hpp"
 #include "mpcdi_zip.hpp"
 #include "replace_file.hpp"
 #include "rig/rig_model.hpp"
@@ -56,6 +57,32 @@ Result<std::string> readSmallFile(const fs::path& file, std::uintmax_t limit) {
   return text;
 }
 
+// The content image, decoded; its header's size checked before decoding (a small file may
+// declare a huge image).
+Result<cv::Mat> readContent(const fs::path& file) {
+  auto bytes = readSmallFile(file, kMaxContentBytes);
+  if (!bytes) return tl::unexpected(bytes.error());
+  auto header = content::readImageHeader(*bytes);
+  if (!header) return fail(ErrorCode::kIo, file.string() + ": " + header.error().message);
+  if (double(header->size.area()) > kMaxContentPixels)
+    return fail(ErrorCode::kTooLarge, file.string() + " is over 33554432 pixels");
+  cv::Mat content;
+  try {
+    content =
+        cv::imdecode(cv::Mat(1, int(bytes->size()), CV_8U, bytes->data()), cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception& e) {
+    return fail(ErrorCode::kIo, file.string() + ": " + e.what());
+  }
+  if (content.empty()) return fail(ErrorCode::kIo, "cannot decode " + file.string());
+  if (double(content.total()) > kMaxContentPixels)
+    return fail(ErrorCode::kTooLarge, file.string() + " is over 33554432 pixels");
+  if ((content.depth() != CV_8U && content.depth() != CV_16U) ||
+      (content.channels() != 1 && content.channels() != 3 && content.channels() != 4))
+    return fail(ErrorCode::kInvalidInput,
+                file.string() + ": an 8 or 16-bit grey, RGB or RGBA image is needed");
+  return content;
+}
+
 // MPCDI's date form, UTC.
 std::string utcNow() {
   const std::time_t now = std::time(nullptr);
@@ -87,7 +114,7 @@ Result<RenderArgs> parseRenderArgs(const std::vector<std::string>& args) {
     const std::string& opt = args[i];
     const bool takes_value = opt == "--rig" || opt == "--content" || opt == "--out" ||
                              opt == "--rect" || opt == "--bit-depth" || opt == "--projector" ||
-                             opt == "--mpcdi";
+                             opt == "--mpcdi" || opt == "--viewer";
     if (takes_value && i + 1 >= args.size())
       return fail(ErrorCode::kInvalidInput, opt + " needs a value");
     if (opt == "--rig") {
@@ -102,6 +129,10 @@ Result<RenderArgs> parseRenderArgs(const std::vector<std::string>& args) {
       if (!((*v)[3] > 0) || !((*v)[4] > 0))
         return fail(ErrorCode::kInvalidInput, "--rect: width and height must be positive");
       a.rect = blend::WorldRect{Vec3((*v)[0], (*v)[1], (*v)[2]), (*v)[3], (*v)[4]};
+    } else if (opt == "--viewer") {
+      auto v = numberList(args[++i], 3, "--viewer");
+      if (!v) return tl::unexpected(v.error());
+      a.viewer = Vec3((*v)[0], (*v)[1], (*v)[2]);
     } else if (opt == "--bit-depth") {
       const std::string& v = args[++i];
       if (v != "8" && v != "16") return fail(ErrorCode::kInvalidInput, "--bit-depth is 8 or 16");
@@ -121,6 +152,44 @@ Result<RenderArgs> parseRenderArgs(const std::vector<std::string>& args) {
   return a;
 }
 
+namespace {
+
+Result<json> runCurved(const RenderArgs& args, const rig::RigModel& rig) {
+  if (args.rect) return fail(ErrorCode::kInvalidInput, "--rect is for a planar display");
+  if (!args.mpcdi.empty())
+    return fail(ErrorCode::kInvalidInput,
+                "--mpcdi exports a planar display (MPCDI's 2D media profile); this rig is curved");
+  auto content = readContent(args.content);
+  if (!content) return tl::unexpected(content.error());
+  std::error_code ec;
+  if (!args.out.empty()) {
+    fs::create_directories(args.out, ec);
+    if (ec) return fail(ErrorCode::kIo, "cannot create " + args.out.string() + ": " + ec.message());
+  }
+  CurvedRenderInput in;
+  in.rig = &rig;
+  in.rig_file = args.rig;
+  in.projectors = args.projectors;
+  in.viewer = args.viewer;
+  in.content = *content;
+  in.out = args.out;
+  in.bit_depth = args.bit_depth;
+  in.geometry_only = args.geometry_only;
+  auto doc = renderCurved(in);
+  if (!doc) return tl::unexpected(doc.error());
+  (*doc)["rig"] = args.rig.string();
+  (*doc)["content"] = {{"path", args.content.string()}, {"size", {content->cols, content->rows}}};
+  (*doc)["bit_depth"] = args.bit_depth;
+  (*doc)["geometry_only"] = args.geometry_only;
+  if (!args.out.empty()) {
+    if (auto ok = replaceFileWith(args.out / "display.json", doc->dump(2) + "\n"); !ok)
+      return tl::unexpected(ok.error());
+  }
+  return doc;
+}
+
+}  // namespace
+
 Result<json> runRender(const RenderArgs& args) {
   auto text = readSmallFile(args.rig, kMaxRigBytes);
   if (!text) return tl::unexpected(text.error());
@@ -135,6 +204,11 @@ Result<json> runRender(const RenderArgs& args) {
     if (it == rig->projectors.end())
       return fail(ErrorCode::kNotFound, "no projector '" + name + "' in " + args.rig.string());
   }
+  // A rig with surface meshes (route (a) on a curved surface), or a viewer given: one
+  // display for the viewer.
+  const bool meshed = !rig->surface.meshes.empty() || !rig->surface.unified_mesh.empty();
+  if (args.viewer || (meshed && !rig->surface.plane)) return runCurved(args, *rig);
+
   std::vector<blend::DisplayTile> tiles;
   std::vector<std::optional<blend::ProjectorResponse>> responses;
   std::vector<std::string> skipped;
@@ -164,27 +238,9 @@ Result<json> runRender(const RenderArgs& args) {
                 "no projector of " + args.rig.string() + " maps onto a display plane" + why);
   }
 
-  auto bytes = readSmallFile(args.content, kMaxContentBytes);
-  if (!bytes) return tl::unexpected(bytes.error());
-  // The header's size is checked before decoding: a small file may declare a huge image.
-  auto header = content::readImageHeader(*bytes);
-  if (!header) return fail(ErrorCode::kIo, args.content.string() + ": " + header.error().message);
-  if (double(header->size.area()) > kMaxContentPixels)
-    return fail(ErrorCode::kTooLarge, args.content.string() + " is over 33554432 pixels");
-  cv::Mat content;
-  try {
-    content =
-        cv::imdecode(cv::Mat(1, int(bytes->size()), CV_8U, bytes->data()), cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception& e) {
-    return fail(ErrorCode::kIo, args.content.string() + ": " + e.what());
-  }
-  if (content.empty()) return fail(ErrorCode::kIo, "cannot decode " + args.content.string());
-  if (double(content.total()) > kMaxContentPixels)
-    return fail(ErrorCode::kTooLarge, args.content.string() + " is over 33554432 pixels");
-  if ((content.depth() != CV_8U && content.depth() != CV_16U) ||
-      (content.channels() != 1 && content.channels() != 3 && content.channels() != 4))
-    return fail(ErrorCode::kInvalidInput,
-                args.content.string() + ": an 8 or 16-bit grey, RGB or RGBA image is needed");
+  auto decoded = readContent(args.content);
+  if (!decoded) return tl::unexpected(decoded.error());
+  const cv::Mat& content = *decoded;
 
   blend::TiledDisplayOptions options;
   options.world_rect = args.rect;

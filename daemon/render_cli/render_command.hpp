@@ -1,6 +1,6 @@
 #pragma once
-// procam-render: a planar rig's projector framebuffers drawn offline from rig.json and
-// one content image, as the daemon would show them (see kUsage).
+// procam-render: a rig's projector framebuffers drawn offline from rig.json and one
+// content image, as the daemon would show them (see kUsage).
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -14,18 +14,23 @@ namespace procam::render_cli {
 
 inline constexpr const char* kUsage =
     "usage: procam-render --rig RIG.json --content IMAGE (--out DIR | --mpcdi FILE) [options]\n"
-    "  Draws the framebuffer of every projector of a planar display that rig.json\n"
-    "  describes: the content in the largest upright rectangle of its aspect inside the\n"
+    "  Draws the framebuffer of every projector of the display that rig.json describes.\n"
+    "  Planar wall: the content in the largest upright rectangle of its aspect inside the\n"
     "  union of the projectors' images on the wall (or the --rect given), through each\n"
-    "  projector's homography, blended in the overlaps in linear light through each\n"
-    "  projector's measured response (rig.json photometric; gamma 2.2 otherwise). Writes\n"
-    "  DIR/NAME.png per projector and DIR/display.json (the display rectangle, and per\n"
-    "  projector its homography, footprint, response and gain).\n"
+    "  projector's homography. Curved surface (projectors with poses and surface meshes,\n"
+    "  the mesh files beside rig.json): the content is the image a viewer at --viewer\n"
+    "  (or the rig's viewer) sees, in the largest upright rectangle inside the union of\n"
+    "  the images as the viewer sees them, through each projector's lookup warp. Both\n"
+    "  blended in the overlaps in linear light through each projector's measured\n"
+    "  response (rig.json photometric; gamma 2.2 otherwise). Writes DIR/NAME.png per\n"
+    "  projector and DIR/display.json (the display rectangle or viewer, and per\n"
+    "  projector its path, homography and footprint (planar), response and gain).\n"
     "options:\n"
     "  --rect X,Y,Z,W,H   the display rectangle: centre (world, metres, on the wall),\n"
     "                     width and height (metres); shrunk to the content's aspect\n"
     "  --bit-depth 8|16   PNG depth (default 8: exactly the daemon's frames; 16: drawn in\n"
     "                     double precision, content ramps keep their codes)\n"
+    "  --viewer X,Y,Z     the viewer's eye (world, metres): a curved display drawn for it\n"
     "  --geometry-only    no blending and no response correction: the geometry alone\n"
     "  --projector NAME   only this projector of the rig (repeatable; default all that\n"
     "                     map onto the display plane)\n"
@@ -43,6 +48,7 @@ struct RenderArgs {
   bool geometry_only = false;
   std::vector<std::string> projectors;
   std::filesystem::path mpcdi;  // empty: no MPCDI export
+  std::optional<Vec3> viewer;   // a curved display's eye
 };
 
 // kInvalidInput (with the reason) for a bad command line.

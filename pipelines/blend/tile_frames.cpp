@@ -3,7 +3,9 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 
 #include "render/bilinear.hpp"
 #include "render/cpu_renderer.hpp"
@@ -11,19 +13,16 @@
 namespace procam::blend {
 namespace {
 
-// The daemon's frame: CPU reference renderer, homography path, the tile's final stage.
-Result<cv::Mat> rendererFrame(const cv::Mat& content, const TiledBlend& blend, std::size_t t,
-                              bool geometry_only) {
+// The daemon's frame: CPU reference renderer, the share's geometry and final stage.
+Result<cv::Mat> rendererFrame(const cv::Mat& content, render::RenderSetup setup,
+                              const BlendTables& blend, std::size_t t, bool geometry_only) {
   cv::Mat rgba;
   const int code = content.channels() == 1   ? cv::COLOR_GRAY2RGBA
                    : content.channels() == 3 ? cv::COLOR_BGR2RGBA
                                              : cv::COLOR_BGRA2RGBA;
   cv::cvtColor(content, rgba, code);
-  render::RenderSetup setup;
-  setup.path = render::RenderPath::kHomography;
   setup.output_size = blend.alpha[t].size();
   setup.content_size = content.size();
-  setup.homography = blend.display.content_to_framebuffer[t];
   if (!geometry_only) {
     setup.final_stage.alpha = blend.alpha[t];
     setup.final_stage.weight_lut = blend.weight_lut[t];
@@ -35,6 +34,21 @@ Result<cv::Mat> rendererFrame(const cv::Mat& content, const TiledBlend& blend, s
   cv::cvtColor(cpu.frame(), out,
                content.channels() == 1 ? cv::COLOR_RGBA2GRAY : cv::COLOR_RGBA2BGR);
   return out;
+}
+
+// The content pixel a framebuffer pixel shows under the share's geometry, if any.
+std::function<std::optional<Vec2>(double, double)> contentOf(const render::RenderSetup& geometry) {
+  if (geometry.path == render::RenderPath::kLookupWarp) {
+    return [&grid = geometry.lookup](double x, double y) {
+      return render::gridSource(grid, Vec2(x, y));
+    };
+  }
+  const Mat3 inverse = geometry.homography.inverse();
+  return [inverse](double x, double y) -> std::optional<Vec2> {
+    const Vec3 p = inverse * Vec3(x, y, 1);
+    if (!(p.z() > 0)) return std::nullopt;
+    return Vec2(p.x() / p.z(), p.y() / p.z());
+  };
 }
 
 }  // namespace
@@ -74,25 +88,31 @@ Result<cv::Mat> unitContent(const cv::Mat& content) {
   return unit;
 }
 
-Result<cv::Mat> tileFrame(const cv::Mat& content, const TiledBlend& blend, std::size_t t,
-                          const TileFrameOptions& options) {
+Result<cv::Mat> shareFrame(const cv::Mat& content, const render::RenderSetup& geometry,
+                           const BlendTables& blend, std::size_t t,
+                           const TileFrameOptions& options) {
   if (content.empty() || (content.depth() != CV_8U && content.depth() != CV_16U) ||
       (content.channels() != 1 && content.channels() != 3 && content.channels() != 4))
     return fail(ErrorCode::kInvalidInput, "content: 8 or 16 bit, 1, 3 or 4 channels");
   if (options.bit_depth != 8 && options.bit_depth != 16)
     return fail(ErrorCode::kInvalidInput, "bit depth must be 8 or 16");
-  if (t >= blend.display.content_to_framebuffer.size() || t >= blend.alpha.size() ||
-      t >= blend.weight_lut.size() || t >= blend.gamma.size() || t >= blend.gain.size())
-    return fail(ErrorCode::kInvalidInput, "tile index out of range");
+  if (t >= blend.alpha.size() || t >= blend.weight_lut.size() || t >= blend.gamma.size() ||
+      t >= blend.gain.size())
+    return fail(ErrorCode::kInvalidInput, "projector index out of range");
+  if (geometry.path != render::RenderPath::kHomography &&
+      geometry.path != render::RenderPath::kLookupWarp)
+    return fail(ErrorCode::kInvalidInput, "a share is drawn by homography or lookup warp");
+  if (geometry.path == render::RenderPath::kHomography) {
+    const Eigen::FullPivLU<Mat3> lu(geometry.homography);
+    if (!lu.isInvertible()) return fail(ErrorCode::kInvalidInput, "the homography is singular");
+  }
   if (options.bit_depth == 8 && content.depth() == CV_8U) {
-    return rendererFrame(content, blend, t, options.geometry_only);
+    return rendererFrame(content, geometry, blend, t, options.geometry_only);
   }
   if (!options.geometry_only && t >= blend.weights.size())
     return fail(ErrorCode::kInvalidInput, "the blend was made without its weights");
   const cv::Size size = blend.alpha[t].size();
-  const Eigen::FullPivLU<Mat3> lu(blend.display.content_to_framebuffer[t]);
-  if (!lu.isInvertible()) return fail(ErrorCode::kInvalidInput, "tile homography is singular");
-  const Mat3 fb_to_content = lu.inverse();
+  const auto to_content = contentOf(geometry);
   auto unit = unitContent(content);
   if (!unit) return tl::unexpected(unit.error());
   const cv::Mat& src = *unit;
@@ -105,8 +125,8 @@ Result<cv::Mat> tileFrame(const cv::Mat& content, const TiledBlend& blend, std::
     double v[3];
     for (int y = rows.start; y < rows.end; ++y) {
       for (int x = 0; x < size.width; ++x) {
-        const Vec3 p = fb_to_content * Vec3(x, y, 1);
-        if (!(p.z() > 0) || !sampleContent(src, p.x() / p.z(), p.y() / p.z(), v)) continue;
+        const auto p = to_content(x, y);
+        if (!p || !sampleContent(src, p->x(), p->y(), v)) continue;
         // Emitted light goes as code^gamma: (gain w)^(1/gamma) scales it by gain w.
         const double scale = options.geometry_only
                                  ? 1.0
@@ -123,6 +143,26 @@ Result<cv::Mat> tileFrame(const cv::Mat& content, const TiledBlend& blend, std::
     }
   });
   return out;
+}
+
+Result<cv::Mat> tileFrame(const cv::Mat& content, const TiledBlend& blend, std::size_t t,
+                          const TileFrameOptions& options) {
+  if (t >= blend.display.content_to_framebuffer.size())
+    return fail(ErrorCode::kInvalidInput, "tile index out of range");
+  render::RenderSetup geometry;
+  geometry.path = render::RenderPath::kHomography;
+  geometry.homography = blend.display.content_to_framebuffer[t];
+  return shareFrame(content, geometry, blend, t, options);
+}
+
+Result<cv::Mat> curvedFrame(const cv::Mat& content, const CurvedBlend& blend, std::size_t t,
+                            const TileFrameOptions& options) {
+  if (t >= blend.display.lookup.size())
+    return fail(ErrorCode::kInvalidInput, "projector index out of range");
+  render::RenderSetup geometry;
+  geometry.path = render::RenderPath::kLookupWarp;
+  geometry.lookup = blend.display.lookup[t];
+  return shareFrame(content, geometry, blend, t, options);
 }
 
 }  // namespace procam::blend

@@ -1,6 +1,6 @@
 #pragma once
-// The framebuffer each projector of a planar display shows, drawn offline
-// (procam-render): the content through the projector's homography, blended
+// The framebuffer each projector of a display shows, drawn offline (procam-render): the
+// content through the projector's homography (planar) or lookup warp (curved), blended
 // ([Raskar02] eq. 4.3 weights in linear light, §4.1.2) or geometry only.
 //  - 8 bit, blended: the daemon's own frame, drawn by the CPU reference renderer with the
 //    same render setup (homography, 8-bit alpha mask, weight table).
@@ -10,8 +10,10 @@
 //    (gain weight)^(1 / gamma) with the unquantized weight.
 #include <opencv2/core.hpp>
 
+#include "blend/curved_display.hpp"
 #include "blend/tiled_blend.hpp"
 #include "core/error.hpp"
+#include "render/render_setup.hpp"
 
 namespace procam::blend {
 
@@ -21,11 +23,20 @@ struct TileFrameOptions {
 };
 
 // `content`: CV_8U or CV_16U with 1, 3 or 4 channels (OpenCV's BGR(A) order). Returns a
-// CV_8U or CV_16U image of the tile's framebuffer size with 1 channel for grey content,
-// else 3 (BGR); black outside the content's image. kInvalidInput for other content, a
-// tile index out of range, a blend made without weights, or a bit depth other than 8 or 16.
+// CV_8U or CV_16U image of projector t's framebuffer size with 1 channel for grey
+// content, else 3 (BGR); black outside the content's image. `geometry`: the share's path
+// (kHomography with its homography, or kLookupWarp with its lookup grid). kInvalidInput
+// for other content or paths, an index out of range, a blend made without weights, a
+// singular homography or a bit depth other than 8 or 16.
+Result<cv::Mat> shareFrame(const cv::Mat& content, const render::RenderSetup& geometry,
+                           const BlendTables& blend, std::size_t t,
+                           const TileFrameOptions& options);
+
+// A planar display's tile (its homography), and a curved display's share (its lookup warp).
 Result<cv::Mat> tileFrame(const cv::Mat& content, const TiledBlend& blend, std::size_t tile,
                           const TileFrameOptions& options);
+Result<cv::Mat> curvedFrame(const cv::Mat& content, const CurvedBlend& blend, std::size_t t,
+                            const TileFrameOptions& options);
 
 // `content` (as above) as CV_64FC1 or CV_64FC3 in [0, 1], alpha dropped.
 Result<cv::Mat> unitContent(const cv::Mat& content);

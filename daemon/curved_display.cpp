@@ -1,0 +1,166 @@
+// Several projectors on one non-planar surface shown as one display for the viewer at
+// the sweet spot ([Raskar02] §4.1.5, PROTOCOL.md "Several projectors on a curved
+// surface"): with two or more usable outputs whose projectors the rig gives a pose and a
+// surface mesh, image content is the image the static viewer ([content] viewer, or the
+// rig model's) should see; every output shows its share through its own lookup warp,
+// feathered in the overlaps (eq. 4.3) in linear light through its measured response
+// (blend/curved_display.hpp). Made on the compute worker and kept until the content's
+// size, the outputs, the rig or the eye change; a tracked viewer is drawn by each output
+// alone (two-pass).
+#include <sstream>
+
+#include "blend/rig_tiles.hpp"
+#include "daemon.hpp"
+#include "log.hpp"
+
+namespace procam::daemon {
+
+using nlohmann::json;
+
+namespace {
+
+struct CurvedInput {
+  std::string output;
+  Mat34 projector;
+  cv::Size size;
+  std::shared_ptr<const void> surface;  // holds `intersector`
+  const geom::MeshIntersector* intersector = nullptr;
+  std::optional<blend::ProjectorResponse> response;
+};
+
+// What a display is made for: the content's size, the eye, every output's projector,
+// surface and response.
+std::string curvedKey(cv::Size content, const Vec3& eye, const std::vector<CurvedInput>& inputs) {
+  std::ostringstream key;
+  key.precision(17);
+  key << content.width << 'x' << content.height << " eye " << eye.transpose();
+  for (const auto& in : inputs) {
+    key << ' ' << in.output << ' ' << in.size.width << 'x' << in.size.height << ' '
+        << in.surface.get();
+    for (int i = 0; i < 12; ++i) key << ' ' << in.projector(i / 4, i % 4);
+    if (in.response) {
+      key << " r " << in.response->gamma << ' ' << in.response->black << ' ' << in.response->white;
+    }
+  }
+  return key.str();
+}
+
+}  // namespace
+
+const KeystoneRuntime::Curved* Daemon::curvedDisplay(cv::Size content, const ViewerEye& eye) {
+  KeystoneRuntime& k = keystone_rt_;
+  std::vector<CurvedInput> inputs;
+  for (const auto& e : devices_.entries()) {
+    if (e.description.family != PROCAM_FAMILY_OUTPUT || !e.usable()) continue;
+    const rig::RigProjector* p = rig_.projectorForOutput(e.name);
+    if (!p || !p->pose_known) continue;
+    auto mode = outputMode(e.device.raw());
+    if (!mode || mode->width != p->width || mode->height != p->height) continue;
+    auto surface = rigSurfaceFor(p->name);
+    if (!surface) continue;
+    inputs.push_back({e.name, p->model().projectionMatrix(), *mode, surface, &surface->intersector,
+                      blend::responseFromPhotometric(p->photometric)});
+  }
+  if (inputs.size() < 2 || content.width < 1 || content.height < 1) {
+    k.curved.reset();
+    k.curved_key.clear();
+    k.curved_error.clear();
+    return nullptr;
+  }
+  const std::string key = curvedKey(content, eye.position, inputs);
+  if (key == k.curved_key) return k.curved.get();  // made, failed, or on its way
+  k.curved_key = key;
+  k.curved_error.clear();
+  k.curved.reset();
+  if (k.curving) return nullptr;  // the job running sees the new key when it ends
+  k.curving = true;
+  logInfo("display across " + std::to_string(inputs.size()) + " outputs on the surface: solving");
+  compute_worker_->submit(
+      [this, key, content, inputs, eye] {
+        auto made = std::make_shared<KeystoneRuntime::Curved>();
+        std::vector<blend::SurfaceProjector> projectors;
+        std::vector<std::optional<blend::ProjectorResponse>> responses;
+        for (const auto& in : inputs) {
+          projectors.push_back({in.intersector, in.projector, in.size});
+          responses.push_back(in.response);
+          made->outputs.push_back(in.output);
+          made->surfaces.push_back(in.surface);
+        }
+        std::string error;
+        auto blended = blend::makeCurvedBlend(projectors, responses, eye.position, content);
+        if (blended) {
+          static_cast<blend::CurvedBlend&>(*made) = std::move(*blended);
+          made->weights.clear();  // the outputs take the 8-bit mask
+          made->content = content;
+          made->eye_source = eye.source;
+        } else {
+          error = blended.error().message;
+        }
+        return [this, key, made, error] {
+          KeystoneRuntime& k = keystone_rt_;
+          k.curving = false;
+          if (key == k.curved_key) {
+            if (error.empty()) {
+              k.curved = made;
+              logInfo("display across " + std::to_string(made->outputs.size()) +
+                      " outputs on the surface: ready");
+            } else {
+              k.curved.reset();
+              k.curved_error = error;
+              warn("no display across the projectors on the surface: " + error);
+            }
+          } else {
+            k.curved_key.clear();  // made for something older: make it again
+          }
+          refreshOutputs();
+        };
+      },
+      [this, key](const std::string& what) {
+        KeystoneRuntime& k = keystone_rt_;
+        k.curving = false;
+        if (key == k.curved_key) {
+          k.curved.reset();
+          k.curved_error = what;
+          warn("no display across the projectors on the surface: " + what);
+        }
+      });
+  return nullptr;
+}
+
+json Daemon::curvedDisplayJson() const {
+  const KeystoneRuntime& k = keystone_rt_;
+  if (!k.curved) {
+    if (!k.curved_error.empty()) return {{"unavailable", k.curved_error}};
+    if (k.curving) return {{"state", "solving"}};
+    return nullptr;
+  }
+  const auto& d = k.curved->display;
+  json tiles = json::array();
+  for (std::size_t t = 0; t < k.curved->outputs.size(); ++t) {
+    tiles.push_back({{"output", k.curved->outputs[t]},
+                     {"response_gamma", k.curved->gamma[t]},
+                     {"gain", k.curved->gain[t]}});
+  }
+  json eye = k.curved->eye_source;
+  eye["position"] = {d.eye.x(), d.eye.y(), d.eye.z()};
+  json viewer = json::array();
+  for (int i = 0; i < 12; ++i) viewer.push_back(d.viewer(i / 4, i % 4));
+  return {{"state", "ready"},
+          {"surface", "mesh"},
+          {"outputs", k.curved->outputs},
+          {"content_size", {k.curved->content.width, k.curved->content.height}},
+          {"viewer", eye},
+          {"viewer_matrix", viewer},
+          // The content on the eye's image plane z = 1 (x right, y up): its field of view.
+          {"rect_tan",
+           {{"centre", {d.rect.centre.x(), d.rect.centre.y()}},
+            {"size", {2 * d.rect.half_width, 2 * d.rect.half_height}}}},
+          {"union_area_tan2", d.union_area},
+          {"cell_tan", d.cell},
+          {"tiles", tiles},
+          {"blend",
+           {{"weights", "feathered"},
+            {"response", k.curved->measured ? "measured" : "assumed gamma 2.2"}}}};
+}
+
+}  // namespace procam::daemon

@@ -1,0 +1,33 @@
+#pragma once
+// procam-render on a curved rig: the projectors with a pose and a surface mesh in the rig
+// model shown as one display for a viewer at a sweet spot (blend/curved_display.hpp).
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "core/error.hpp"
+#include "core/types.hpp"
+#include "rig/rig_model.hpp"
+
+namespace procam::render_cli {
+
+struct CurvedRenderInput {
+  const rig::RigModel* rig = nullptr;
+  std::filesystem::path rig_file;       // its meshes are files beside it
+  std::vector<std::string> projectors;  // only these (empty: every posed one with a mesh)
+  std::optional<Vec3> viewer;           // --viewer, else the rig model's
+  cv::Mat content;                      // decoded, 8 or 16 bit
+  std::filesystem::path out;            // frames and display.json go here (empty: none)
+  int bit_depth = 8;
+  bool geometry_only = false;
+};
+
+// Draws every share and returns display.json's document (without the rig and content
+// entries the caller adds). kNotFound without a viewer or a projector with a pose and a
+// mesh; kInvalidInput for a mesh named outside the rig file's folder; errors of reading
+// the meshes and of blend::makeCurvedBlend.
+Result<nlohmann::json> renderCurved(const CurvedRenderInput& in);
+
+}  // namespace procam::render_cli

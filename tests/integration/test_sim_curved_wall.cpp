@@ -1,0 +1,366 @@
+// Three projectors on a curved wall shown as one display for a viewer at the sweet
+// spot, end to end on the virtual rig over the socket only: cylinder3 (three 1280x800
+// projectors with unmatched responses inside a cylinder, two cameras) with nothing
+// handed over but the cameras' calibration (TruthParts::kCamerasOnly) and the viewer's
+// position in procamd.toml. calibrate (route a) triangulates each projector's pose and
+// its piece of the wall, content load makes one display of them ([Raskar02] §4.1.5)
+// feathered in the overlaps (eq. 4.3), and the daemon's lookup warps and weights,
+// rebuilt from the rig.json it wrote and the viewer matrix it reports, are judged with
+// the TRUE projectors and wall.
+#include <gtest/gtest.h>
+
+#include <Eigen/LU>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+#include "blend/curved_display.hpp"
+#include "blend/rig_tiles.hpp"
+#include "content/mesh_content.hpp"
+#include "daemon_harness.hpp"
+#include "render/cpu_renderer.hpp"
+#include "render/viewer_view.hpp"
+#include "rig/rig_model.hpp"
+#include "sim/renderer.hpp"
+#include "sim/scene_library.hpp"
+#include "truth_rig_file.hpp"
+
+namespace procam::itest {
+namespace {
+
+const char* const kOutputs[] = {"proj_l", "proj_c", "proj_r"};
+constexpr int kW = 4800, kH = 900;  // a panorama
+
+Mat34 rowMajor34(const json& j) {
+  Mat34 m;
+  for (int i = 0; i < 12; ++i) m(i / 4, i % 4) = j[i].get<double>();
+  return m;
+}
+
+// d lookup / d pixel at u, numerically.
+std::optional<Eigen::Matrix2d> lookupJacobian(const render::WarpGrid& g, const Vec2& u) {
+  const auto x0 = render::gridSource(g, u - Vec2(0.5, 0)),
+             x1 = render::gridSource(g, u + Vec2(0.5, 0));
+  const auto y0 = render::gridSource(g, u - Vec2(0, 0.5)),
+             y1 = render::gridSource(g, u + Vec2(0, 0.5));
+  if (!x0 || !x1 || !y0 || !y1) return std::nullopt;
+  Eigen::Matrix2d J;
+  J.col(0) = *x1 - *x0;
+  J.col(1) = *y1 - *y0;
+  return J;
+}
+
+// The pixel of a projector whose lookup shows content pixel c: Newton from the nearest node.
+std::optional<Vec2> showing(const render::WarpGrid& g, const Vec2& c) {
+  double best = 1e300;
+  Vec2 u;
+  for (int j = 0; j < g.rows; ++j) {
+    for (int i = 0; i < g.cols; ++i) {
+      const Vec2& s = g.at(i, j);
+      if (s.x() == render::kOutside) continue;
+      if (const double d = (s - c).squaredNorm(); d < best) {
+        best = d;
+        u = g.node(i, j);
+      }
+    }
+  }
+  if (best > 4 * g.step.squaredNorm() * 16) return std::nullopt;  // c is not in this image
+  for (int it = 0; it < 8; ++it) {
+    const auto at = render::gridSource(g, u);
+    const auto J = lookupJacobian(g, u);
+    if (!at || !J) return std::nullopt;
+    u += J->inverse() * (c - *at);
+  }
+  const auto at = render::gridSource(g, u);
+  if (!at || (*at - c).norm() > 1e-3) return std::nullopt;
+  return u;
+}
+
+struct Calibrated {
+  rig::RigModel rig;
+  std::vector<geom::MeshIntersector> surfaces;  // per output, kOutputs order
+  std::vector<blend::SurfaceProjector> projectors;
+  std::vector<std::optional<blend::ProjectorResponse>> responses;
+};
+
+// The rig model calibrate wrote, with each projector's mesh, in kOutputs order.
+void readCalibrated(const std::string& state_dir, Calibrated& out) {
+  std::ifstream in(state_dir + "/rig.json");
+  std::stringstream text;
+  text << in.rdbuf();
+  auto rig = rig::rigFromText(text.str(), "rig.json");
+  ASSERT_TRUE(rig) << rig.error().message;
+  out.rig = std::move(*rig);
+  out.surfaces.reserve(3);
+  for (const char* name : kOutputs) {
+    const rig::RigProjector* p = out.rig.projectorForOutput(name);
+    ASSERT_TRUE(p && p->pose_known) << name;
+    ASSERT_TRUE(out.rig.surface.meshes.count(p->name)) << name;
+    auto mesh = content::loadMeshContent(state_dir + "/" + out.rig.surface.meshes.at(p->name));
+    ASSERT_TRUE(mesh) << mesh.error().message;
+    auto intersector = geom::MeshIntersector::build(std::move(mesh->mesh));
+    ASSERT_TRUE(intersector);
+    out.surfaces.push_back(std::move(*intersector));
+  }
+  for (std::size_t t = 0; t < 3; ++t) {
+    const rig::RigProjector* p = out.rig.projectorForOutput(kOutputs[t]);
+    out.projectors.push_back(
+        {&out.surfaces[t], p->model().projectionMatrix(), cv::Size(p->width, p->height)});
+    out.responses.push_back(blend::responseFromPhotometric(p->photometric));
+  }
+}
+
+TEST(SimCurvedWall, ThreeProjectorsCalibratedIntoOneDisplayForTheSweetSpot) {
+  auto scene = sim::resolveScene("cylinder3");
+  ASSERT_TRUE(scene) << scene.error().message;
+  const sim::SceneState state = scene->at(0);
+  std::map<std::string, geom::CameraModel> truth;
+  std::map<std::string, sim::ProjectorSpec> spec;
+  for (const auto& p : state.projectors) {
+    truth[p.spec.name] = p.model;
+    spec[p.spec.name] = p.spec;
+  }
+  const Vec3 eye = state.viewer.pose.center();
+  TempDir dir;
+  dir.write("procamd.toml", "[sim]\nscene = \"cylinder3\"\n[content]\nviewer = [" +
+                                std::to_string(eye.x()) + ", " + std::to_string(eye.y()) + ", " +
+                                std::to_string(eye.z()) + "]\n");
+  DaemonProcess d(dir,
+                  DaemonProcess::Launch{{"--config", dir.file("procamd.toml"), "--rig",
+                                         truthRigFile(dir, "cylinder3", TruthParts::kCamerasOnly)},
+                                        {},
+                                        -1,
+                                        true});
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+
+  // Every projector in turn through both cameras (route a); one rig model at the end.
+  const auto t0 = std::chrono::steady_clock::now();
+  const json request = {{"cmd", "calibrate"},
+                        {"id", 1},
+                        {"projectors", "all"},
+                        {"cameras", {"cam_a", "cam_b"}},
+                        {"mode", "gray+phase"},
+                        {"phase_steps", 3},
+                        {"grid", 8},
+                        {"settle_frames", 0}};
+  auto started = c.call(request);
+  ASSERT_TRUE(started);
+  ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
+  auto done = finalReply(c, 1, 600s);
+  ASSERT_TRUE(done) << d.log();
+  ASSERT_EQ((*done)["class"], "CALIBRATE") << done->dump();
+  ASSERT_EQ((*done)["outputs"].size(), 3u) << done->dump();
+  for (const json& o : (*done)["outputs"]) {
+    const std::string name = o["output"].get<std::string>();
+    const json& p = o["projector"];
+    const Vec3 centre(o["position"][0].get<double>(), o["position"][1].get<double>(),
+                      o["position"][2].get<double>());
+    const double centre_mm = 1000 * (centre - truth[name].pose.center()).norm();
+    std::printf(
+        "[ figures  ] %s: route a, %d nodes triangulated, reprojection %.4f px, centre %.2f mm "
+        "off, response gamma %.3f (true %.1f)\n",
+        name.c_str(), o["triangulated"].get<int>(), p["reprojection_rms_px"].get<double>(),
+        centre_mm, o["response"]["response_gamma"].get<double>(), spec[name].gamma);
+    EXPECT_EQ(o["surface_type"], "mesh") << name;
+    EXPECT_NEAR(o["response"]["response_gamma"].get<double>(), spec[name].gamma, 0.05) << name;
+  }
+  std::printf("[ figures  ] three projectors calibrated in %.1f s (%d captures)\n",
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+              (*started)["captures"].get<int>());
+
+  // A white panorama on the one display.
+  const std::string png = contentFile(dir, "panorama.png");
+  ASSERT_TRUE(cv::imwrite(png, cv::Mat(kH, kW, CV_8UC3, cv::Scalar(255, 255, 255))));
+  auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", png}}, 30s);
+  ASSERT_TRUE(load);
+  ASSERT_EQ((*load)["class"], "CONTENT") << load->dump();
+  json display;
+  std::map<std::string, json> shown;
+  const bool ready = eventually(
+      [&] {
+        auto s = c.call({{"cmd", "status"}});
+        if (!s) return false;
+        display = (*s)["outputs"].value("display", json());
+        shown.clear();
+        for (const json& o : (*s)["outputs"]["shown"]) {
+          if (o["source"] == "content" && o.value("path", "") == "lookup-warp" &&
+              o.contains("display") && display.is_object() && display["state"] == "ready") {
+            shown[o["name"].get<std::string>()] = o;
+          }
+        }
+        return shown.size() == 3;
+      },
+      60s);
+  ASSERT_TRUE(ready) << display.dump() << "\n" << d.log();
+  EXPECT_EQ(display["outputs"], json({"proj_l", "proj_c", "proj_r"})) << display.dump();
+  EXPECT_EQ(display["viewer"]["source"], "config");
+  EXPECT_EQ(display["blend"]["response"], "measured");
+  const Mat34 V = rowMajor34(display["viewer_matrix"]);
+  for (const char* name : kOutputs) {
+    EXPECT_EQ(rowMajor34(shown[name]["viewer_matrix"]), V) << name;
+    EXPECT_EQ(shown[name]["display"]["surface"], "mesh");
+  }
+
+  // The same display from the rig model the daemon wrote: what every output draws.
+  Calibrated cal;
+  ASSERT_NO_FATAL_FAILURE(readCalibrated(dir.file("state"), cal));
+  auto blend = blend::makeCurvedBlend(cal.projectors, cal.responses, eye, {kW, kH});
+  ASSERT_TRUE(blend) << blend.error().message;
+  EXPECT_LT((blend->display.viewer - V).norm(), 1e-9 * V.norm());
+  const auto& lookup = blend->display.lookup;
+
+  // TRUE surface point of a TRUE projector pixel.
+  auto onTheWall = [&](const std::string& name, const Vec2& u) -> std::optional<Vec3> {
+    auto rays = render::pixelRays(truth[name].projectionMatrix());
+    auto hit = scene->world().intersect(rays->through(u.x(), u.y()));
+    return hit ? std::optional<Vec3>(hit->hit.point) : std::nullopt;
+  };
+  auto inFrame = [](const Vec2& u, double margin) {
+    return u.x() >= -0.5 + margin && u.y() >= -0.5 + margin && u.x() <= 1279.5 - margin &&
+           u.y() <= 799.5 - margin;
+  };
+
+  // Seams: where one projector puts a content point on the TRUE wall, the other shows
+  // the same content point within 0.3 px RMS, 1 px at most (its pixels).
+  double sq = 0, worst = 0;
+  int pairs = 0;
+  for (std::size_t m = 0; m < 3; ++m) {
+    const auto& g = lookup[m];
+    for (int j = 0; j < g.rows; ++j) {
+      for (int i = 0; i < g.cols; ++i) {
+        const Vec2 content = g.at(i, j);
+        if (content.x() < 0 || content.y() < 0 || content.x() > kW - 1 || content.y() > kH - 1)
+          continue;
+        const auto X = onTheWall(kOutputs[m], g.node(i, j));
+        if (!X) continue;
+        for (std::size_t n = 0; n < 3; ++n) {
+          if (n == m) continue;
+          const Vec2 q = *truth[kOutputs[n]].project(*X);
+          if (!inFrame(q, 1)) continue;
+          const auto other = render::gridSource(lookup[n], q);
+          const auto J = lookupJacobian(lookup[n], q);
+          if (!other || !J) continue;
+          const double e = (J->inverse() * (content - *other)).norm();
+          sq += e * e;
+          worst = std::max(worst, e);
+          ++pairs;
+        }
+      }
+    }
+  }
+  ASSERT_GT(pairs, 1000);
+  const double rms = std::sqrt(sq / pairs);
+  std::printf("[ figures  ] seams: %d content points lit twice, RMS %.3f px, max %.3f px\n", pairs,
+              rms, worst);
+  EXPECT_LE(rms, 0.3);
+  EXPECT_LE(worst, 1.0);
+
+  // Straight lines of the content stay straight for the viewer: where the TRUE wall point
+  // that shows content pixel c appears in the viewer's pinhole (V, a camera at the eye),
+  // along every 10th row and column: within 0.5 content px of a straight line.
+  double bent = 0;
+  auto straightness = [&](bool rows, double at) {
+    std::vector<Vec2> seen;  // (along, across) in content px
+    const int n = rows ? kW : kH;
+    for (int k = 10; k < n - 10; k += 20) {
+      const Vec2 content = rows ? Vec2(k, at) : Vec2(at, k);
+      for (std::size_t m = 0; m < 3; ++m) {
+        const auto u = showing(lookup[m], content);
+        if (!u || !inFrame(*u, 1)) continue;
+        const auto X = onTheWall(kOutputs[m], *u);
+        if (!X) continue;
+        const Vec2 s = (V * X->homogeneous()).hnormalized();
+        seen.push_back(rows ? Vec2(k, s.y()) : Vec2(k, s.x()));
+      }
+    }
+    EXPECT_GT(seen.size(), size_t(n / 25));
+    // Least-squares line across = a + b along; the largest residual.
+    Eigen::MatrixXd A(seen.size(), 2);
+    Eigen::VectorXd b(seen.size());
+    for (std::size_t i = 0; i < seen.size(); ++i) {
+      A(i, 0) = 1;
+      A(i, 1) = seen[i].x();
+      b(i) = seen[i].y();
+    }
+    const Eigen::VectorXd line = A.colPivHouseholderQr().solve(b);
+    bent = std::max(bent, (A * line - b).cwiseAbs().maxCoeff());
+  };
+  for (int k = 1; k < 10; ++k) {
+    straightness(true, kH * k / 10.0);
+    straightness(false, kW * k / 10.0);
+  }
+  std::printf(
+      "[ figures  ] content lines seen from the sweet spot: %.3f content px from straight\n", bent);
+  EXPECT_LE(bent, 0.5);
+
+  // The frames: white through each output's lookup warp and blend, as the daemon drew them
+  // (its statistics agree), lit by the TRUE projectors and seen by the viewer in linear
+  // light: no step above 2 % between neighbouring viewer pixels over the display (inset by
+  // 3 %).
+  const cv::Mat white(kH, kW, CV_8UC4, cv::Scalar::all(255));
+  sim::Framebuffers frames;
+  for (std::size_t t = 0; t < 3; ++t) {
+    render::RenderSetup setup;
+    setup.output_size = cv::Size(1280, 800);
+    setup.content_size = cv::Size(kW, kH);
+    setup.path = render::RenderPath::kLookupWarp;
+    setup.lookup = lookup[t];
+    setup.final_stage.alpha = blend->alpha[t];
+    setup.final_stage.weight_lut = blend->weight_lut[t];
+    render::CpuRenderer cpu;
+    ASSERT_TRUE(cpu.configure(setup));
+    ASSERT_TRUE(cpu.render({&white, nullptr, 1}));
+    cv::Mat bgr, grey;
+    cv::cvtColor(cpu.frame(), bgr, cv::COLOR_RGBA2BGR);
+    cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+    const double lit = cv::countNonZero(grey) / double(grey.total());
+    const double mean = cv::mean(bgr)[0];
+    std::printf("[ figures  ] %s: lit %.5f (daemon %.5f), mean %.3f (daemon %.3f)\n", kOutputs[t],
+                lit, shown[kOutputs[t]]["lit_fraction"].get<double>(), mean,
+                shown[kOutputs[t]]["mean_rgb"][0].get<double>());
+    EXPECT_NEAR(lit, shown[kOutputs[t]]["lit_fraction"].get<double>(), 1e-4) << kOutputs[t];
+    EXPECT_NEAR(mean, shown[kOutputs[t]]["mean_rgb"][0].get<double>(), 0.01) << kOutputs[t];
+    frames[kOutputs[t]] = bgr;
+  }
+  auto lit = sim::Renderer::create(*scene, state, frames);
+  ASSERT_TRUE(lit) << lit.error().message;
+  const cv::Mat view = lit->renderViewer(4);
+  const geom::CameraModel& viewer = state.viewer;
+  auto inside = [&](int x, int y) {
+    auto ray = viewer.backproject(Vec2(x, y));
+    if (!ray) return false;
+    auto hit = scene->world().intersect(*ray);
+    if (!hit) return false;
+    const Vec2 q = (V * hit->hit.point.homogeneous()).hnormalized();
+    return q.x() > 0.03 * kW && q.x() < 0.97 * kW && q.y() > 0.03 * kH && q.y() < 0.97 * kH;
+  };
+  double step = 0, lo = 1e9, hi = 0;
+  Vec2 step_at = Vec2::Zero();
+  for (int y = 0; y + 1 < view.rows; ++y) {
+    for (int x = 0; x + 1 < view.cols; ++x) {
+      if (!inside(x, y) || !inside(x + 1, y + 1)) continue;
+      const double l = view.at<cv::Vec3f>(y, x)[0];
+      const double right = view.at<cv::Vec3f>(y, x + 1)[0], down = view.at<cv::Vec3f>(y + 1, x)[0];
+      const double st = std::max(std::abs(right - l) / l, std::abs(down - l) / l);
+      if (st > step) {
+        step = st;
+        step_at = Vec2(x, y);
+      }
+      lo = std::min(lo, l);
+      hi = std::max(hi, l);
+    }
+  }
+  std::printf(
+      "[ figures  ] white seen from the sweet spot: largest step %.2f %% at viewer pixel (%.0f, "
+      "%.0f), uniformity min/max %.3f\n",
+      100 * step, step_at.x(), step_at.y(), lo / hi);
+  EXPECT_GT(hi, 0);
+  EXPECT_LE(step, 0.02);
+}
+
+}  // namespace
+}  // namespace procam::itest
