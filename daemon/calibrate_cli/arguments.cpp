@@ -1,5 +1,6 @@
 #include "arguments.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -32,6 +33,36 @@ Result<Arguments> Arguments::parse(int argc, char** argv, int first) {
       return usage("unexpected argument '" + word + "'");
     } else {
       a.values_[current].push_back(word);
+    }
+  }
+  return a;
+}
+
+Result<Arguments> Arguments::parseGrouped(int argc, char** argv, int first,
+                                          const std::string& starter,
+                                          const std::vector<std::string>& members) {
+  Arguments a;
+  Arguments* into = &a;  // the group being filled, or the common options
+  std::string current;
+  for (int i = first; i < argc; ++i) {
+    const std::string word = argv[i];
+    if (word.rfind("--", 0) == 0 && word.size() > 2) {
+      current = word.substr(2);
+      if (current == starter) {
+        a.groups_.emplace_back();
+        into = &a.groups_.back();
+      } else if (std::find(members.begin(), members.end(), current) == members.end()) {
+        into = &a;
+      }
+      if (into->values_.count(current)) {
+        return usage("option --" + current + " given twice" +
+                     (into == &a ? std::string() : " for one --" + starter));
+      }
+      into->values_[current];
+    } else if (current.empty()) {
+      return usage("unexpected argument '" + word + "'");
+    } else {
+      into->values_[current].push_back(word);
     }
   }
   return a;

@@ -13,6 +13,13 @@ class Arguments {
  public:
   // argv[first..argc): every "--name" takes the words up to the next "--name".
   static Result<Arguments> parse(int argc, char** argv, int first);
+  // The same, with groups: "--<starter> NAME" opens a group that takes the options in
+  // `members` following it (each once per group); any other option closes it. Each group
+  // holds its starter's value under `starter` and its members.
+  static Result<Arguments> parseGrouped(int argc, char** argv, int first,
+                                        const std::string& starter,
+                                        const std::vector<std::string>& members);
+  const std::vector<Arguments>& groups() const { return groups_; }
 
   bool has(const std::string& name) const { return values_.count(name) > 0; }
   // Exactly one value; kInvalidInput names the option when missing.
@@ -24,6 +31,7 @@ class Arguments {
 
  private:
   std::map<std::string, std::vector<std::string>> values_;
+  std::vector<Arguments> groups_;
 };
 
 // Errors of the helpers here start with this: a malformed command line (exit 2).

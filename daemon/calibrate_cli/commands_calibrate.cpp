@@ -58,6 +58,20 @@ Result<sl::Decoded> decodeDir(const sl::PatternSet& set, const std::string& dir,
   return d;
 }
 
+// Route (a) from the captures of the first two cameras (the i-th directory the i-th's).
+Result<calib::StereoRouteResult> stereoRoute(const sl::PatternSet& set,
+                                             const std::vector<std::string>& dirs,
+                                             const std::vector<rig::NamedCamera>& cameras,
+                                             int step) {
+  calib::DecodedView views[2];
+  for (std::size_t i = 0; i < 2; ++i) {
+    auto d = decodeDir(set, dirs[i], i, 2);
+    if (!d) return tl::unexpected(d.error());
+    views[i] = {cameras[i].name, cameras[i].model, std::move(*d)};
+  }
+  return calib::solveStereoRoute(set, views[0], views[1], step);
+}
+
 Result<int> stepOption(const Arguments& a) {
   if (auto s = a.optional("step")) return toInt(*s, "--step");
   return 8;
@@ -138,7 +152,83 @@ Result<void> runStereo(const Arguments& a) {
   return writeText(*out, j.dump(2) + "\n");
 }
 
+// Route (a) for several projectors, one `--projector NAME --patterns DIR --captures A B`
+// group each, into one rig.json: every projector in the cameras' world frame, its mesh
+// beside rig.json as surface-NAME.ply (rig.json `surface.meshes`).
+Result<void> runSolveProjectors(const Arguments& a) {
+  if (auto ok = a.only({"cameras", "out", "step"}); !ok) return ok;
+  auto cameras_file = a.one("cameras");
+  auto out = a.one("out");
+  auto step = stepOption(a);
+  for (const auto* r : {&cameras_file, &out})
+    if (!*r) return asVoid(*r);
+  if (!step) return asVoid(step);
+  if (a.groups().size() > 64)
+    return fail(ErrorCode::kInvalidInput, kCommandLine + "at most 64 --projector groups");
+  auto cameras = readCameras(*cameras_file);
+  if (!cameras) return asVoid(cameras);
+  if (cameras->size() < 2)
+    return fail(ErrorCode::kInvalidInput, *cameras_file + " holds one camera; solve needs two");
+  nlohmann::json doc;
+  nlohmann::json meshes = nlohmann::json::object();
+  std::vector<std::pair<std::string, std::string>> plies;  // file, text
+  for (const Arguments& g : a.groups()) {
+    if (auto ok = g.only({"projector", "patterns", "captures"}); !ok) return ok;
+    auto name = g.one("projector");
+    auto patterns = g.one("patterns");
+    for (const auto* r : {&name, &patterns})
+      if (!*r) return asVoid(*r);
+    // The name becomes a file name beside rig.json.
+    if (name->empty() || name->size() > 128 ||
+        name->find_first_not_of(
+            "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789._-") !=
+            std::string::npos ||
+        (*name)[0] == '.')
+      return fail(ErrorCode::kInvalidInput,
+                  kCommandLine + "--projector '" + *name + "': 1-128 of A-Z a-z 0-9 . _ -");
+    if (meshes.contains(*name))
+      return fail(ErrorCode::kInvalidInput, kCommandLine + "--projector " + *name + " given twice");
+    const auto& dirs = g.all("captures");
+    if (dirs.size() != 2)
+      return fail(ErrorCode::kInvalidInput,
+                  kCommandLine + "--projector " + *name + ": give --captures CAPDIR CAPDIR2");
+    auto set = readSequence(*patterns);
+    if (!set) return asVoid(set);
+    auto route = stereoRoute(*set, dirs, *cameras, *step);
+    if (!route) {
+      return fail(route.error().code, "projector " + *name + ": " + route.error().message);
+    }
+    if (route->surface.planar)
+      return fail(ErrorCode::kCoplanar,
+                  "projector " + *name +
+                      ": the surface it lights is planar; several projectors on one wall are "
+                      "calibrated with one camera and the wall's plane (procamd calibrate, "
+                      "route b')");
+    progress(*name + ": triangulated " + std::to_string(route->triangulated) +
+             " projector nodes, " + std::to_string(route->consistent) +
+             " consistent with the projector");
+    const NamedProjector p{*name, set->options.width, set->options.height, route->projector};
+    if (doc.is_null()) {
+      doc = rig::rigJson(*cameras, p, nullptr);
+    } else {
+      doc["projectors"].push_back(rig::projectorJson(p));
+    }
+    const std::string file = "surface-" + *name + ".ply";
+    meshes[*name] = file;
+    plies.emplace_back((fs::path(*out).parent_path() / file).string(),
+                       surface::toPly(route->surface.mesh));
+  }
+  // Meshes first, rig.json last: a rig.json never names a mesh that is not written.
+  for (const auto& [file, text] : plies) {
+    progress("mesh -> " + file);
+    if (auto w = writeText(file, text); !w) return w;
+  }
+  doc["surface"] = {{"meshes", meshes}};
+  return writeText(*out, doc.dump(2) + "\n");
+}
+
 Result<void> runSolve(const Arguments& a) {
+  if (!a.groups().empty()) return runSolveProjectors(a);
   if (auto ok = a.only({"patterns", "captures", "cameras", "out", "surface-out", "step", "name"});
       !ok)
     return ok;
@@ -160,13 +250,7 @@ Result<void> runSolve(const Arguments& a) {
     return fail(ErrorCode::kInvalidInput, *cameras_file + " holds one camera; solve needs two");
   auto set = readSequence(*patterns);
   if (!set) return asVoid(set);
-  calib::DecodedView views[2];
-  for (std::size_t i = 0; i < 2; ++i) {
-    auto d = decodeDir(*set, dirs[i], i, 2);
-    if (!d) return asVoid(d);
-    views[i] = {(*cameras)[i].name, (*cameras)[i].model, std::move(*d)};
-  }
-  auto route = calib::solveStereoRoute(*set, views[0], views[1], *step);
+  auto route = stereoRoute(*set, dirs, *cameras, *step);
   if (!route && route.error().code == ErrorCode::kCoplanar)
     return fail(ErrorCode::kCoplanar, route.error().message +
                                           " (procam-calibrate solve-planes, with captures of "

@@ -18,6 +18,8 @@ constexpr const char* kUsage = R"(usage: procam-calibrate COMMAND [options]
   stereo   --images DIR_A DIR_B --board SPEC --out cameras.json [--names A B]
   solve    --patterns DIR --captures CAPDIR CAPDIR2 --cameras cameras.json --out rig.json
            [--surface-out surface.ply] [--step K] [--name NAME]          (route a)
+  solve    --cameras cameras.json --out rig.json [--step K]              (route a, several)
+           --projector NAME --patterns DIR --captures CAPDIR CAPDIR2 [--projector ...]
   solve-planes --patterns DIR --captures CAPDIR1 CAPDIR2 [...] --cameras cameras.json
            [--camera NAME] [--plane-distance M] [--principal-x PX] --out rig.json (route b)
   solve-fiducials --fiducials points.json --projector WxH --out rig.json
@@ -47,7 +49,11 @@ static int run(int argc, char** argv) {
                   {"solve-fiducials", procam::cli::runSolveFiducials}};
   for (const auto& c : commands) {
     if (std::strcmp(argv[1], c.name) != 0) continue;
-    auto args = procam::cli::Arguments::parse(argc, argv, 2);
+    // solve takes one --projector NAME --patterns DIR --captures A B group per projector.
+    auto args = std::strcmp(c.name, "solve") == 0
+                    ? procam::cli::Arguments::parseGrouped(argc, argv, 2, "projector",
+                                                           {"patterns", "captures"})
+                    : procam::cli::Arguments::parse(argc, argv, 2);
     if (!args) {
       std::fprintf(stderr, "procam-calibrate %s: %s\n%s", c.name, args.error().message.c_str(),
                    kUsage);

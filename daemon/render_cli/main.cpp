@@ -1,4 +1,5 @@
 // procam-render: a rig's framebuffers drawn offline (see kUsage).
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -33,11 +34,24 @@ static int run(int argc, char** argv) {
                   (parsed->out / p["file"].get<std::string>()).c_str());
     }
   }
-  const auto& size = (*done)["display"]["size_m"];
-  std::printf("display: %.4f m x %.4f m (%s)%s%s\n", size[0].get<double>(), size[1].get<double>(),
-              (*done)["display"]["rect_source"].get<std::string>().c_str(),
-              parsed->out.empty() ? "" : ", ",
-              parsed->out.empty() ? "" : (parsed->out / "display.json").c_str());
+  const auto& display = (*done)["display"];
+  const char* sep = parsed->out.empty() ? "" : ", ";
+  const std::string json_file = parsed->out.empty() ? "" : (parsed->out / "display.json").string();
+  if (display.value("surface", "") == "mesh") {
+    // A curved display: its field of view as the viewer sees it.
+    const auto& tan = display["rect_tan"]["size"];
+    const double to_deg = 360 / 3.141592653589793;
+    std::printf("display: %.2f x %.2f deg seen from (%.3f, %.3f, %.3f)%s%s\n",
+                to_deg * std::atan(0.5 * tan[0].get<double>()),
+                to_deg * std::atan(0.5 * tan[1].get<double>()),
+                display["viewer"]["position"][0].get<double>(),
+                display["viewer"]["position"][1].get<double>(),
+                display["viewer"]["position"][2].get<double>(), sep, json_file.c_str());
+  } else {
+    const auto& size = display["size_m"];
+    std::printf("display: %.4f m x %.4f m (%s)%s%s\n", size[0].get<double>(), size[1].get<double>(),
+                display["rect_source"].get<std::string>().c_str(), sep, json_file.c_str());
+  }
   if (!parsed->mpcdi.empty()) std::printf("MPCDI: %s\n", parsed->mpcdi.c_str());
   return 0;
 }

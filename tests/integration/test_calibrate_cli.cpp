@@ -64,11 +64,12 @@ Vec3 vector3(const nlohmann::json& a) {
   return Vec3(a.at(0).get<double>(), a.at(1).get<double>(), a.at(2).get<double>());
 }
 
-// Projector of rig.json against procam-sim's truth: the intrinsics accuracy bounds
-// (focal 0.5%, principal point 2 px), and pose ones when `pose`.
-void expectProjector(const nlohmann::json& rig, const nlohmann::json& truth, bool pose) {
-  ASSERT_EQ(rig.at("projectors").size(), 1u);
-  const auto& p = rig["projectors"][0];
+// Projector `index` of rig.json (which holds `count`) against procam-sim's truth: the
+// intrinsics accuracy bounds (focal 0.5%, principal point 2 px), and pose ones when `pose`.
+void expectProjector(const nlohmann::json& rig, const nlohmann::json& truth, bool pose,
+                     std::size_t count = 1, std::size_t index = 0) {
+  ASSERT_EQ(rig.at("projectors").size(), count);
+  const auto& p = rig["projectors"][index];
   const Mat3 K = matrix9(p.at("K")), Kt = matrix3x3(truth.at("K_matrix"));
   EXPECT_NEAR(K(0, 0), Kt(0, 0), 0.005 * Kt(0, 0));
   EXPECT_NEAR(K(1, 1), Kt(1, 1), 0.005 * Kt(1, 1));
@@ -251,6 +252,134 @@ TEST(CalibrateCli, DecodeAndSolveRouteAOnCornerStereo) {
   EXPECT_LE(surface_rms, 0.001);
   std::printf("[ figures  ] surface: %d vertices, %.3f mm RMS from the walls\n", vertices,
               1000 * surface_rms);
+}
+
+// Two projectors side by side on a curved wall (a cylinder of radius 3 m, as cylinder3 at
+// half resolution), each scanned by both cameras: one `solve` with a --projector group
+// each writes one rig.json with both projectors in the cameras' frame and a mesh beside it
+// for each, which procam-render then draws as one display for a viewer.
+TEST(CalibrateCli, SolveSeveralProjectorsIntoOneRigThatProcamRenderDraws) {
+  TempDir dir;
+  const std::string scene = writeScene(dir, "curve", R"(
+[scene]
+name = "curve"
+ambient = 0.02
+[[projectors]]
+name = "left"
+resolution = [640, 400]
+intrinsics = { hfov_deg = 50.0 }
+pose = { position = [-0.35, -0.2, 1.3], look_at = [-1.35, 2.68, 1.75] }
+blur_sigma_px = 0.5
+brightness = 10.0
+[[projectors]]
+name = "right"
+resolution = [640, 400]
+intrinsics = { hfov_deg = 50.0 }
+pose = { position = [0.35, -0.2, 1.3], look_at = [1.35, 2.68, 1.75] }
+blur_sigma_px = 0.5
+brightness = 10.0
+[[cameras]]
+name = "cam_a"
+resolution = [512, 384]
+intrinsics = { hfov_deg = 90.0 }
+distortion = { k1 = -0.04, k2 = 0.01 }
+pose = { position = [-1.2, -1.5, 1.6], look_at = [0.0, 3.0, 1.6] }
+bit_depth = 10
+read_noise_dn = 1.0
+full_well_e = 10000.0
+exposure = 0.7
+psf_sigma_px = 0.7
+supersamples = 4
+[[cameras]]
+name = "cam_b"
+resolution = [512, 384]
+intrinsics = { hfov_deg = 90.0 }
+distortion = { k1 = -0.05, k2 = 0.012 }
+pose = { position = [1.2, -1.5, 1.6], look_at = [0.0, 3.0, 1.6] }
+bit_depth = 10
+read_noise_dn = 1.0
+full_well_e = 10000.0
+exposure = 0.7
+psf_sigma_px = 0.7
+supersamples = 4
+[[surfaces]]
+name = "screen"
+type = "cylinder"
+base = [0.0, 0.0, 0.0]
+axis = [0.0, 0.0, 1.0]
+radius = 3.0
+height = 3.5
+albedo = 0.85
+)");
+  auto r = calibrate({"patterns", "--projector", "640x400", "--mode", "gray+phase", "--phase-steps",
+                      "3", "--out", dir.file("patterns")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  int seed = 11;
+  for (const char* projector : {"left", "right"}) {
+    for (const char* cam : {"cam_a", "cam_b"}) {
+      const std::string failed =
+          renderCaptures(scene, dir.file("patterns"), projector, cam,
+                         dir.file(std::string(projector) + "_" + cam), ++seed);
+      ASSERT_TRUE(failed.empty()) << failed;
+    }
+  }
+  const nlohmann::json truth = sceneTruth(scene);
+  ASSERT_FALSE(truth.is_null());
+  dir.write("cameras.json", camerasJson(truth, {"cam_a", "cam_b"}));
+  fs::create_directories(dir.file("rig"));
+  r = calibrate({"solve", "--cameras", dir.file("cameras.json"), "--out", dir.file("rig/rig.json"),
+                 "--projector", "left", "--patterns", dir.file("patterns"), "--captures",
+                 dir.file("left_cam_a"), dir.file("left_cam_b"), "--projector", "right",
+                 "--patterns", dir.file("patterns"), "--captures", dir.file("right_cam_a"),
+                 dir.file("right_cam_b")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json rig = readJsonFile(dir.file("rig/rig.json"));
+  ASSERT_FALSE(rig.is_discarded());
+  expectProjector(rig, device(truth, "projectors", "left"), true, 2, 0);
+  expectProjector(rig, device(truth, "projectors", "right"), true, 2, 1);
+  EXPECT_EQ(rig["surface"]["meshes"],
+            nlohmann::json({{"left", "surface-left.ply"}, {"right", "surface-right.ply"}}));
+  // Every mesh vertex on the true wall: within 1 mm of the radius.
+  for (const char* name : {"left", "right"}) {
+    std::ifstream ply(dir.file(std::string("rig/surface-") + name + ".ply"));
+    std::string line;
+    int vertices = -1;
+    while (std::getline(ply, line) && line != "end_header")
+      if (line.rfind("element vertex ", 0) == 0) vertices = std::stoi(line.substr(15));
+    ASSERT_GT(vertices, 100) << name;
+    double sq = 0;
+    for (int i = 0; i < vertices; ++i) {
+      double x = 0, y = 0, z = 0;
+      ASSERT_TRUE(std::getline(ply, line));
+      ASSERT_EQ(std::sscanf(line.c_str(), "%lf %lf %lf", &x, &y, &z), 3) << line;
+      sq += std::pow(std::hypot(x, y) - 3.0, 2);
+    }
+    std::printf("[ figures  ] %s: %d mesh vertices, %.3f mm RMS from the cylinder\n", name,
+                vertices, 1000 * std::sqrt(sq / vertices));
+    EXPECT_LE(std::sqrt(sq / vertices), 0.001) << name;
+  }
+  // The wrong shapes of a group are command-line errors naming the option.
+  r = calibrate({"solve", "--cameras", dir.file("cameras.json"), "--out", dir.file("x.json"),
+                 "--projector", "left", "--patterns", dir.file("patterns"), "--captures",
+                 dir.file("left_cam_a")});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--captures"), std::string::npos) << r.err;
+  r = calibrate({"solve", "--cameras", dir.file("cameras.json"), "--out", dir.file("x.json"),
+                 "--projector", "../up", "--patterns", dir.file("patterns"), "--captures",
+                 dir.file("left_cam_a"), dir.file("left_cam_b")});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_FALSE(fs::exists(dir.file("x.json")));
+
+  // procam-render draws the calibrated pair as one display for a viewer.
+  cv::imwrite(dir.file("white.png"), cv::Mat(300, 1200, CV_8UC3, cv::Scalar::all(255)));
+  const procam::itest::RunResult drawn = procam::itest::runProgram(
+      {PROCAM_RENDER_BIN, "--rig", dir.file("rig/rig.json"), "--content", dir.file("white.png"),
+       "--out", dir.file("frames"), "--viewer", "0,-0.6,1.6"});
+  ASSERT_EQ(drawn.status, 0) << drawn.err;
+  const nlohmann::json display = readJsonFile(dir.file("frames/display.json"));
+  EXPECT_EQ(display["display"]["surface"], "mesh");
+  EXPECT_EQ(display["projectors"].size(), 2u);
+  EXPECT_FALSE(cv::imread(dir.file("frames/left.png")).empty());
 }
 
 // wall_oblique: `solve` (route a) on the plane fails with the coplanar error naming
