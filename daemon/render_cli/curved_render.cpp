@@ -7,6 +7,7 @@
 #include "blend/rig_tiles.hpp"
 #include "blend/tile_frames.hpp"
 #include "content/mesh_content.hpp"
+#include "mpcdi_zip.hpp"
 #include "replace_file.hpp"
 
 namespace procam::render_cli {
@@ -104,6 +105,13 @@ Result<json> renderCurved(const CurvedRenderInput& in) {
                       {"path", "lookup-warp"},
                       {"response_gamma", made->gamma[t]},
                       {"gain", made->gain[t]}});
+  }
+  if (!in.mpcdi.empty()) {
+    std::vector<std::string> names;
+    for (const auto* p : chosen) names.push_back(p->name);
+    auto package = blend::mpcdi2d(*made, names, in.content.size(), in.date);
+    if (!package) return tl::unexpected(package.error());
+    if (auto ok = writeMpcdiZip(in.mpcdi, *package); !ok) return tl::unexpected(ok.error());
   }
   json viewer_matrix = json::array();
   for (int i = 0; i < 12; ++i) viewer_matrix.push_back(d.viewer(i / 4, i % 4));

@@ -19,13 +19,15 @@ struct CurvedRenderInput {
   std::vector<std::string> projectors;  // only these (empty: every posed one with a mesh)
   std::optional<Vec3> viewer;           // --viewer, else the rig model's
   cv::Mat content;                      // decoded, 8 or 16 bit
-  std::filesystem::path out;            // frames and display.json go here (empty: none)
+  std::filesystem::path out;            // frames go here (empty: none)
+  std::filesystem::path mpcdi;          // the MPCDI package (empty: none)
+  std::string date;                     // the package's date, in MPCDI's form
   int bit_depth = 8;
   bool geometry_only = false;
 };
 
-// Draws every share and returns display.json's document (without the rig and content
-// entries the caller adds). kNotFound without a viewer or a projector with a pose and a
+// Draws every share (with `out`), writes the MPCDI package (with `mpcdi`) and returns
+// display.json's document (without the rig and content entries the caller adds). kNotFound without a viewer or a projector with a pose and a
 // mesh; kInvalidInput for a mesh named outside the rig file's folder; errors of reading
 // the meshes and of blend::makeCurvedBlend.
 Result<nlohmann::json> renderCurved(const CurvedRenderInput& in);

@@ -156,9 +156,6 @@ namespace {
 
 Result<json> runCurved(const RenderArgs& args, const rig::RigModel& rig) {
   if (args.rect) return fail(ErrorCode::kInvalidInput, "--rect is for a planar display");
-  if (!args.mpcdi.empty())
-    return fail(ErrorCode::kInvalidInput,
-                "--mpcdi exports a planar display (MPCDI's 2D media profile); this rig is curved");
   auto content = readContent(args.content);
   if (!content) return tl::unexpected(content.error());
   std::error_code ec;
@@ -173,6 +170,8 @@ Result<json> runCurved(const RenderArgs& args, const rig::RigModel& rig) {
   in.viewer = args.viewer;
   in.content = *content;
   in.out = args.out;
+  in.mpcdi = args.mpcdi;
+  in.date = utcNow();
   in.bit_depth = args.bit_depth;
   in.geometry_only = args.geometry_only;
   auto doc = renderCurved(in);
@@ -181,6 +180,7 @@ Result<json> runCurved(const RenderArgs& args, const rig::RigModel& rig) {
   (*doc)["content"] = {{"path", args.content.string()}, {"size", {content->cols, content->rows}}};
   (*doc)["bit_depth"] = args.bit_depth;
   (*doc)["geometry_only"] = args.geometry_only;
+  if (!args.mpcdi.empty()) (*doc)["mpcdi"] = args.mpcdi.string();
   if (!args.out.empty()) {
     if (auto ok = replaceFileWith(args.out / "display.json", doc->dump(2) + "\n"); !ok)
       return tl::unexpected(ok.error());

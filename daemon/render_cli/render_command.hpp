@@ -37,7 +37,8 @@ inline constexpr const char* kUsage =
     "  --mpcdi FILE       also (or, without --out, only) export the display as VESA MPCDI,\n"
     "                     2D media profile: a zip of mpcdi.xml and per projector a warp\n"
     "                     (PFM), an alpha map (16-bit PNG, gamma embedded) and a beta map;\n"
-    "                     the content image gives the buffer's size\n"
+    "                     the content image gives the buffer's size (a curved display's\n"
+    "                     warps hold the viewer's image: right for that viewer)\n"
     "  --help             this text\n"
     "Exit status: 0 success, 1 failure, 2 bad command line.\n";
 

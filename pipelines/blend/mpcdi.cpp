@@ -66,13 +66,15 @@ const char* textOf(const tinyxml2::XMLElement* parent, const char* name) {
 
 }  // namespace
 
-Result<std::vector<MpcdiFile>> mpcdi2d(const TiledBlend& blend,
+Result<std::vector<MpcdiFile>> mpcdi2d(const BlendTables& blend,
+                                       std::span<const render::RenderSetup> geometry,
                                        const std::vector<std::string>& names, cv::Size content,
                                        const std::string& date) {
-  const std::size_t n = blend.display.content_to_framebuffer.size();
+  const std::size_t n = geometry.size();
   if (names.size() != n || blend.weights.size() != n || blend.gamma.size() != n ||
       blend.gain.size() != n)
-    return fail(ErrorCode::kInvalidInput, "MPCDI: one name, weight map, gamma and gain per tile");
+    return fail(ErrorCode::kInvalidInput,
+                "MPCDI: one name, geometry, weight map, gamma and gain per projector");
   if (content.width < 1 || content.height < 1)
     return fail(ErrorCode::kInvalidInput, "MPCDI: empty content size");
   for (const auto& id : names) {
@@ -111,16 +113,15 @@ Result<std::vector<MpcdiFile>> mpcdi2d(const TiledBlend& blend,
     region->SetAttribute("ysize", "1");
     buffer->InsertEndChild(region);
 
-    const Eigen::FullPivLU<Mat3> lu(blend.display.content_to_framebuffer[t]);
-    if (!lu.isInvertible()) return fail(ErrorCode::kInvalidInput, "MPCDI: singular homography");
-    const Mat3 fb_to_content = lu.inverse();
+    auto content_of = shareContent(geometry[t]);
+    if (!content_of) return fail(content_of.error().code, "MPCDI: " + content_of.error().message);
     cv::Mat warp(size, CV_32FC3), alpha(size, CV_16UC1);
     for (int y = 0; y < size.height; ++y) {
       for (int x = 0; x < size.width; ++x) {
-        const Vec3 p = fb_to_content * Vec3(x, y, 1);
-        const double cx = p.x() / p.z(), cy = p.y() / p.z();
-        const bool shown = p.z() > 0 && cx >= -0.5 && cy >= -0.5 && cx < content.width - 0.5 &&
-                           cy < content.height - 0.5;
+        const auto p = (*content_of)(x, y);
+        const double cx = p ? p->x() : -1e9, cy = p ? p->y() : -1e9;
+        const bool shown =
+            p && cx >= -0.5 && cy >= -0.5 && cx < content.width - 0.5 && cy < content.height - 0.5;
         // Outside the content: a fixed position off the buffer, never a mirrored one
         // from behind the wall's horizon or a value too large for a float.
         warp.at<cv::Vec3f>(y, x) = shown ? cv::Vec3f(float((cx + 0.5) / content.width),
@@ -174,6 +175,28 @@ Result<std::vector<MpcdiFile>> mpcdi2d(const TiledBlend& blend,
   doc.Print(&printer);
   out[0] = {"mpcdi.xml", std::string(printer.CStr())};
   return out;
+}
+
+Result<std::vector<MpcdiFile>> mpcdi2d(const TiledBlend& blend,
+                                       const std::vector<std::string>& names, cv::Size content,
+                                       const std::string& date) {
+  std::vector<render::RenderSetup> geometry(blend.display.content_to_framebuffer.size());
+  for (std::size_t t = 0; t < geometry.size(); ++t) {
+    geometry[t].path = render::RenderPath::kHomography;
+    geometry[t].homography = blend.display.content_to_framebuffer[t];
+  }
+  return mpcdi2d(blend, geometry, names, content, date);
+}
+
+Result<std::vector<MpcdiFile>> mpcdi2d(const CurvedBlend& blend,
+                                       const std::vector<std::string>& names, cv::Size content,
+                                       const std::string& date) {
+  std::vector<render::RenderSetup> geometry(blend.display.lookup.size());
+  for (std::size_t t = 0; t < geometry.size(); ++t) {
+    geometry[t].path = render::RenderPath::kLookupWarp;
+    geometry[t].lookup = blend.display.lookup[t];
+  }
+  return mpcdi2d(blend, geometry, names, content, date);
 }
 
 Result<MpcdiDisplay> readMpcdi2d(const std::vector<MpcdiFile>& files) {

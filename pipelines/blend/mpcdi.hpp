@@ -1,5 +1,5 @@
 #pragma once
-// A planar display as VESA MPCDI ([MPCDI] in README), 2D media profile: one buffer
+// A display as VESA MPCDI ([MPCDI] in README), 2D media profile: one buffer
 // (the content, its pixel size) and one region per projector covering all of it, each
 // with its files — a geometry warp (PFM, one sample per framebuffer pixel centre: the
 // content position it shows, normalized to [0, 1] from the content's top-left outer
@@ -10,11 +10,14 @@
 // linearizes with gammaEmbedded and re-applies the projector's gamma, draws the frames
 // procam-render draws. In memory: the caller writes the package (a zip with mpcdi.xml first).
 #include <opencv2/core.hpp>
+#include <span>
 #include <string>
 #include <vector>
 
+#include "blend/curved_display.hpp"
 #include "blend/tiled_blend.hpp"
 #include "core/error.hpp"
+#include "render/render_setup.hpp"
 
 namespace procam::blend {
 
@@ -26,9 +29,20 @@ struct MpcdiFile {
   std::string bytes;
 };
 
-// `names`: one region id per tile, [A-Za-z0-9._-]; `blend` made with its weights;
-// `date` as MPCDI writes it ("YYYY-MM-DD HH:MM:SS"). mpcdi.xml is the first file.
+// `names`: one region id per projector, [A-Za-z0-9._-]; `blend` made with its weights;
+// `geometry`: each projector's share (tile_frames.hpp shareContent: a homography or a
+// lookup warp); `date` as MPCDI writes it ("YYYY-MM-DD HH:MM:SS"). mpcdi.xml is the
+// first file. A curved display's warp holds the viewer's content for each pixel, so
+// its package is right for the viewer it was made for.
+Result<std::vector<MpcdiFile>> mpcdi2d(const BlendTables& blend,
+                                       std::span<const render::RenderSetup> geometry,
+                                       const std::vector<std::string>& names, cv::Size content,
+                                       const std::string& date);
+// A planar display's tiles, and a curved display's shares.
 Result<std::vector<MpcdiFile>> mpcdi2d(const TiledBlend& blend,
+                                       const std::vector<std::string>& names, cv::Size content,
+                                       const std::string& date);
+Result<std::vector<MpcdiFile>> mpcdi2d(const CurvedBlend& blend,
                                        const std::vector<std::string>& names, cv::Size content,
                                        const std::string& date);
 

@@ -36,21 +36,6 @@ Result<cv::Mat> rendererFrame(const cv::Mat& content, render::RenderSetup setup,
   return out;
 }
 
-// The content pixel a framebuffer pixel shows under the share's geometry, if any.
-std::function<std::optional<Vec2>(double, double)> contentOf(const render::RenderSetup& geometry) {
-  if (geometry.path == render::RenderPath::kLookupWarp) {
-    return [&grid = geometry.lookup](double x, double y) {
-      return render::gridSource(grid, Vec2(x, y));
-    };
-  }
-  const Mat3 inverse = geometry.homography.inverse();
-  return [inverse](double x, double y) -> std::optional<Vec2> {
-    const Vec3 p = inverse * Vec3(x, y, 1);
-    if (!(p.z() > 0)) return std::nullopt;
-    return Vec2(p.x() / p.z(), p.y() / p.z());
-  };
-}
-
 }  // namespace
 
 bool sampleContent(const cv::Mat& img, double x, double y, double* out) {
@@ -88,6 +73,25 @@ Result<cv::Mat> unitContent(const cv::Mat& content) {
   return unit;
 }
 
+Result<std::function<std::optional<Vec2>(double, double)>> shareContent(
+    const render::RenderSetup& geometry) {
+  if (geometry.path == render::RenderPath::kLookupWarp) {
+    return [&grid = geometry.lookup](double x, double y) {
+      return render::gridSource(grid, Vec2(x, y));
+    };
+  }
+  if (geometry.path != render::RenderPath::kHomography)
+    return fail(ErrorCode::kInvalidInput, "a share is drawn by homography or lookup warp");
+  const Eigen::FullPivLU<Mat3> lu(geometry.homography);
+  if (!lu.isInvertible()) return fail(ErrorCode::kInvalidInput, "the homography is singular");
+  const Mat3 inverse = lu.inverse();
+  return [inverse](double x, double y) -> std::optional<Vec2> {
+    const Vec3 p = inverse * Vec3(x, y, 1);
+    if (!(p.z() > 0)) return std::nullopt;
+    return Vec2(p.x() / p.z(), p.y() / p.z());
+  };
+}
+
 Result<cv::Mat> shareFrame(const cv::Mat& content, const render::RenderSetup& geometry,
                            const BlendTables& blend, std::size_t t,
                            const TileFrameOptions& options) {
@@ -99,20 +103,14 @@ Result<cv::Mat> shareFrame(const cv::Mat& content, const render::RenderSetup& ge
   if (t >= blend.alpha.size() || t >= blend.weight_lut.size() || t >= blend.gamma.size() ||
       t >= blend.gain.size())
     return fail(ErrorCode::kInvalidInput, "projector index out of range");
-  if (geometry.path != render::RenderPath::kHomography &&
-      geometry.path != render::RenderPath::kLookupWarp)
-    return fail(ErrorCode::kInvalidInput, "a share is drawn by homography or lookup warp");
-  if (geometry.path == render::RenderPath::kHomography) {
-    const Eigen::FullPivLU<Mat3> lu(geometry.homography);
-    if (!lu.isInvertible()) return fail(ErrorCode::kInvalidInput, "the homography is singular");
-  }
+  auto to_content = shareContent(geometry);
+  if (!to_content) return tl::unexpected(to_content.error());
   if (options.bit_depth == 8 && content.depth() == CV_8U) {
     return rendererFrame(content, geometry, blend, t, options.geometry_only);
   }
   if (!options.geometry_only && t >= blend.weights.size())
     return fail(ErrorCode::kInvalidInput, "the blend was made without its weights");
   const cv::Size size = blend.alpha[t].size();
-  const auto to_content = contentOf(geometry);
   auto unit = unitContent(content);
   if (!unit) return tl::unexpected(unit.error());
   const cv::Mat& src = *unit;
@@ -125,7 +123,7 @@ Result<cv::Mat> shareFrame(const cv::Mat& content, const render::RenderSetup& ge
     double v[3];
     for (int y = rows.start; y < rows.end; ++y) {
       for (int x = 0; x < size.width; ++x) {
-        const auto p = to_content(x, y);
+        const auto p = (*to_content)(x, y);
         if (!p || !sampleContent(src, p->x(), p->y(), v)) continue;
         // Emitted light goes as code^gamma: (gain w)^(1/gamma) scales it by gain w.
         const double scale = options.geometry_only

@@ -8,7 +8,9 @@
 //    and sampled bilinearly in double precision (render/bilinear.hpp's convention), so a
 //    16-bit ramp keeps its codes; blended, each channel is scaled by
 //    (gain weight)^(1 / gamma) with the unquantized weight.
+#include <functional>
 #include <opencv2/core.hpp>
+#include <optional>
 
 #include "blend/curved_display.hpp"
 #include "blend/tiled_blend.hpp"
@@ -21,6 +23,13 @@ struct TileFrameOptions {
   int bit_depth = 8;           // 8 or 16
   bool geometry_only = false;  // no weights, no response correction
 };
+
+// The content position a framebuffer pixel (x, y) shows under a share's geometry
+// (kHomography: its inverse; kLookupWarp: render::gridSource), nullopt where none. The
+// function refers to `geometry`'s grid: keep it alive. kInvalidInput for another path or
+// a singular homography.
+Result<std::function<std::optional<Vec2>(double, double)>> shareContent(
+    const render::RenderSetup& geometry);
 
 // `content`: CV_8U or CV_16U with 1, 3 or 4 channels (OpenCV's BGR(A) order). Returns a
 // CV_8U or CV_16U image of projector t's framebuffer size with 1 channel for grey
