@@ -312,11 +312,67 @@ tl::expected<void, CalibrationFailure> blankOutput(const IdleOutput& idle) {
   return {};
 }
 
+namespace {
+
+// Shows `rgb` on every member's output, then waits `settle_frames` refreshes once.
+tl::expected<bool, CalibrationFailure> showAllAndSettle(
+    std::span<const CalibrationPlan* const> members, const cv::Mat& rgb, const char* what,
+    int settle_frames, const CalibrationHooks& hooks) {
+  for (std::size_t m = 0; m + 1 < members.size(); ++m) {
+    auto shown = showAndSettle(*members[m], rgb, what, 0, hooks);
+    if (!shown) return shown;
+  }
+  return showAndSettle(*members.back(), rgb, what, settle_frames, hooks);
+}
+
+// The decoded map of one member of a batch: only where its footprint lies (other
+// pixels flagged as shadow: another member's light).
+sl::Decoded maskedToFootprint(const sl::Decoded& d, const cv::Mat& footprint) {
+  if (footprint.empty()) return d;
+  sl::Decoded out = d;
+  out.u = d.u.clone();
+  out.v = d.v.clone();
+  out.confidence = d.confidence.clone();
+  out.flags = d.flags.clone();
+  const cv::Mat outside = footprint == 0;
+  out.flags.setTo(sl::kShadow, outside);
+  out.u.setTo(-1.0f, outside);
+  out.v.setTo(-1.0f, outside);
+  out.confidence.setTo(0.0f, outside);
+  out.decoded = cv::countNonZero(out.flags == 0);
+  return out;
+}
+
+}  // namespace
+
 tl::expected<CalibrationOutcome, CalibrationFailure> runCalibration(const CalibrationPlan& plan,
                                                                     const CalibrationHooks& hooks) {
+  const CalibrationPlan* one[] = {&plan};
+  auto outcomes = runBatchCalibration(one, {}, hooks);
+  if (!outcomes) return tl::unexpected(outcomes.error());
+  return std::move(outcomes->front());
+}
+
+tl::expected<std::vector<CalibrationOutcome>, CalibrationFailure> runBatchCalibration(
+    std::span<const CalibrationPlan* const> members,
+    const std::vector<std::vector<cv::Mat>>& footprints, const CalibrationHooks& hooks) {
   const CalibrationFailure cancelled{code::kCancelled, "calibration cancelled"};
+  if (members.empty() || (!footprints.empty() && footprints.size() != members.size()) ||
+      (members.size() > 1 && footprints.empty())) {
+    return tl::unexpected(CalibrationFailure{code::kFailed,
+                                             "internal: a scan batch without "
+                                             "its members' footprints"});
+  }
+  const CalibrationPlan& plan = *members.front();
+  for (const CalibrationPlan* m : members) {
+    if (members.size() > 1 && m->board) {
+      return tl::unexpected(CalibrationFailure{
+          code::kFailed, "internal: a board's plane is found with one projector at a time"});
+    }
+  }
   const int total = plan.captures();
-  CalibrationOutcome outcome;
+  std::vector<CalibrationOutcome> outcomes(members.size());
+  CalibrationOutcome& outcome = outcomes.front();
   outcome.settle_frames = plan.settle_frames;
   double start = 0;  // progress fraction where the captures start
   if (plan.auto_settle) {
@@ -345,7 +401,7 @@ tl::expected<CalibrationOutcome, CalibrationFailure> runCalibration(const Calibr
     if (hooks.cancelled()) return tl::unexpected(cancelled);
     cv::Mat rgb;
     cv::cvtColor(sl::renderFrame(plan.set, f), rgb, cv::COLOR_GRAY2RGB);
-    auto shown = showAndSettle(plan, rgb, "show a pattern", outcome.settle_frames, hooks);
+    auto shown = showAllAndSettle(members, rgb, "show a pattern", outcome.settle_frames, hooks);
     if (!shown) return tl::unexpected(shown.error());
     if (!*shown) return tl::unexpected(cancelled);
     for (std::size_t c = 0; c < plan.cameras.size(); ++c) {
@@ -371,7 +427,7 @@ tl::expected<CalibrationOutcome, CalibrationFailure> runCalibration(const Calibr
     if (hooks.cancelled()) return tl::unexpected(cancelled);
     const cv::Mat grey(plan.set.options.height, plan.set.options.width, CV_8UC3,
                        cv::Scalar::all(level));
-    auto shown = showAndSettle(plan, grey, "show a grey", outcome.settle_frames, hooks);
+    auto shown = showAllAndSettle(members, grey, "show a grey", outcome.settle_frames, hooks);
     if (!shown) return tl::unexpected(shown.error());
     if (!*shown) return tl::unexpected(cancelled);
     auto gray = captureGray(plan.cameras[0]);
@@ -380,7 +436,7 @@ tl::expected<CalibrationOutcome, CalibrationFailure> runCalibration(const Calibr
     ++done;
     hooks.progress({start + (0.9 - start) * done / total, "capturing", done});
   }
-  std::vector<calib::DecodedView> views;
+  std::vector<sl::Decoded> decoded;  // per camera, the whole batch
   for (std::size_t c = 0; c < plan.cameras.size(); ++c) {
     hooks.progress({0.9 + 0.05 * c / plan.cameras.size(), "decoding", total});
     auto d = sl::decode(plan.set, captures[c]);
@@ -388,42 +444,175 @@ tl::expected<CalibrationOutcome, CalibrationFailure> runCalibration(const Calibr
       return tl::unexpected(CalibrationFailure{
           code::kFailed, "camera '" + plan.cameras[c].device.name + "': " + d.error().message});
     }
-    if (d->decoded == 0) {
-      return tl::unexpected(CalibrationFailure{
-          code::kFailed, "camera '" + plan.cameras[c].device.name +
-                             "' decoded no pixel: it does not see the projected patterns"});
-    }
-    outcome.decoded.push_back(d->decoded);
-    if (c == 0 && !ramp.empty()) {
-      auto response = rampResponse(ramp, d->flags);
-      if (!response) {
-        return tl::unexpected(CalibrationFailure{
-            code::kFailed, "the response of output '" + plan.output.name + "' seen by camera '" +
-                               plan.cameras[0].device.name + "': " + response.error().message});
-      }
-      outcome.response = *response;
-    }
-    views.push_back({plan.cameras[c].device.name, plan.cameras[c].model, std::move(*d)});
+    decoded.push_back(std::move(*d));
     if (hooks.cancelled()) return tl::unexpected(cancelled);
   }
   hooks.progress({0.95, "solving", total});
-  if (plan.planar()) {
-    if (plan.board && !outcome.board) {
-      return tl::unexpected(
-          CalibrationFailure{code::kFailed, "the pattern set has no white frame"});
+  for (std::size_t m = 0; m < members.size(); ++m) {
+    const CalibrationPlan& member = *members[m];
+    CalibrationOutcome& out = outcomes[m];
+    if (m > 0) {
+      out.settle_frames = outcome.settle_frames;
+      out.latency = outcome.latency;
     }
-    const geom::Plane plane = plan.board ? outcome.board->plane : *plan.plane;
-    auto planar = calib::solvePlaneHomographyRoute(plan.set, views[0], plane, {.step = plan.grid});
-    if (!planar) {
-      return tl::unexpected(CalibrationFailure{code::kFailed, planar.error().message});
+    std::vector<calib::DecodedView> views;
+    for (std::size_t c = 0; c < member.cameras.size(); ++c) {
+      sl::Decoded d =
+          maskedToFootprint(decoded[c], footprints.empty() ? cv::Mat() : footprints[m][c]);
+      if (d.decoded == 0) {
+        return tl::unexpected(CalibrationFailure{
+            code::kFailed, "camera '" + member.cameras[c].device.name +
+                               "' decoded no pixel of output '" + member.output.name +
+                               "': it does not see the projected patterns"});
+      }
+      out.decoded.push_back(d.decoded);
+      if (c == 0 && !ramp.empty()) {
+        auto response = rampResponse(ramp, d.flags);
+        if (!response) {
+          return tl::unexpected(CalibrationFailure{
+              code::kFailed, "the response of output '" + member.output.name +
+                                 "' seen by camera '" + member.cameras[0].device.name +
+                                 "': " + response.error().message});
+        }
+        out.response = *response;
+      }
+      views.push_back({member.cameras[c].device.name, member.cameras[c].model, std::move(d)});
     }
-    outcome.planar = std::move(*planar);
-    return outcome;
+    if (member.planar()) {
+      if (member.board && !outcome.board) {
+        return tl::unexpected(
+            CalibrationFailure{code::kFailed, "the pattern set has no white frame"});
+      }
+      if (member.board) out.board = outcome.board;
+      const geom::Plane plane = member.board ? out.board->plane : *member.plane;
+      auto planar =
+          calib::solvePlaneHomographyRoute(member.set, views[0], plane, {.step = member.grid});
+      if (!planar) {
+        return tl::unexpected(CalibrationFailure{code::kFailed, planar.error().message});
+      }
+      out.planar = std::move(*planar);
+      continue;
+    }
+    auto route = calib::solveStereoRoute(member.set, views[0], views[1], member.grid);
+    if (!route) return tl::unexpected(CalibrationFailure{code::kFailed, route.error().message});
+    out.route = std::move(*route);
   }
-  auto route = calib::solveStereoRoute(plan.set, views[0], views[1], plan.grid);
-  if (!route) return tl::unexpected(CalibrationFailure{code::kFailed, route.error().message});
-  outcome.route = std::move(*route);
-  return outcome;
+  return outcomes;
+}
+
+namespace {
+
+// Camera pixels a projector lights: white minus black above a fifth of its 99.5th
+// percentile (the projector's light, whatever the exposure), specks opened away, then
+// dilated by 4 pixels for the blur of its edge. Empty (all zero) when the camera sees
+// too little of it: a 99.5th percentile under 5 % of the white view's.
+cv::Mat litPixels(const cv::Mat& white, const cv::Mat& black) {
+  cv::Mat w, b, diff;
+  white.convertTo(w, CV_32F);
+  black.convertTo(b, CV_32F);
+  cv::subtract(w, b, diff);
+  auto percentile = [](const cv::Mat& m, double q) {
+    std::vector<float> v;
+    for (int y = 0; y < m.rows; y += 2) {
+      const float* r = m.ptr<float>(y);
+      for (int x = 0; x < m.cols; x += 2) v.push_back(r[x]);
+    }
+    if (v.empty()) return 0.0f;
+    const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(q * v.size()));
+    std::nth_element(v.begin(), v.begin() + k, v.end());
+    return v[k];
+  };
+  const float top = percentile(diff, 0.995), bright = percentile(w, 0.995);
+  cv::Mat mask(diff.size(), CV_8UC1, cv::Scalar(0));
+  if (!(top > 0.05f * bright) || !(top > 0)) return mask;
+  mask = diff > 0.2f * top;
+  const cv::Mat k3 = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
+  cv::morphologyEx(mask, mask, cv::MORPH_OPEN, k3);
+  cv::dilate(mask, mask, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(9, 9)));
+  return mask;
+}
+
+// Whether two plans can share a batch: the same frames on the same cameras, one route.
+bool batchable(const CalibrationPlan& a, const CalibrationPlan& b) {
+  if (a.board || b.board || a.set.frames.size() != b.set.frames.size() ||
+      a.set.options.width != b.set.options.width || a.set.options.height != b.set.options.height ||
+      a.set.options.mode != b.set.options.mode || a.response != b.response ||
+      a.auto_settle != b.auto_settle || a.settle_frames != b.settle_frames ||
+      a.cameras.size() != b.cameras.size() || a.planar() != b.planar())
+    return false;
+  for (std::size_t c = 0; c < a.cameras.size(); ++c) {
+    if (a.cameras[c].device.name != b.cameras[c].device.name) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+tl::expected<ScanBatches, CalibrationFailure> planScanBatches(
+    std::span<const CalibrationPlan* const> plans, const CalibrationHooks& hooks) {
+  const CalibrationFailure cancelled{code::kCancelled, "calibration cancelled"};
+  ScanBatches out;
+  if (plans.empty()) return out;
+  const CalibrationPlan& first = *plans.front();
+  const std::size_t cams = first.cameras.size();
+  // Every projector of the run shows black already.
+  if (!waitCancellable(first.settle_frames / first.refresh_hz, hooks))
+    return tl::unexpected(cancelled);
+  std::vector<cv::Mat> black;
+  for (const auto& cam : first.cameras) {
+    auto gray = captureGray(cam);
+    if (!gray) return tl::unexpected(gray.error());
+    black.push_back(std::move(*gray));
+  }
+  out.footprints.resize(plans.size());
+  for (std::size_t i = 0; i < plans.size(); ++i) {
+    const CalibrationPlan& p = *plans[i];
+    const cv::Mat white(p.set.options.height, p.set.options.width, CV_8UC3, cv::Scalar::all(255));
+    auto shown = showAndSettle(p, white, "show white", p.settle_frames, hooks);
+    if (!shown) return tl::unexpected(shown.error());
+    if (!*shown) return tl::unexpected(cancelled);
+    for (std::size_t c = 0; c < cams; ++c) {
+      // Plans of other cameras are never batched with these: no footprint for them.
+      if (p.cameras.size() != cams || p.cameras[c].device.name != first.cameras[c].device.name) {
+        out.footprints[i].emplace_back();
+        continue;
+      }
+      auto gray = captureGray(p.cameras[c]);
+      if (!gray) return tl::unexpected(gray.error());
+      out.footprints[i].push_back(gray->size() == black[c].size() ? litPixels(*gray, black[c])
+                                                                  : cv::Mat());
+    }
+    if (auto ok = blankOutput(p); !ok) return tl::unexpected(ok.error());
+    hooks.progress({0.0, "finding overlaps", static_cast<int>(i + 1)});
+  }
+  out.captures = static_cast<int>((plans.size() + 1) * cams);
+  // Overlap: the (dilated) lit pixels of two projectors meet in some camera.
+  auto overlap = [&](std::size_t i, std::size_t j) {
+    for (std::size_t c = 0; c < cams; ++c) {
+      const cv::Mat& a = out.footprints[i][c];
+      const cv::Mat& b = out.footprints[j][c];
+      if (a.empty() || b.empty() || a.size() != b.size()) return true;  // cannot tell
+      if (cv::countNonZero(a & b) > 0) return true;
+    }
+    return false;
+  };
+  for (std::size_t i = 0; i < plans.size(); ++i) {
+    bool placed = false;
+    for (auto& batch : out.batches) {
+      bool fits = true;
+      for (std::size_t j : batch) {
+        fits = fits && batchable(*plans[i], *plans[j]) && !overlap(i, j) &&
+               cv::countNonZero(out.footprints[i][0]) > 0;
+      }
+      if (fits) {
+        batch.push_back(i);
+        placed = true;
+        break;
+      }
+    }
+    if (!placed) out.batches.push_back({i});
+  }
+  return out;
 }
 
 }  // namespace procam::daemon

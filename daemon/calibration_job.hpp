@@ -9,7 +9,9 @@
 #include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -143,5 +145,28 @@ tl::expected<void, CalibrationFailure> blankOutput(const IdleOutput& idle);
 // Runs on a worker: blocks on the devices; never touches daemon state.
 tl::expected<CalibrationOutcome, CalibrationFailure> runCalibration(const CalibrationPlan& plan,
                                                                     const CalibrationHooks& hooks);
+
+// Several projectors whose images do not overlap scanned at once: every member shows
+// the same pattern frames (the same pattern set and cameras; no board), the captures are
+// decoded once and each member keeps the camera pixels of its own footprint
+// (`footprints[m][c]`: camera c's CV_8U mask of member m's light; empty for a batch of
+// one), then each is solved as alone. One outcome per member.
+tl::expected<std::vector<CalibrationOutcome>, CalibrationFailure> runBatchCalibration(
+    std::span<const CalibrationPlan* const> members,
+    const std::vector<std::vector<cv::Mat>>& footprints, const CalibrationHooks& hooks);
+
+// The scan batches of a run: a coarse pass lights each projector white alone (the others
+// black) and takes every camera's view of it against one all-black view; projectors
+// whose lit pixels meet in no camera (after a margin for blur) share a batch when their
+// plans allow it (same pattern set and cameras, no board), so three projectors in a row
+// take two batches, not three ([Raskar02] §4.1.1 scans one projector at a time; light
+// that does not overlap can be told apart by where it falls).
+struct ScanBatches {
+  std::vector<std::vector<std::size_t>> batches;  // plan indices, scan order
+  std::vector<std::vector<cv::Mat>> footprints;   // per plan, per camera
+  int captures = 0;                               // of the coarse pass
+};
+tl::expected<ScanBatches, CalibrationFailure> planScanBatches(
+    std::span<const CalibrationPlan* const> plans, const CalibrationHooks& hooks);
 
 }  // namespace procam::daemon

@@ -374,29 +374,66 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
             if (auto ok = blankOutput(*p); !ok && result) result = tl::unexpected(ok.error());
           }
         }
-        int done = 0;
-        for (std::size_t i = 0; i < plans.size() && result; ++i) {
-          const double share = double(plans[i]->captures()) / std::max(1, captures);
+        // Which projectors light disjoint parts of the cameras' views and can be scanned
+        // together (calibration_job.hpp planScanBatches); one at a time otherwise.
+        ScanBatches scan;
+        if (plans.size() > 1 && result) {
+          std::vector<const CalibrationPlan*> all;
+          for (const auto& p : plans) all.push_back(p.get());
+          auto planned = planScanBatches(all, hooks);
+          if (planned) {
+            scan = std::move(*planned);
+          } else {
+            result = tl::unexpected(planned.error());
+          }
+        } else {
+          scan.batches = {{0}};
+        }
+        int done = scan.captures;
+        std::vector<std::optional<CalibrationOutcome>> by_plan(plans.size());
+        for (std::size_t b = 0; b < scan.batches.size() && result; ++b) {
+          const std::vector<std::size_t>& batch = scan.batches[b];
+          std::vector<const CalibrationPlan*> members;
+          std::vector<std::vector<cv::Mat>> footprints;
+          std::string names;
+          for (std::size_t i : batch) {
+            members.push_back(plans[i].get());
+            if (batch.size() > 1) footprints.push_back(scan.footprints[i]);
+            names += (names.empty() ? "'" : ", '") + plans[i]->output.name + "'";
+          }
+          const int batch_captures = members.front()->captures();
+          const double share = double(batch_captures) / std::max(1, captures);
           const double before = double(done) / std::max(1, captures);
           CalibrationHooks one{
               hooks.cancelled, [&, share, before, done](const CalibrationProgress& p) {
                 hooks.progress({before + share * p.fraction, p.stage, done + p.capture});
               }};
-          auto r = runCalibration(*plans[i], one);
+          auto r = runBatchCalibration(members, footprints, one);
           if (!r) {
             Failure f = r.error();
-            if (plans.size() > 1)
-              f.message = "output '" + plans[i]->output.name + "': " + f.message;
+            if (plans.size() > 1) f.message = "output " + names + ": " + f.message;
             result = tl::unexpected(f);
           } else {
-            result->push_back(std::move(*r));
+            for (std::size_t k = 0; k < batch.size(); ++k) by_plan[batch[k]] = std::move((*r)[k]);
             if (plans.size() > 1) {
-              if (auto ok = blankOutput(*plans[i]); !ok) result = tl::unexpected(ok.error());
+              for (const CalibrationPlan* m : members) {
+                if (auto ok = blankOutput(*m); !ok) result = tl::unexpected(ok.error());
+              }
             }
           }
-          done += plans[i]->captures();
+          done += batch_captures;
         }
-        return [this, client, req, op_id, cancelled, plans, result, progress, captures] {
+        if (result) {
+          for (auto& o : by_plan) result->push_back(std::move(*o));
+        }
+        json batches = json::array();
+        for (const auto& batch : scan.batches) {
+          json names = json::array();
+          for (std::size_t i : batch) names.push_back(plans[i]->output.name);
+          batches.push_back(std::move(names));
+        }
+        const json scanned = {{"batches", std::move(batches)}, {"captures", done}};
+        return [this, client, req, op_id, cancelled, plans, result, progress, captures, scanned] {
           auto finish = [this, client, req, op_id](const json& reply, const Failure* failure) {
             operations_.erase(op_id);
             calibration_.op.clear();
@@ -450,7 +487,10 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
             if (i == 0) reply = learnt.reply;
             per_output.push_back(std::move(learnt.reply));
           }
-          if (plans.size() > 1) reply["outputs"] = per_output;
+          if (plans.size() > 1) {
+            reply["outputs"] = per_output;
+            reply["scan"] = scanned;
+          }
           reply["operation"] = op_id;
           reply["state"] = "done";
           // fsync may block: the I/O worker writes the meshes first, then rig.json

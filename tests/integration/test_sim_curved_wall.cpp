@@ -168,9 +168,15 @@ TEST(SimCurvedWall, ThreeProjectorsCalibratedIntoOneDisplayForTheSweetSpot) {
     EXPECT_EQ(o["surface_type"], "mesh") << name;
     EXPECT_NEAR(o["response"]["response_gamma"].get<double>(), spec[name].gamma, 0.05) << name;
   }
-  std::printf("[ figures  ] three projectors calibrated in %.1f s (%d captures)\n",
-              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
-              (*started)["captures"].get<int>());
+  // proj_l and proj_r light disjoint parts of the wall: scanned together, then proj_c.
+  EXPECT_EQ((*done)["scan"]["batches"], json({{"proj_l", "proj_r"}, {"proj_c"}})) << done->dump();
+  std::printf(
+      "[ figures  ] three projectors calibrated in %.1f s: %d captures in %zu scan batches "
+      "(%d one at a time)\n",
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+      (*done)["scan"]["captures"].get<int>(), (*done)["scan"]["batches"].size(),
+      (*started)["captures"].get<int>());
+  EXPECT_LT((*done)["scan"]["captures"].get<int>(), (*started)["captures"].get<int>());
 
   // A white panorama on the one display.
   const std::string png = contentFile(dir, "panorama.png");
