@@ -502,8 +502,9 @@ tl::expected<std::vector<CalibrationOutcome>, CalibrationFailure> runBatchCalibr
 
 namespace {
 
-// Camera pixels a projector lights: white minus black above a fifth of its 99.5th
-// percentile (the projector's light, whatever the exposure), specks opened away, then
+// Camera pixels a projector lights: white minus black above 5 % of its 99.5th
+// percentile (the projector's light, whatever the exposure: the dim far or grazing parts
+// of a curved wall stay in, the camera's noise out), specks opened away, then
 // dilated by 4 pixels for the blur of its edge. Empty (all zero) when the camera sees
 // too little of it: a 99.5th percentile under 5 % of the white view's.
 cv::Mat litPixels(const cv::Mat& white, const cv::Mat& black) {
@@ -525,7 +526,7 @@ cv::Mat litPixels(const cv::Mat& white, const cv::Mat& black) {
   const float top = percentile(diff, 0.995), bright = percentile(w, 0.995);
   cv::Mat mask(diff.size(), CV_8UC1, cv::Scalar(0));
   if (!(top > 0.05f * bright) || !(top > 0)) return mask;
-  mask = diff > 0.2f * top;
+  mask = diff > 0.05f * top;
   const cv::Mat k3 = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
   cv::morphologyEx(mask, mask, cv::MORPH_OPEN, k3);
   cv::dilate(mask, mask, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(9, 9)));
@@ -536,9 +537,9 @@ cv::Mat litPixels(const cv::Mat& white, const cv::Mat& black) {
 bool batchable(const CalibrationPlan& a, const CalibrationPlan& b) {
   if (a.board || b.board || a.set.frames.size() != b.set.frames.size() ||
       a.set.options.width != b.set.options.width || a.set.options.height != b.set.options.height ||
-      a.set.options.mode != b.set.options.mode || a.response != b.response ||
-      a.auto_settle != b.auto_settle || a.settle_frames != b.settle_frames ||
-      a.cameras.size() != b.cameras.size() || a.planar() != b.planar())
+      a.set.options.mode != b.set.options.mode || a.response != b.response || a.auto_settle ||
+      b.auto_settle || a.settle_frames != b.settle_frames || a.cameras.size() != b.cameras.size() ||
+      a.planar() != b.planar())
     return false;
   for (std::size_t c = 0; c < a.cameras.size(); ++c) {
     if (a.cameras[c].device.name != b.cameras[c].device.name) return false;
@@ -547,6 +548,15 @@ bool batchable(const CalibrationPlan& a, const CalibrationPlan& b) {
 }
 
 }  // namespace
+
+bool mayBatch(std::span<const CalibrationPlan* const> plans) {
+  for (std::size_t i = 0; i < plans.size(); ++i) {
+    for (std::size_t j = i + 1; j < plans.size(); ++j) {
+      if (batchable(*plans[i], *plans[j])) return true;
+    }
+  }
+  return false;
+}
 
 tl::expected<ScanBatches, CalibrationFailure> planScanBatches(
     std::span<const CalibrationPlan* const> plans, const CalibrationHooks& hooks) {
@@ -583,7 +593,8 @@ tl::expected<ScanBatches, CalibrationFailure> planScanBatches(
                                                                   : cv::Mat());
     }
     if (auto ok = blankOutput(p); !ok) return tl::unexpected(ok.error());
-    hooks.progress({0.0, "finding overlaps", static_cast<int>(i + 1)});
+    hooks.progress(
+        {double(i + 1) / plans.size(), "finding overlaps", static_cast<int>((i + 2) * cams)});
   }
   out.captures = static_cast<int>((plans.size() + 1) * cams);
   // Overlap: the (dilated) lit pixels of two projectors meet in some camera.
@@ -596,13 +607,20 @@ tl::expected<ScanBatches, CalibrationFailure> planScanBatches(
     }
     return false;
   };
+  // Seen: every camera sees some of its light (one that does not is scanned alone, and
+  // fails or succeeds as it would have).
+  auto seen = [&](std::size_t i) {
+    for (const cv::Mat& m : out.footprints[i]) {
+      if (m.empty() || cv::countNonZero(m) == 0) return false;
+    }
+    return !out.footprints[i].empty();
+  };
   for (std::size_t i = 0; i < plans.size(); ++i) {
     bool placed = false;
     for (auto& batch : out.batches) {
-      bool fits = true;
+      bool fits = seen(i);
       for (std::size_t j : batch) {
-        fits = fits && batchable(*plans[i], *plans[j]) && !overlap(i, j) &&
-               cv::countNonZero(out.footprints[i][0]) > 0;
+        fits = fits && seen(j) && batchable(*plans[i], *plans[j]) && !overlap(i, j);
       }
       if (fits) {
         batch.push_back(i);

@@ -158,9 +158,10 @@ tl::expected<std::vector<CalibrationOutcome>, CalibrationFailure> runBatchCalibr
 // The scan batches of a run: a coarse pass lights each projector white alone (the others
 // black) and takes every camera's view of it against one all-black view; projectors
 // whose lit pixels meet in no camera (after a margin for blur) share a batch when their
-// plans allow it (same pattern set and cameras, no board), so three projectors in a row
-// take two batches, not three ([Raskar02] §4.1.1 scans one projector at a time; light
-// that does not overlap can be told apart by where it falls).
+// plans allow it (same pattern set and cameras, settle frames given, no board; the
+// caller runs it only when some pair can share), so three projectors in a row
+// take two batches, not three: light that does not overlap is told apart by where it
+// falls.
 struct ScanBatches {
   std::vector<std::vector<std::size_t>> batches;  // plan indices, scan order
   std::vector<std::vector<cv::Mat>> footprints;   // per plan, per camera
@@ -168,5 +169,8 @@ struct ScanBatches {
 };
 tl::expected<ScanBatches, CalibrationFailure> planScanBatches(
     std::span<const CalibrationPlan* const> plans, const CalibrationHooks& hooks);
+// Whether planScanBatches could put any two of `plans` in one batch (so its coarse pass
+// is worth its captures); (plans + 1) x cameras captures when it runs.
+bool mayBatch(std::span<const CalibrationPlan* const> plans);
 
 }  // namespace procam::daemon

@@ -323,11 +323,16 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
   std::vector<std::string> used;
   json output_names = json::array();
   int captures = 0;
+  std::vector<const CalibrationPlan*> all;
   for (const auto& p : plans) {
     used.push_back(p->output.name);
     output_names.push_back(p->output.name);
     captures += p->captures();
+    all.push_back(p.get());
   }
+  // The coarse pass that finds which projectors can be scanned together, when any can.
+  const bool batching = plans.size() > 1 && mayBatch(all);
+  if (batching) captures += static_cast<int>((plans.size() + 1) * plans.front()->cameras.size());
   for (const auto& c : plan->cameras) used.push_back(c.device.name);
   // The gate closes here; a read the device manager has running on one of
   // these devices ends before the worker's first driver call (read_fence.hpp).
@@ -360,7 +365,8 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
   const CalibrationHooks hooks = operationHooks(client, op_id, cancelled, progress);
   using Outcomes = tl::expected<std::vector<CalibrationOutcome>, Failure>;
   compute_worker_->submit(
-      [this, client, req, op_id, cancelled, plans, idle, progress, hooks, fence, captures] {
+      [this, client, req, op_id, cancelled, plans, idle, progress, hooks, fence, captures,
+       batching] {
         fence.wait();
         // The projectors one after the other; progress over the whole run.
         Outcomes result = std::vector<CalibrationOutcome>{};
@@ -377,17 +383,22 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
         // Which projectors light disjoint parts of the cameras' views and can be scanned
         // together (calibration_job.hpp planScanBatches); one at a time otherwise.
         ScanBatches scan;
-        if (plans.size() > 1 && result) {
+        if (batching && result) {
           std::vector<const CalibrationPlan*> all;
           for (const auto& p : plans) all.push_back(p.get());
-          auto planned = planScanBatches(all, hooks);
+          // Its progress: a share of the run's captures.
+          const CalibrationHooks coarse{
+              hooks.cancelled, [&](const CalibrationProgress& p) {
+                hooks.progress({double(p.capture) / captures, p.stage, p.capture});
+              }};
+          auto planned = planScanBatches(all, coarse);
           if (planned) {
             scan = std::move(*planned);
           } else {
             result = tl::unexpected(planned.error());
           }
         } else {
-          scan.batches = {{0}};
+          for (std::size_t i = 0; i < plans.size(); ++i) scan.batches.push_back({i});
         }
         int done = scan.captures;
         std::vector<std::optional<CalibrationOutcome>> by_plan(plans.size());

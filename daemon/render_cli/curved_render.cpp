@@ -39,10 +39,6 @@ Result<json> renderCurved(const CurvedRenderInput& in) {
     const bool asked =
         std::find(in.projectors.begin(), in.projectors.end(), p.name) != in.projectors.end();
     if (!in.projectors.empty() && !asked) continue;
-    if (!blend::isSafeRegionId(p.name))
-      return fail(
-          ErrorCode::kInvalidInput,
-          "projector name '" + p.name + "' cannot name a file (1-128 of A-Z a-z 0-9 . _ -)");
     const auto mesh_it = rig.surface.meshes.find(p.name);
     const std::string file =
         mesh_it != rig.surface.meshes.end() ? mesh_it->second : rig.surface.unified_mesh;
@@ -54,6 +50,10 @@ Result<json> renderCurved(const CurvedRenderInput& in) {
       skipped.push_back(p.name + ": " + why);
       continue;
     }
+    if (!blend::isSafeRegionId(p.name))
+      return fail(
+          ErrorCode::kInvalidInput,
+          "projector name '" + p.name + "' cannot name a file (1-128 of A-Z a-z 0-9 . _ -)");
     if (!plainFileName(file))
       return fail(ErrorCode::kInvalidInput,
                   "surface mesh '" + file + "' is not a file name beside the rig model");

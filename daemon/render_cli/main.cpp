@@ -38,12 +38,15 @@ static int run(int argc, char** argv) {
   const char* sep = parsed->out.empty() ? "" : ", ";
   const std::string json_file = parsed->out.empty() ? "" : (parsed->out / "display.json").string();
   if (display.value("surface", "") == "mesh") {
-    // A curved display: its field of view as the viewer sees it.
-    const auto& tan = display["rect_tan"]["size"];
-    const double to_deg = 360 / 3.141592653589793;
+    // A curved display: its field of view as the viewer sees it (the rectangle on the
+    // eye's plane z = 1, possibly off its axis).
+    const auto& rect = display["rect_tan"];
+    const double cx = rect["centre"][0].get<double>(), cy = rect["centre"][1].get<double>();
+    const double hw = 0.5 * rect["size"][0].get<double>(), hh = 0.5 * rect["size"][1].get<double>();
+    const double to_deg = 180 / 3.141592653589793;
     std::printf("display: %.2f x %.2f deg seen from (%.3f, %.3f, %.3f)%s%s\n",
-                to_deg * std::atan(0.5 * tan[0].get<double>()),
-                to_deg * std::atan(0.5 * tan[1].get<double>()),
+                to_deg * (std::atan(cx + hw) - std::atan(cx - hw)),
+                to_deg * (std::atan(cy + hh) - std::atan(cy - hh)),
                 display["viewer"]["position"][0].get<double>(),
                 display["viewer"]["position"][1].get<double>(),
                 display["viewer"]["position"][2].get<double>(), sep, json_file.c_str());

@@ -85,15 +85,51 @@ Result<CurvedDisplay> solveCurvedDisplay(std::span<const SurfaceProjector> proje
   out.rect = largest->rect;
   out.cell = largest->cell;
   out.union_area = largest->region_area;
-  out.viewer = render::contentViewMatrix(R, eye, out.rect, content);
-  if (!out.viewer.allFinite()) return fail(ErrorCode::kDegenerate, "degenerate display rectangle");
-  for (std::size_t m = 0; m < projectors.size(); ++m) {
-    auto grid = render::lookupGridForViewer(*projectors[m].surface, projectors[m].projector,
-                                            projectors[m].size, out.viewer, options.lookup_step);
-    if (!grid) return tl::unexpected(grid.error());
-    out.lookup.push_back(std::move(*grid));
+  // The lookup warps draw no triangle with an unreached node, so a projector's drawn
+  // image ends up to one lookup cell inside its mesh: where the union's border is a
+  // mesh's edge, shrink about the centre until every point of the rectangle's border is
+  // drawn by some projector (render::gridSource on its warp).
+  auto drawn = [&](const CurvedDisplay& d, double x, double y) {
+    const geom::Ray ray{eye, (R.transpose() * Vec3(x, -y, 1)).normalized()};
+    for (std::size_t m = 0; m < projectors.size(); ++m) {
+      const auto hit = projectors[m].surface->intersect(ray);
+      if (!hit) continue;
+      const Vec3 u = projectors[m].projector * hit->point.homogeneous();
+      if (u.z() > 0 && render::gridSource(d.lookup[m], u.hnormalized())) return true;
+    }
+    return false;
+  };
+  for (int iteration = 0; iteration < 40; ++iteration) {
+    out.viewer = render::contentViewMatrix(R, eye, out.rect, content);
+    if (!out.viewer.allFinite())
+      return fail(ErrorCode::kDegenerate, "degenerate display rectangle");
+    out.lookup.clear();
+    for (std::size_t m = 0; m < projectors.size(); ++m) {
+      auto grid = render::lookupGridForViewer(*projectors[m].surface, projectors[m].projector,
+                                              projectors[m].size, out.viewer, options.lookup_step);
+      if (!grid) return tl::unexpected(grid.error());
+      out.lookup.push_back(std::move(*grid));
+    }
+    bool inside = true;
+    const keystone::AxisRect& r = out.rect;
+    for (int i = 0; i <= 64 && inside; ++i) {
+      const double a = -1 + 2.0 * i / 64;
+      for (const Vec2& c : {Vec2(a, -1), Vec2(1, a), Vec2(-a, 1), Vec2(-1, -a)}) {
+        // Half a content pixel in from the edge: the outermost pixel centres.
+        const double x = r.centre.x() + c.x() * r.half_width * (1 - 1.0 / content.width);
+        const double y = r.centre.y() + c.y() * r.half_height * (1 - 1.0 / content.height);
+        if (!drawn(out, x, y)) {
+          inside = false;
+          break;
+        }
+      }
+    }
+    if (inside) return out;
+    out.rect.half_width *= 0.99;
+    out.rect.half_height *= 0.99;
   }
-  return out;
+  return fail(ErrorCode::kNotFound,
+              "no display rectangle is drawn whole by the projectors' lookup warps");
 }
 
 Result<CurvedBlend> makeCurvedBlend(std::span<const SurfaceProjector> projectors,

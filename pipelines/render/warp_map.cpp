@@ -87,6 +87,10 @@ Result<WarpMap> gridMap(const WarpGrid& grid, cv::Size output_size) {
 }
 
 std::optional<Vec2> gridSource(const WarpGrid& grid, const Vec2& pixel) {
+  if (grid.cols < 2 || grid.rows < 2 ||
+      grid.source.size() != static_cast<size_t>(grid.cols) * grid.rows || !(grid.step.x() > 0) ||
+      !(grid.step.y() > 0))
+    return std::nullopt;
   const double gu = (pixel.x() - grid.origin.x()) / grid.step.x();
   const double gv = (pixel.y() - grid.origin.y()) / grid.step.y();
   if (!(gu >= 0 && gv >= 0 && gu <= grid.cols - 1 && gv <= grid.rows - 1)) return std::nullopt;

@@ -42,7 +42,7 @@ Result<WarpMap> homographyMap(const Mat3& H, cv::Size output_size);
 Result<WarpMap> gridMap(const WarpGrid& grid, cv::Size output_size);
 
 // The grid's source coordinate at an output pixel (gridMap's, in double precision);
-// nullopt where gridMap gives kOutside.
+// nullopt where gridMap gives kOutside, and for a grid gridMap refuses.
 std::optional<Vec2> gridSource(const WarpGrid& grid, const Vec2& pixel);
 
 // The map of applying `first` then `second`: result(m) = first(second(m)), `first`

@@ -172,7 +172,7 @@ TEST(SimCurvedWall, ThreeProjectorsCalibratedIntoOneDisplayForTheSweetSpot) {
   EXPECT_EQ((*done)["scan"]["batches"], json({{"proj_l", "proj_r"}, {"proj_c"}})) << done->dump();
   std::printf(
       "[ figures  ] three projectors calibrated in %.1f s: %d captures in %zu scan batches "
-      "(%d one at a time)\n",
+      "(%d announced: one at a time, and the coarse pass)\n",
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
       (*done)["scan"]["captures"].get<int>(), (*done)["scan"]["batches"].size(),
       (*started)["captures"].get<int>());

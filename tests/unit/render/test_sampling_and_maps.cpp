@@ -203,7 +203,13 @@ TEST(GridMap, TrianglesWithANodeNoSourceReachesAreNotDrawn) {
   const auto s = gridSource(g, Vec2(2.5, 7.25));
   ASSERT_TRUE(s);
   EXPECT_NEAR(s->x(), 2.5, 1e-12);
-  EXPECT_NEAR(s->y(), 7.25, 1e-12);
+  EXPECT_NEAR(s->y(), 7.25, 1e-12);  // A grid gridMap refuses has no source anywhere (no read outside its nodes).
+  WarpGrid thin = g;
+  thin.cols = 1;
+  EXPECT_FALSE(gridSource(thin, Vec2(0, 0)));
+  thin = g;
+  thin.source.pop_back();
+  EXPECT_FALSE(gridSource(thin, Vec2(2.5, 7.25)));
 }
 
 TEST(ComposeMaps, EqualsTheAnalyticComposition) {
