@@ -150,7 +150,7 @@ TEST(SimCurvedWall, ThreeProjectorsCalibratedIntoOneDisplayForTheSweetSpot) {
   auto started = c.call(request);
   ASSERT_TRUE(started);
   ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
-  auto done = finalReply(c, 1, 600s);
+  auto done = finalReply(c, 1, kSlowdown * 600s);
   ASSERT_TRUE(done) << d.log();
   ASSERT_EQ((*done)["class"], "CALIBRATE") << done->dump();
   ASSERT_EQ((*done)["outputs"].size(), 3u) << done->dump();
@@ -181,7 +181,7 @@ TEST(SimCurvedWall, ThreeProjectorsCalibratedIntoOneDisplayForTheSweetSpot) {
   // A white panorama on the one display.
   const std::string png = contentFile(dir, "panorama.png");
   ASSERT_TRUE(cv::imwrite(png, cv::Mat(kH, kW, CV_8UC3, cv::Scalar(255, 255, 255))));
-  auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", png}}, 30s);
+  auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", png}}, kSlowdown * 30s);
   ASSERT_TRUE(load);
   ASSERT_EQ((*load)["class"], "CONTENT") << load->dump();
   json display;
@@ -200,7 +200,7 @@ TEST(SimCurvedWall, ThreeProjectorsCalibratedIntoOneDisplayForTheSweetSpot) {
         }
         return shown.size() == 3;
       },
-      60s);
+      kSlowdown * 60s);
   ASSERT_TRUE(ready) << display.dump() << "\n" << d.log();
   EXPECT_EQ(display["outputs"], json({"proj_l", "proj_c", "proj_r"})) << display.dump();
   EXPECT_EQ(display["viewer"]["source"], "config");
