@@ -52,19 +52,6 @@ void trueRig(Rig& rig) {
   rig.eye = s.viewer.pose.center();
 }
 
-// The lookup warp between its nodes (two triangles per cell, render/warp_map.hpp).
-std::optional<Vec2> lookupAt(const render::WarpGrid& g, const Vec2& u) {
-  const double gx = (u.x() - g.origin.x()) / g.step.x(), gy = (u.y() - g.origin.y()) / g.step.y();
-  const int i = std::clamp(static_cast<int>(gx), 0, g.cols - 2);
-  const int j = std::clamp(static_cast<int>(gy), 0, g.rows - 2);
-  const double fx = gx - i, fy = gy - j;
-  if (fx < -1e-9 || fy < -1e-9 || fx > 1 + 1e-9 || fy > 1 + 1e-9) return std::nullopt;
-  const Vec2 a = g.at(i, j), b = g.at(i + 1, j), c = g.at(i, j + 1), d = g.at(i + 1, j + 1);
-  for (const Vec2& n : {a, b, c, d})
-    if (n.x() == render::kOutside) return std::nullopt;
-  return fx >= fy ? Vec2(a + fx * (b - a) + fy * (d - b)) : Vec2(a + fy * (c - a) + fx * (d - c));
-}
-
 std::optional<Vec3> surfacePoint(const Rig& rig, std::size_t m, const Vec2& u) {
   auto rays = render::pixelRays(rig.projectors[m].projector);
   auto hit = rig.wall.intersect(rays->through(u.x(), u.y()));
@@ -105,7 +92,7 @@ TEST(CurvedDisplay, ProjectorsAgreeOnEveryContentPointTheyShareOnTheTrueCylinder
           if (n == m) continue;
           const Vec2 u = (rig.projectors[n].projector * X->homogeneous()).hnormalized();
           if (!inFrame(rig.projectors[n], u, 0.5)) continue;
-          const auto cn = lookupAt(d.lookup[n], u);
+          const auto cn = render::gridSource(d.lookup[n], u);
           ASSERT_TRUE(cn);
           worst = std::max(worst, (*cn - c).norm());
           ++shared;
