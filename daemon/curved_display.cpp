@@ -11,6 +11,7 @@
 
 #include "blend/rig_tiles.hpp"
 #include "daemon.hpp"
+#include "json_matrix.hpp"
 #include "log.hpp"
 
 namespace procam::daemon {
@@ -143,14 +144,12 @@ json Daemon::curvedDisplayJson() const {
   }
   json eye = k.curved->eye_source;
   eye["position"] = {d.eye.x(), d.eye.y(), d.eye.z()};
-  json viewer = json::array();
-  for (int i = 0; i < 12; ++i) viewer.push_back(d.viewer(i / 4, i % 4));
   return {{"state", "ready"},
           {"surface", "mesh"},
           {"outputs", k.curved->outputs},
           {"content_size", {k.curved->content.width, k.curved->content.height}},
           {"viewer", eye},
-          {"viewer_matrix", viewer},
+          {"viewer_matrix", rowMajor(d.viewer)},
           // The content on the eye's image plane z = 1 (x right, y up): its field of view.
           {"rect_tan",
            {{"centre", {d.rect.centre.x(), d.rect.centre.y()}},

@@ -3,6 +3,7 @@
 // setup and the content with its version; drawn by the outputs on compute_worker_
 // (output_draw.hpp), results posted back.
 #include "daemon.hpp"
+#include "json_matrix.hpp"
 #include "log.hpp"
 #include "output_draw.hpp"
 #include "support/render_abi.hpp"
@@ -17,19 +18,6 @@ namespace {
 // frames change quickly, and once more after such a burst.
 constexpr auto kStatsPeriod = std::chrono::milliseconds(200);
 constexpr auto kStatsCatchUp = std::chrono::milliseconds(250);
-
-json rowMajor(const Mat34& m) {
-  json v = json::array();
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 4; ++c) v.push_back(m(r, c));
-  return v;
-}
-
-json rowMajor(const Mat3& m) {
-  json out = json::array();
-  for (int i = 0; i < 9; ++i) out.push_back(m(i / 3, i % 3));
-  return out;
-}
 
 }  // namespace
 
