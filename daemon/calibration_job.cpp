@@ -37,6 +37,28 @@ bool integerArg(const json& request, const char* key, int lo, int hi, int& out,
 
 }  // namespace
 
+tl::expected<calib::BoardSpec, std::string> boardArg(const json& value) {
+  const std::string text = value.is_string() ? value.get<std::string>() : std::string();
+  auto spec = !text.empty() && text.size() <= 64
+                  ? calib::parseBoard(text)
+                  : Result<calib::BoardSpec>(tl::unexpect, Error{ErrorCode::kParse, "not a board"});
+  if (!spec) {
+    return tl::unexpected(
+        "\"board\" must be a board: aprilgrid:COLSxROWS:TAG_M[:GAP_M], "
+        "checker:COLSxROWS:SQUARE_M or charuco:COLSxROWS:SQUARE_M:MARKER_M (metres): " +
+        spec.error().message);
+  }
+  // Bounded: the detector's work and memory grow with the board's cells.
+  if (spec->cols > 64 || spec->rows > 64 || !(spec->square_m >= 0.001 && spec->square_m <= 10) ||
+      !(spec->gap_m >= 0 && spec->gap_m <= 10 * spec->square_m) ||
+      (spec->kind == calib::BoardKind::kAprilGrid && spec->cols * spec->rows > 587)) {
+    return tl::unexpected(
+        std::string("\"board\" must have at most 64 x 64 cells of 1 mm to 10 m, a gap of at "
+                    "most 10 cells and, for aprilgrid, at most 587 tags (tag36h11)"));
+  }
+  return *spec;
+}
+
 CalibrationFailure deviceFailure(const char* family, const std::string& name, int rc,
                                  const char* what, const char* reason) {
   const std::string why = reason[0] ? reason : "no reason given";
@@ -183,25 +205,8 @@ tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const json& requ
     a.plane = geom::Plane{n / n.norm(), (*it)[3].get<double>() / n.norm()};
   }
   if (auto it = request.find("board"); it != request.end()) {
-    const std::string text = it->is_string() ? it->get<std::string>() : std::string();
-    auto spec =
-        !text.empty() && text.size() <= 64
-            ? calib::parseBoard(text)
-            : Result<calib::BoardSpec>(tl::unexpect, Error{ErrorCode::kParse, "not a board"});
-    if (!spec) {
-      return tl::unexpected(
-          "\"board\" must be a board on the display plane: aprilgrid:COLSxROWS:TAG_M[:GAP_M], "
-          "checker:COLSxROWS:SQUARE_M or charuco:COLSxROWS:SQUARE_M:MARKER_M (metres): " +
-          spec.error().message);
-    }
-    // Bounded: the detector's work and memory grow with the board's cells.
-    if (spec->cols > 64 || spec->rows > 64 || !(spec->square_m >= 0.001 && spec->square_m <= 10) ||
-        !(spec->gap_m >= 0 && spec->gap_m <= 10 * spec->square_m) ||
-        (spec->kind == calib::BoardKind::kAprilGrid && spec->cols * spec->rows > 587)) {
-      return tl::unexpected(std::string(
-          "\"board\" must have at most 64 x 64 cells of 1 mm to 10 m, a gap of at most 10 "
-          "cells and, for aprilgrid, at most 587 tags (tag36h11)"));
-    }
+    auto spec = boardArg(*it);
+    if (!spec) return tl::unexpected(spec.error());
     if (a.plane) {
       return tl::unexpected(
           std::string("give either \"plane\" or \"board\": both say where the display plane is"));
@@ -211,9 +216,25 @@ tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const json& requ
           std::string("\"board\" is for route (b′) with one camera; \"cameras\" names two"));
     }
     a.board = *spec;
-    a.board_text = text;
+    a.board_text = it->get<std::string>();
   }
   return a;
+}
+
+tl::expected<cv::Mat, CalibrationFailure> captureGray(const CalibrationDevice& cam) {
+  const auto& raw = cam.device->raw();
+  procam_image img{};
+  char err[256] = {0};
+  if (int rc = raw.ops.camera->capture(raw.self, 5000, &img, err, sizeof err - 1);
+      rc != PROCAM_OK) {
+    return tl::unexpected(deviceFailure("camera", cam.name, rc, "capture", err));
+  }
+  cv::Mat gray = grayImage(img);
+  if (gray.empty()) {
+    return tl::unexpected(CalibrationFailure{
+        code::kIo, "camera '" + cam.name + "' returned an unknown pixel format"});
+  }
+  return gray;
 }
 
 namespace {
@@ -253,23 +274,6 @@ tl::expected<bool, CalibrationFailure> showAndSettle(const CalibrationPlan& plan
     return tl::unexpected(deviceFailure("output", plan.output.name, rc, what, err));
   }
   return waitCancellable(settle_frames / plan.refresh_hz, hooks);
-}
-
-// One frame of `cam` as a single-channel image.
-tl::expected<cv::Mat, CalibrationFailure> captureGray(const CalibrationCamera& cam) {
-  const auto& raw = cam.device.device->raw();
-  procam_image img{};
-  char err[256] = {0};
-  if (int rc = raw.ops.camera->capture(raw.self, 5000, &img, err, sizeof err - 1);
-      rc != PROCAM_OK) {
-    return tl::unexpected(deviceFailure("camera", cam.device.name, rc, "capture", err));
-  }
-  cv::Mat gray = grayImage(img);
-  if (gray.empty()) {
-    return tl::unexpected(CalibrationFailure{
-        code::kIo, "camera '" + cam.device.name + "' returned an unknown pixel format"});
-  }
-  return gray;
 }
 
 // The camera's mean at each ramp level over the pixels that decoded this projector
@@ -405,7 +409,7 @@ tl::expected<std::vector<CalibrationOutcome>, CalibrationFailure> runBatchCalibr
     if (!shown) return tl::unexpected(shown.error());
     if (!*shown) return tl::unexpected(cancelled);
     for (std::size_t c = 0; c < plan.cameras.size(); ++c) {
-      auto gray = captureGray(plan.cameras[c]);
+      auto gray = captureGray(plan.cameras[c].device);
       if (!gray) return tl::unexpected(gray.error());
       captures[c].push_back(std::move(*gray));
       ++done;
@@ -430,7 +434,7 @@ tl::expected<std::vector<CalibrationOutcome>, CalibrationFailure> runBatchCalibr
     auto shown = showAllAndSettle(members, grey, "show a grey", outcome.settle_frames, hooks);
     if (!shown) return tl::unexpected(shown.error());
     if (!*shown) return tl::unexpected(cancelled);
-    auto gray = captureGray(plan.cameras[0]);
+    auto gray = captureGray(plan.cameras[0].device);
     if (!gray) return tl::unexpected(gray.error());
     ramp.push_back(std::move(*gray));
     ++done;
@@ -570,7 +574,7 @@ tl::expected<ScanBatches, CalibrationFailure> planScanBatches(
     return tl::unexpected(cancelled);
   std::vector<cv::Mat> black;
   for (const auto& cam : first.cameras) {
-    auto gray = captureGray(cam);
+    auto gray = captureGray(cam.device);
     if (!gray) return tl::unexpected(gray.error());
     black.push_back(std::move(*gray));
   }
@@ -587,7 +591,7 @@ tl::expected<ScanBatches, CalibrationFailure> planScanBatches(
         out.footprints[i].emplace_back();
         continue;
       }
-      auto gray = captureGray(p.cameras[c]);
+      auto gray = captureGray(p.cameras[c].device);
       if (!gray) return tl::unexpected(gray.error());
       out.footprints[i].push_back(gray->size() == black[c].size() ? litPixels(*gray, black[c])
                                                                   : cv::Mat());

@@ -56,6 +56,10 @@ struct CalibrationArgs {
 tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(
     const nlohmann::json& request, const CalibrationConfig& defaults = {});
 
+// A request's "board" (procam-calibrate's board form), bounded in cells and size;
+// the message says what a board looks like otherwise.
+tl::expected<calib::BoardSpec, std::string> boardArg(const nlohmann::json& value);
+
 // A device the run uses; the shared reference keeps it alive if the daemon
 // closes its entry meanwhile.
 struct CalibrationDevice {
@@ -127,6 +131,8 @@ CalibrationFailure deviceFailure(const char* family, const std::string& name, in
 // The driver's frame as a single-channel image (a copy: the driver reuses its
 // buffer); empty for an unknown pixel format.
 cv::Mat grayImage(const procam_image& img);
+// One frame of the camera as a single-channel image (5 s at most).
+tl::expected<cv::Mat, CalibrationFailure> captureGray(const CalibrationDevice& camera);
 // Waits `seconds`, waking every 20 ms to honour a cancel; false when cancelled.
 bool waitCancellable(double seconds, const CalibrationHooks& hooks);
 

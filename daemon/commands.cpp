@@ -70,6 +70,7 @@ void Daemon::handle(ClientId client, const proto::Request& req) {
       {"content", &Daemon::cmdContent},     {"save", &Daemon::cmdSave},
       {"reload", &Daemon::cmdReload},       {"log-level", &Daemon::cmdLogLevel},
       {"tracker", &Daemon::cmdTracker},     {"latency", &Daemon::cmdLatency},
+      {"snapshot", &Daemon::cmdSnapshot},   {"calibrate-camera", &Daemon::cmdCalibrateCamera},
   };
   for (const auto& [name, fn] : kCommands) {
     if (req.cmd != name) continue;

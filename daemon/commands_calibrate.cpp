@@ -24,7 +24,15 @@ using Failure = CalibrationFailure;
 // procam-calibrate camera/stereo, `procamd --rig` or an earlier calibrate put it.
 tl::expected<geom::CameraModel, Failure> cameraModel(const DeviceEntry& e,
                                                      const rig::RigModel& rig) {
-  if (const rig::RigCamera* c = rig.camera(e.name)) return c->model;
+  if (const rig::RigCamera* c = rig.camera(e.name)) {
+    if (c->pose_known) return c->model;
+    return tl::unexpected(
+        Failure{code::kUnavailable,
+                "camera '" + e.name +
+                    "' has intrinsics but no pose in the rig model (calibrated alone "
+                    "from board views): calibrate the camera pair with procam-calibrate "
+                    "stereo, or give the rig a pose for it with procamd --rig"});
+  }
   return tl::unexpected(Failure{
       code::kUnavailable, "camera '" + e.name +
                               "' is not calibrated: the rig model has no camera of that name "

@@ -309,7 +309,10 @@ void parseDevices(Checker& c, const toml::node& node, const std::string& section
     } else {
       c.error(t->source(), key + ".name", "missing (every device needs a unique name)");
     }
-    if (auto* n = t->get("driver")) c.string(*n, key + ".driver", dev.driver);
+    if (auto* n = t->get("driver")) {
+      c.string(*n, key + ".driver", dev.driver);
+      dev.driver_line = static_cast<int>(n->source().begin.line);
+    }
     if (auto* n = t->get("devnode")) c.string(*n, key + ".devnode", dev.devnode);
     if (auto* n = t->get("options")) {
       if (const toml::table* opts = n->as_table()) {

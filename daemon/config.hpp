@@ -23,6 +23,7 @@ struct DeviceConfig {
   std::string devnode;                                       // empty: any device of the family
   std::vector<std::pair<std::string, std::string>> options;  // values as text
   int line = 0;
+  int driver_line = 0;  // where `driver` was given
 };
 
 enum class RecalibratePolicy { kOff, kOnDrift };

@@ -101,7 +101,9 @@ class Daemon {
   void cmdDevices(ClientId, const proto::Request&);
   void cmdWatch(ClientId, const proto::Request&);
   void cmdCalibrate(ClientId, const proto::Request&);
-  void cmdLatency(ClientId, const proto::Request&);  // commands_latency.cpp
+  void cmdLatency(ClientId, const proto::Request&);          // commands_latency.cpp
+  void cmdSnapshot(ClientId, const proto::Request&);         // commands_snapshot.cpp
+  void cmdCalibrateCamera(ClientId, const proto::Request&);  // commands_calibrate_camera.cpp
   void cmdCancel(ClientId, const proto::Request&);
   void cmdKeystone(ClientId, const proto::Request&);
   void cmdPattern(ClientId, const proto::Request&);
@@ -218,6 +220,7 @@ class Daemon {
     ClientId client = 0;
     nlohmann::json request_id;
     std::shared_ptr<std::atomic<bool>> cancelled;
+    std::shared_ptr<std::atomic<bool>> finish = {};  // calibrate-camera: solve now
   };
 
   DaemonOptions options_;

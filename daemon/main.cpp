@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <map>
 #include <string>
 #include <thread>
 
@@ -12,6 +13,7 @@
 #if defined(__SANITIZE_THREAD__)
 #include <opencv2/core/utility.hpp>
 #endif
+#include "config.hpp"
 #include "daemon.hpp"
 #include "loader.hpp"
 #include "log.hpp"
@@ -39,6 +41,9 @@ constexpr const char* kUsage =
     "  --plugin-dir DIR    driver plugins (default " PROCAM_DEFAULT_PLUGIN_DIR
     ")\n"
     "  --list-drivers      print the available drivers and exit\n"
+    "  --check-config FILE check a configuration without starting: syntax, keys,\n"
+    "                      values, the group and every named driver; exit 0 when\n"
+    "                      it is valid, 1 with file:line: key: problem otherwise\n"
     "  --version           print the release and exit\n";
 
 std::string envOr(const char* name, const char* fallback) {
@@ -48,24 +53,66 @@ std::string envOr(const char* name, const char* fallback) {
   return fallback;
 }
 
-int listDrivers(const std::string& plugin_dir) {
+// The built-in drivers and those of the plugin directory; refusals and load errors
+// are appended to `problems`.
+procam::plugins::DriverRegistry loadRegistry(const std::string& plugin_dir,
+                                             std::vector<std::string>& problems) {
   procam::plugins::DriverRegistry registry;
-  std::vector<std::string> refused;
   auto statics = procam::plugins::loadStaticPlugins(procam::plugins::staticPlugins());
   if (!statics) {
-    std::fprintf(stderr, "procamd: %s\n", statics.error().message.c_str());
-    return 1;
+    problems.push_back(statics.error().message);
+    return registry;
   }
-  registry.addAll(*statics, refused);
+  registry.addAll(*statics, problems);
   std::vector<procam::Error> errors;
-  registry.addAll(procam::plugins::loadPluginDirectory(plugin_dir, errors), refused);
+  registry.addAll(procam::plugins::loadPluginDirectory(plugin_dir, errors), problems);
+  for (const auto& e : errors) problems.push_back(e.message);
+  return registry;
+}
+
+int listDrivers(const std::string& plugin_dir) {
+  std::vector<std::string> problems;
+  const auto registry = loadRegistry(plugin_dir, problems);
   for (const auto& d : registry.drivers()) {
     std::printf("%-8s %-24s %s\n", procam::plugins::familyName(d.family()), d.name().c_str(),
                 d.origin.c_str());
   }
-  for (const auto& e : errors) std::fprintf(stderr, "procamd: %s\n", e.message.c_str());
-  for (const auto& r : refused) std::fprintf(stderr, "procamd: %s\n", r.c_str());
-  return errors.empty() && refused.empty() ? 0 : 1;
+  for (const auto& p : problems) std::fprintf(stderr, "procamd: %s\n", p.c_str());
+  return problems.empty() ? 0 : 1;
+}
+
+// What the service's ExecStartPre= and an installer run: everything start-up would
+// refuse in the file, without a socket, a device or a state directory.
+int checkConfig(const std::string& path, const std::string& plugin_dir_option) {
+  auto cfg = procam::daemon::loadConfig(path);
+  if (!cfg) {
+    std::fprintf(stderr, "%s\n", cfg.error().message.c_str());
+    return 1;
+  }
+  std::string plugin_dir = plugin_dir_option;
+  if (plugin_dir.empty()) plugin_dir = cfg->plugin_dir;
+  if (plugin_dir.empty()) plugin_dir = PROCAM_DEFAULT_PLUGIN_DIR;
+  std::vector<std::string> problems;
+  const auto registry = loadRegistry(plugin_dir, problems);
+  // A plugin directory that cannot be read is a warning at start-up, not a refusal.
+  for (const auto& p : problems) std::fprintf(stderr, "procamd: warning: %s\n", p.c_str());
+  int bad = 0;
+  std::map<procam_family, int> index;  // the device's place in its [[family]] array
+  for (const auto& d : cfg->devices) {
+    const int i = index[d.family]++;
+    if (d.driver.empty() || registry.find(d.family, d.driver)) continue;
+    // The configuration's arrays: [[projector]] holds output devices.
+    const char* family =
+        d.family == PROCAM_FAMILY_OUTPUT ? "projector" : procam::plugins::familyName(d.family);
+    std::fprintf(stderr, "%s:%d: %s[%d].driver: no %s driver named '%s' is built in or in %s\n",
+                 path.c_str(), d.driver_line, family, i, family, d.driver.c_str(),
+                 plugin_dir.c_str());
+    ++bad;
+  }
+  if (bad > 0) return 1;
+  std::printf("%s: valid (%zu device%s configured)\n", path.c_str(), cfg->devices.size(),
+              cfg->devices.size() == 1 ? "" : "s");
+  return 0;
 }
 
 }  // namespace
@@ -75,6 +122,7 @@ static int run(int argc, char** argv) {
   opts.runtime_dir = envOr("RUNTIME_DIRECTORY", "/run/procamd");
   opts.state_dir = envOr("STATE_DIRECTORY", "/var/lib/procamd");
   bool list = false;
+  std::string check_path;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&](std::string& out) {
@@ -103,6 +151,8 @@ static int run(int argc, char** argv) {
       value(opts.plugin_dir);
     } else if (a == "--list-drivers") {
       list = true;
+    } else if (a == "--check-config") {
+      value(check_path);
     } else if (a == "--version") {
       std::printf("procamd %s (control protocol %d.%d, plugin ABI %u)\n", procam::daemon::kRelease,
                   procam::daemon::proto::kMajor, procam::daemon::proto::kMinor,
@@ -116,6 +166,7 @@ static int run(int argc, char** argv) {
       return 2;
     }
   }
+  if (!check_path.empty()) return checkConfig(check_path, opts.plugin_dir);
   if (list)
     return listDrivers(opts.plugin_dir.empty() ? PROCAM_DEFAULT_PLUGIN_DIR : opts.plugin_dir);
   if (opts.config_path.empty() && opts.sim_scene.empty() &&

@@ -94,12 +94,14 @@ Result<void> StateFile::write(std::string_view contents) const {
   }
   // Keep the current version as the backup (through a hard link, so that the
   // main file exists at every instant), unless it is corrupt.
-  if (auto current = readWholeFile(path_); current && validate_(*current)) {
-    const std::string bak_tmp = backupPath() + ".tmp";
-    ::unlink(bak_tmp.c_str());
-    if (::link(path_.c_str(), bak_tmp.c_str()) != 0) return ioError("cannot link", bak_tmp);
-    if (::rename(bak_tmp.c_str(), backupPath().c_str()) != 0) {
-      return ioError("cannot rename to", backupPath());
+  if (validate_) {
+    if (auto current = readWholeFile(path_); current && validate_(*current)) {
+      const std::string bak_tmp = backupPath() + ".tmp";
+      ::unlink(bak_tmp.c_str());
+      if (::link(path_.c_str(), bak_tmp.c_str()) != 0) return ioError("cannot link", bak_tmp);
+      if (::rename(bak_tmp.c_str(), backupPath().c_str()) != 0) {
+        return ioError("cannot rename to", backupPath());
+      }
     }
   }
   if (::rename(tmp.c_str(), path_.c_str()) != 0) return ioError("cannot rename to", path_);
@@ -110,7 +112,7 @@ Result<StateFile::Loaded> StateFile::read() const {
   std::string problem;
   auto main = readWholeFile(path_);
   if (main) {
-    auto ok = validate_(*main);
+    auto ok = validate_ ? validate_(*main) : Result<void>{};
     if (ok) return Loaded{std::move(*main), false, {}};
     problem = path_ + " is corrupt: " + ok.error().message;
   } else if (main.error().code != ErrorCode::kNotFound) {
@@ -124,7 +126,7 @@ Result<StateFile::Loaded> StateFile::read() const {
     }
     return fail(ErrorCode::kParse, problem + "; " + backup.error().message);
   }
-  if (auto ok = validate_(*backup); !ok) {
+  if (auto ok = validate_ ? validate_(*backup) : Result<void>{}; !ok) {
     if (problem.empty()) problem = path_ + " is missing";
     return fail(ErrorCode::kParse,
                 problem + "; backup " + backupPath() + " is corrupt too: " + ok.error().message);

@@ -15,6 +15,8 @@ class StateFile {
  public:
   using Validator = std::function<Result<void>(std::string_view contents)>;
 
+  // Without a validator (nullptr) every file is valid and no backup is kept: for
+  // files that are only ever replaced (camera snapshots).
   StateFile(std::string dir, std::string name, Validator validate);
 
   const std::string& path() const { return path_; }

@@ -219,6 +219,19 @@ std::optional<double> trackerRate(const procam_device& d) {
   return hz;
 }
 
+// get_settings came with version 2 of the camera table.
+constexpr uint32_t kCameraSettingsVersion = 2;
+
+std::optional<procam_camera_settings> cameraSettings(const procam_device& d) {
+  if (d.family != PROCAM_FAMILY_CAMERA || !d.ops.camera ||
+      d.ops.camera->version < kCameraSettingsVersion || !d.ops.camera->get_settings) {
+    return std::nullopt;
+  }
+  procam_camera_settings s{std::nan(""), std::nan(""), 0};
+  if (d.ops.camera->get_settings(d.self, &s) != PROCAM_OK) return std::nullopt;
+  return s;
+}
+
 // get_counts came with version 2 of the tilt table: a version 1 table ends before it.
 constexpr uint32_t kTiltCountsVersion = 2;
 

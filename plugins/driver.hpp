@@ -89,6 +89,10 @@ Result<std::vector<DeviceDescription>> enumerateDevices(
 // The tracker's own sample rate when its driver reports one.
 std::optional<double> trackerRate(const procam_device& device);
 
+// The exposure and gain a camera runs at when its table (version 2 or later) has
+// get_settings and the driver answers; fields the driver cannot tell are NaN.
+std::optional<procam_camera_settings> cameraSettings(const procam_device& device);
+
 // A tilt driver's sample counts (procam_tilt_ops::get_counts) when its table has them
 // (version 2 or later) and it reports them.
 std::optional<procam_tilt_counts> tiltCounts(const procam_device& device);

@@ -83,14 +83,94 @@ std::string calibrateText(const json& r) {
   const json& p = r["projector"];
   std::string out =
       field("projector", scalar(p["name"]) + " " + scalar(p["width"]) + "x" + scalar(p["height"]));
-  char k[160];
-  std::snprintf(k, sizeof k, "fx %.2f  fy %.2f  cx %.2f  cy %.2f", p["K"][0].get<double>(),
-                p["K"][4].get<double>(), p["K"][2].get<double>(), p["K"][5].get<double>());
-  out += field("intrinsics", k);
-  out += field("position", pairList(r["position"]) + " m");
+  // Route (b') calibrates a plane homography: no intrinsics, no position.
+  if (p.contains("K") && p["K"].is_array() && p["K"].size() == 9) {
+    char k[160];
+    std::snprintf(k, sizeof k, "fx %.2f  fy %.2f  cx %.2f  cy %.2f", p["K"][0].get<double>(),
+                  p["K"][4].get<double>(), p["K"][2].get<double>(), p["K"][5].get<double>());
+    out += field("intrinsics", k);
+  }
+  if (r.contains("position")) out += field("position", pairList(r["position"]) + " m");
   out += field("reprojection", scalar(r["reprojection_rms_px"]) + " px RMS over " +
                                    scalar(p["points"]) + " points");
   out += field("surface", scalar(r["surface_type"]));
+  out += field("written", scalar(r["path"]));
+  return out;
+}
+
+std::string latencyText(const json& r) {
+  if (r.value("state", "") == "started") {
+    return "latency " + scalar(r["operation"]) + ": output " + scalar(r["output"]) + ", cameras " +
+           pairList(r["cameras"]) + ", " + scalar(r["repeats"]) + " repeats\n";
+  }
+  char line[200];
+  std::snprintf(line, sizeof line, "%.1f ms -> settle %s frames at %.1f Hz (margin %s)",
+                r.value("latency_s", 0.0) * 1e3, scalar(r["settle_frames"]).c_str(),
+                r.value("refresh_hz", 0.0), scalar(r["margin_frames"]).c_str());
+  std::string out = field("output", scalar(r["output"])) + field("latency", line);
+  for (const auto& c : r["cameras"]) {
+    const json& l = c["latency_s"];
+    const size_t samples = c["samples"].is_array() ? c["samples"].size() : 0;
+    std::snprintf(line, sizeof line, "median %.1f ms, spread %.1f ms, %zu samples, contrast %.1f",
+                  l.value("median", 0.0) * 1e3, l.value("spread", 0.0) * 1e3, samples,
+                  c.value("contrast", 0.0));
+    out += field(("camera " + scalar(c["name"])).c_str(), line);
+  }
+  return out;
+}
+
+std::string snapshotText(const json& r) {
+  std::string out = field("camera", scalar(r["camera"]) + " " + scalar(r["width"]) + "x" +
+                                        scalar(r["height"]) + " " + scalar(r["format"]));
+  char line[160];
+  // Exposure and gain are what the driver reports; not every driver can.
+  const char* unknown = "not reported by the driver";
+  if (r.contains("exposure_s") && r["exposure_s"].is_number()) {
+    std::snprintf(line, sizeof line, "%.3f ms", r["exposure_s"].get<double>() * 1e3);
+    out += field("exposure", line);
+  } else {
+    out += field("exposure", unknown);
+  }
+  if (r.contains("gain") && r["gain"].is_number()) {
+    const bool db = r.value("gain_unit", "") == "dB";
+    std::snprintf(line, sizeof line, db ? "%.2f dB" : "%.6g (device units)",
+                  r["gain"].get<double>());
+    out += field("gain", line);
+  } else {
+    out += field("gain", unknown);
+  }
+  std::snprintf(line, sizeof line, "%.2f %% saturated, %.2f %% under-exposed, mean %.1f %%",
+                r.value("saturated_pct", 0.0), r.value("underexposed_pct", 0.0),
+                r.value("mean_pct", 0.0));
+  out += field("levels", line);
+  if (r.contains("path")) out += field("written", scalar(r["path"]));
+  return out;
+}
+
+std::string calibrateCameraText(const json& r) {
+  if (r.contains("finishing")) return "finishing " + pairList(r["finishing"]) + "\n";
+  if (r.value("state", "") == "started") {
+    return "camera calibration " + scalar(r["operation"]) + ": camera " + scalar(r["camera"]) +
+           ", board " + scalar(r["board"]) + "; move the board before the camera\n";
+  }
+  const json& c = r["camera"];
+  char line[200];
+  std::string out =
+      field("camera", scalar(c["name"]) + " " + scalar(c["width"]) + "x" + scalar(c["height"]));
+  if (c.contains("K") && c["K"].is_array() && c["K"].size() == 9) {
+    std::snprintf(line, sizeof line, "fx %.2f  fy %.2f  cx %.2f  cy %.2f", c["K"][0].get<double>(),
+                  c["K"][4].get<double>(), c["K"][2].get<double>(), c["K"][5].get<double>());
+    out += field("intrinsics", line);
+  }
+  std::snprintf(line, sizeof line, "%.3f px RMS over %s views (%s frames, %s rejected)",
+                r.value("reprojection_rms_px", 0.0), scalar(r["views"]).c_str(),
+                scalar(r["frames"]).c_str(), scalar(r["rejected"]).c_str());
+  out += field("reprojection", line);
+  std::snprintf(line, sizeof line, "%.0f %% of the image", 100.0 * r.value("coverage", 0.0));
+  out += field("coverage", line);
+  out += field("stopped", scalar(r["stopped"]));
+  out += field("pose", c.value("pose_known", false) ? "kept from the rig model"
+                                                    : "unknown (calibrate the pair for it)");
   out += field("written", scalar(r["path"]));
   return out;
 }
@@ -210,6 +290,9 @@ std::string formatReply(const json& r) {
   if (cls == "LOG-LEVEL") return "log level " + scalar(r["level"]) + "\n";
   if (cls == "TRACKER") return trackerText(r);
   if (cls == "CALIBRATE") return calibrateText(r);
+  if (cls == "LATENCY") return latencyText(r);
+  if (cls == "SNAPSHOT") return snapshotText(r);
+  if (cls == "CALIBRATE-CAMERA") return calibrateCameraText(r);
   if (cls == "CANCEL") return "cancelled " + pairList(r["cancelled"]) + "\n";
   if (cls == "WATCH") {
     return r.value("enabled", false) ? "watching: " + pairList(r["events"]) + "\n"

@@ -1,6 +1,8 @@
 // procamctl: command-line client of procamd (daemon/PROTOCOL.md).
 #include <unistd.h>
 
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -24,7 +26,10 @@ constexpr const char* kUsage =
     "  watch                          stream events until interrupted\n"
     "  calibrate [KEY=VALUE ...]      run a calibration with a progress bar; keys: mode,\n"
     "                                 step, phase_steps, grid, settle_frames, output,\n"
-    "                                 cameras=A,B (daemon/PROTOCOL.md)\n"
+    "                                 cameras=A,B, projectors=P,Q|all, response=true,\n"
+    "                                 plane=[A,B,C,D], board=SPEC (daemon/PROTOCOL.md)\n"
+    "  latency [KEY=VALUE ...]        measure the display-to-capture latency; keys:\n"
+    "                                 output, cameras=A,B, repeats, timeout_s, margin_frames\n"
     "  cancel [OPERATION]\n"
     "  keystone [get]\n"
     "  keystone set X,Y X,Y X,Y X,Y   corners: top-left top-right bottom-right bottom-left\n"
@@ -41,6 +46,15 @@ constexpr const char* kUsage =
     "  content test PATTERN [WxH [FPS]]  a test video (smpte, ball, snow, white...)\n"
     "  content pipeline 'GST-SOURCE'  video from a gst-launch source description\n"
     "                                 (only where [content] allow_pipeline = true)\n"
+    "  calibrate-camera [CAMERA] --board SPEC [KEY=VALUE ...]\n"
+    "                                 intrinsics from a board moved before the camera,\n"
+    "                                 written to rig.json; keys: views, coverage, rms_px,\n"
+    "                                 timeout_s, interval_s, min_shift\n"
+    "  calibrate-camera finish        solve a running one with the views it has\n"
+    "  snapshot [CAMERA] [-o FILE.png] [--exposure SECONDS]\n"
+    "                                 one frame of a camera (default: the first) as PNG\n"
+    "                                 (default FILE: CAMERA.png here), with its exposure,\n"
+    "                                 gain and saturated/under-exposed pixels\n"
     "  log-level [error|warning|info|debug]\n"
     "  tracker [get]                  trackers: positions, rates, registrations\n"
     "  tracker register FILE          FILE: the request's JSON, e.g. {\"points\": [{\"tracker\":\n"
@@ -216,26 +230,113 @@ int runWatch(const Options& o, procam::ctl::Client& c) {
   }
 }
 
-// calibrate's KEY=VALUE arguments: integers as numbers, cameras=A,B as a list.
-json calibrateRequest(const std::vector<std::string>& a) {
-  json r = {{"cmd", "calibrate"}};
+// An operation's KEY=VALUE arguments: numbers as numbers, true/false as booleans,
+// [..] or {..} as JSON, cameras= and projectors= as comma-separated name lists
+// (projectors=all stays the word), anything else as text.
+json keyValueRequest(const std::string& cmd, const std::vector<std::string>& a) {
+  json r = {{"cmd", cmd}};
   for (const std::string& kv : a) {
     const size_t eq = kv.find('=');
-    if (eq == std::string::npos || eq == 0) usage("calibrate takes KEY=VALUE arguments");
+    if (eq == std::string::npos || eq == 0) usage(cmd + " takes KEY=VALUE arguments");
     const std::string key = kv.substr(0, eq), value = kv.substr(eq + 1);
     char* end = nullptr;
-    const long n = std::strtol(value.c_str(), &end, 10);
-    if (key == "cameras") {
-      const size_t comma = value.find(',');
-      if (comma == std::string::npos) usage("cameras=A,B names two cameras");
-      r[key] = {value.substr(0, comma), value.substr(comma + 1)};
-    } else if (!value.empty() && *end == '\0') {
-      r[key] = n;
+    const double n = std::strtod(value.c_str(), &end);
+    if ((key == "cameras" || key == "projectors") && value != "all") {
+      json names = json::array();
+      for (size_t start = 0;;) {
+        const size_t comma = value.find(',', start);
+        const std::string name = value.substr(start, comma - start);
+        if (name.empty()) usage(key + "= takes names separated by commas");
+        names.push_back(name);
+        if (comma == std::string::npos) break;
+        start = comma + 1;
+      }
+      r[key] = names;
+    } else if (value == "true" || value == "false") {
+      r[key] = value == "true";
+    } else if (!value.empty() && (value.front() == '[' || value.front() == '{')) {
+      json parsed = json::parse(value, nullptr, false);
+      if (parsed.is_discarded()) usage(key + "=" + value + " is not JSON");
+      r[key] = std::move(parsed);
+    } else if (!value.empty() && *end == '\0' && std::isfinite(n)) {
+      // Integers stay integers: the daemon checks integer arguments as such.
+      if (n == std::floor(n) && std::abs(n) < 1e15) {
+        r[key] = static_cast<std::int64_t>(n);
+      } else {
+        r[key] = n;
+      }
     } else {
       r[key] = value;
     }
   }
   return r;
+}
+
+// snapshot [CAMERA] [-o FILE] [--exposure SECONDS]: the request, and where the PNG goes.
+json snapshotRequest(const std::vector<std::string>& a, std::string& out_file) {
+  json r = {{"cmd", "snapshot"}};
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (a[i] == "-o" || a[i] == "--exposure") {
+      if (i + 1 >= a.size()) usage("snapshot: " + a[i] + " needs a value");
+      const std::string value = a[++i];
+      if (a[i - 1] == "-o") {
+        out_file = value;
+        continue;
+      }
+      char* end = nullptr;
+      const double s = std::strtod(value.c_str(), &end);
+      if (value.empty() || *end || !(s > 0)) usage("snapshot: --exposure takes seconds");
+      r["exposure_s"] = s;
+    } else if (!a[i].empty() && a[i][0] == '-') {
+      usage("snapshot: unknown option '" + a[i] + "'");
+    } else if (!r.contains("camera")) {
+      r["camera"] = a[i];
+    } else {
+      usage("snapshot takes one camera");
+    }
+  }
+  return r;
+}
+
+// calibrate-camera [CAMERA] --board SPEC [KEY=VALUE ...] | calibrate-camera finish.
+json calibrateCameraRequest(const std::vector<std::string>& a) {
+  if (a.size() == 1 && a[0] == "finish") return {{"cmd", "calibrate-camera"}, {"action", "finish"}};
+  std::vector<std::string> pairs;
+  std::string camera, board;
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (a[i] == "--board") {
+      if (i + 1 >= a.size())
+        usage("calibrate-camera: --board needs a board, e.g. checker:9x6:0.08");
+      board = a[++i];
+    } else if (a[i].find('=') != std::string::npos) {
+      pairs.push_back(a[i]);
+    } else if (camera.empty() && !a[i].empty() && a[i][0] != '-') {
+      camera = a[i];
+    } else {
+      usage("calibrate-camera: unexpected '" + a[i] + "'");
+    }
+  }
+  if (board.empty()) usage("calibrate-camera needs --board SPEC");
+  json r = keyValueRequest("calibrate-camera", pairs);
+  r["board"] = board;
+  if (!camera.empty()) r["camera"] = camera;
+  return r;
+}
+
+// Copies the daemon's snapshot (in its state directory, readable by its group) to
+// the file the user asked for.
+int saveSnapshot(const Options& o, const json& reply, std::string file) {
+  const std::string from = reply.value("path", "");
+  if (file.empty()) file = reply.value("camera", "snapshot") + ".png";
+  std::error_code ec;
+  std::filesystem::copy_file(from, file, std::filesystem::copy_options::overwrite_existing, ec);
+  if (ec) {
+    std::fprintf(stderr, "procamctl: cannot copy the snapshot %s to %s: %s\n", from.c_str(),
+                 file.c_str(), ec.message().c_str());
+    return procam::ctl::kExitError;
+  }
+  if (!o.json) std::printf("%-15s%s\n", "saved:", file.c_str());
+  return procam::ctl::kExitOk;
 }
 
 // Sends a request that starts an operation and follows its progress events
@@ -246,7 +347,18 @@ int runOperation(const Options& o, procam::ctl::Client& c, const json& request) 
   bool bar_shown = false;
   auto on_event = [&](const json& e) {
     if (o.json) return print(o, e, true);
-    if (e.value("event", "") != "progress" || !tty) return;
+    if (!tty) return;
+    if (e.value("event", "") == "views") {  // calibrate-camera, after every frame
+      const json& rms = e["rms_px"];
+      std::fprintf(
+          stderr, "\rviews %s kept, %s rejected (last: %s), coverage %.0f %%, RMS %s\033[K",
+          e["views"].dump().c_str(), e["rejected"].dump().c_str(), e.value("last", "").c_str(),
+          100.0 * e.value("coverage", 0.0),
+          rms.is_number() ? (std::to_string(rms.get<double>()).substr(0, 5) + " px").c_str() : "-");
+      bar_shown = true;
+      return;
+    }
+    if (e.value("event", "") != "progress") return;
     std::string stage = e.value("stage", "");
     if (e.contains("captures") && stage == "capturing") {
       stage += " " + e["capture"].dump() + "/" + e["captures"].dump();
@@ -303,20 +415,32 @@ static int run(int argc, char** argv) {
   const std::string cmd = argv[i++];
   const std::vector<std::string> args(argv + i, argv + argc);
   json request;
-  if (cmd != "watch" && cmd != "calibrate") request = buildRequest(cmd, args);
-  if (cmd == "calibrate") request = calibrateRequest(args);
+  const bool key_value = cmd == "calibrate" || cmd == "latency";
+  std::string snapshot_file;
+  if (cmd == "snapshot") {
+    request = snapshotRequest(args, snapshot_file);
+  } else if (cmd == "calibrate-camera") {
+    request = calibrateCameraRequest(args);
+  } else if (cmd != "watch" && !key_value) {
+    request = buildRequest(cmd, args);
+  }
+  if (key_value) request = keyValueRequest(cmd, args);
   if (cmd == "watch" && !args.empty()) usage(cmd + " takes no arguments");
 
   auto client = procam::ctl::Client::connect(o.socket, o.timeout);
   if (!client) return fail(client.error());
   if (cmd == "watch") return runWatch(o, *client);
-  if (cmd == "calibrate") return runOperation(o, *client, request);
+  if (key_value) return runOperation(o, *client, request);
+  if (cmd == "calibrate-camera" && request.value("action", "") != "finish") {
+    return runOperation(o, *client, request);
+  }
   if (cmd == "content" && request.value("action", "") == "load") {
     return runOperation(o, *client, request);
   }
   auto reply = client->call(request, o.timeout);
   if (!reply) return fail(reply.error());
   print(o, *reply, false);
+  if (cmd == "snapshot" && exitFor(*reply) == 0) return saveSnapshot(o, *reply, snapshot_file);
   return exitFor(*reply);
 }
 

@@ -12,6 +12,7 @@
 
 #include <cstdint>
 #include <opencv2/core/mat.hpp>
+#include <optional>
 #include <string>
 
 #include "core/error.hpp"
@@ -54,6 +55,11 @@ class Camera {
   // kNotSupported naming the control when the device does not have it. kAutoExposure
   // takes 0 (manual) or 1 (automatic).
   virtual Result<void> setControl(Control control, double value) = 0;
+  // The exposure (seconds) and gain (the `gain` option's unit) in effect, read from
+  // the device; nullopt where it cannot tell.
+  virtual std::optional<double> exposureSeconds() { return std::nullopt; }
+  virtual std::optional<double> gain() { return std::nullopt; }
+  virtual bool gainInDb() const { return false; }
   // A descriptor that becomes readable when a frame is waiting, or -1.
   virtual int pollFd() const { return -1; }
   virtual std::string name() const = 0;

@@ -91,6 +91,13 @@ Result<BoardView> detectBoard(const BoardSpec& s, const cv::Mat& image) {
       case BoardKind::kChecker: {
         std::vector<cv::Point2f> corners;
         const cv::Size size(s.cols, s.rows);
+        // The sector-based detector first, as a gate: on a board partly out of view
+        // the classic one passes its fast check and then searches for 10 s (measured
+        // on 800x600 frames; the gate answers in 40-130 ms). The corners stay the
+        // classic detector's, refined below.
+        if (!cv::findChessboardCornersSB(g, size, corners, cv::CALIB_CB_NORMALIZE_IMAGE))
+          return fail(ErrorCode::kNotFound, "checkerboard not found");
+        corners.clear();
         if (!cv::findChessboardCorners(g, size, corners,
                                        cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE |
                                            cv::CALIB_CB_FAST_CHECK))

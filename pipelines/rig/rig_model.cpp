@@ -138,6 +138,11 @@ Result<RigCamera> cameraFromJson(const json& c, const std::string& where, size_t
   out.model.pose = {*R, *t};
   out.rms_px = numberField(c, "reprojection_rms_px", -1);
   out.calibrated = provenance(c);
+  // Absent in files written before cameras could be calibrated alone: posed.
+  if (auto it = c.find("pose_known"); it != c.end()) {
+    if (!it->is_boolean()) return fail(ErrorCode::kParse, where + ": 'pose_known' must be a bool");
+    out.pose_known = it->get<bool>();
+  }
   return out;
 }
 
@@ -382,6 +387,7 @@ json rigToJson(const RigModel& rig) {
                {"dist", {m.dist.k1, m.dist.k2, m.dist.p1, m.dist.p2, m.dist.k3}},
                {"R", matrixJson(m.pose.R)},
                {"t", vecJson(m.pose.t)},
+               {"pose_known", c.pose_known},
                {"calibrated", provenanceJson(c.calibrated)}};
     if (c.rms_px >= 0) cj["reprojection_rms_px"] = c.rms_px;
     j["cameras"].push_back(std::move(cj));

@@ -36,6 +36,9 @@ struct RigCamera {
   geom::CameraModel model;
   double rms_px = -1;  // reprojection RMS; < 0 when unknown
   Provenance calibrated;
+  // false: only K and the distortion are known (a camera calibrated alone from board
+  // views); the pose is then the identity and no route may use the camera.
+  bool pose_known = true;
 };
 
 // How a tilt sensor sits on a projector and how its readings are corrected.

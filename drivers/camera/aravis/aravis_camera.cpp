@@ -371,6 +371,26 @@ Result<double> AravisCamera::exposure() const {
   return us * 1e-6;
 }
 
+std::optional<double> AravisCamera::exposureSeconds() {
+  auto e = exposure();
+  if (!e || !std::isfinite(*e)) return std::nullopt;
+  return *e;
+}
+
+std::optional<double> AravisCamera::gain() {
+  if (!camera_) return std::nullopt;
+  GError* error = nullptr;
+  const bool available = arv_camera_is_gain_available(camera_, &error);
+  g_clear_error(&error);
+  if (!available) return std::nullopt;
+  const double db = arv_camera_get_gain(camera_, &error);
+  if (error) {
+    g_clear_error(&error);
+    return std::nullopt;
+  }
+  return std::isfinite(db) ? std::optional<double>(db) : std::nullopt;
+}
+
 Result<void> AravisCamera::setControl(Control control, double value) {
   if (!camera_) return fail(ErrorCode::kInvalidInput, name() + ": not open");
   if (!std::isfinite(value))

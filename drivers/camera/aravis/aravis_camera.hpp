@@ -71,6 +71,10 @@ class AravisCamera final : public Camera {
 
   // The camera's exposure time in seconds (read back), for checks.
   Result<double> exposure() const;
+  std::optional<double> exposureSeconds() override;
+  // GenICam Gain, dB.
+  std::optional<double> gain() override;
+  bool gainInDb() const override { return true; }
   // Buffers the stream dropped or completed badly since start.
   uint64_t failedFrames() const { return failed_; }
 

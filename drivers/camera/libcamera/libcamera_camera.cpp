@@ -77,6 +77,7 @@ struct LibcameraCamera::State {
   std::mutex mutex;
   std::deque<lc::Request*> completed;  // filled on libcamera's thread
   lc::Request* held = nullptr;
+  std::optional<double> exposure_s, analogue_gain;  // the last frame's metadata
   cv::Mat storage;
   Frame frame;
 
@@ -258,9 +259,20 @@ Result<const Frame*> LibcameraCamera::capture(int timeout_ms) {
                         s.stride};
   if (auto ok = convertFrame(src, s.format.pixel, true, s.storage, s.frame); !ok)
     return fail(ok.error().code, name() + ": " + ok.error().message);
+  const lc::ControlList& controls = r->metadata();
+  if (auto us = controls.get(lc::controls::ExposureTime)) s.exposure_s = double(*us) * 1e-6;
+  if (auto g = controls.get(lc::controls::AnalogueGain)) s.analogue_gain = double(*g);
   s.frame.sequence = meta.sequence;
   s.frame.timestamp_ns = meta.timestamp ? meta.timestamp : monotonicNs();
   return &s.frame;
+}
+
+std::optional<double> LibcameraCamera::exposureSeconds() {
+  return s_ ? s_->exposure_s : std::nullopt;
+}
+
+std::optional<double> LibcameraCamera::gain() {
+  return s_ ? s_->analogue_gain : std::nullopt;
 }
 
 Result<void> LibcameraCamera::setControl(Control control, double value) {

@@ -39,6 +39,9 @@ class LibcameraCamera final : public Camera {
   // Applied to the requests queued from now on. Gain is libcamera's analogue gain
   // (a multiplier, not dB); white balance is ColourTemperature with AWB off.
   Result<void> setControl(Control control, double value) override;
+  // From the metadata of the last frame captured (ExposureTime, AnalogueGain).
+  std::optional<double> exposureSeconds() override;
+  std::optional<double> gain() override;
   int pollFd() const override;
   std::string name() const override { return "libcamera " + options_.id; }
 

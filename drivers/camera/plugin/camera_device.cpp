@@ -119,6 +119,18 @@ int capture(void* self, int timeout_ms, procam_image* out, char* err, std::size_
   }
 }
 
+int getSettings(void* self, procam_camera_settings* out) {
+  try {
+    Camera* c = cam(self);
+    out->exposure_s = c->exposureSeconds().value_or(std::nan(""));
+    out->gain = c->gain().value_or(std::nan(""));
+    out->gain_db = c->gainInDb() ? 1 : 0;
+    return PROCAM_OK;
+  } catch (const std::exception&) {
+    return PROCAM_EINTERNAL;
+  }
+}
+
 int pollFd(void* self) {
   return cam(self)->pollFd();
 }
@@ -129,8 +141,8 @@ void destroy(void* self) {
   delete c;
 }
 
-const procam_camera_ops kOps = {PROCAM_CAMERA_OPS_VERSION, &getFormat, &setExposure, &capture,
-                                nullptr};
+const procam_camera_ops kOps = {
+    PROCAM_CAMERA_OPS_VERSION, &getFormat, &setExposure, &capture, nullptr, &getSettings};
 
 }  // namespace
 

@@ -393,6 +393,26 @@ bool V4l2Camera::hasCtrl(uint32_t id) {
   return io_->ioctl(fd_, VIDIOC_QUERYCTRL, &q) == 0 && !(q.flags & V4L2_CTRL_FLAG_DISABLED);
 }
 
+std::optional<int64_t> V4l2Camera::getCtrl(uint32_t id) {
+  if (fd_ < 0 || !hasCtrl(id)) return std::nullopt;
+  v4l2_control c{};
+  c.id = id;
+  if (io_->ioctl(fd_, VIDIOC_G_CTRL, &c) != 0) return std::nullopt;
+  return c.value;
+}
+
+std::optional<double> V4l2Camera::exposureSeconds() {
+  auto v = getCtrl(V4L2_CID_EXPOSURE_ABSOLUTE);
+  if (!v) return std::nullopt;
+  return double(*v) * 1e-4;
+}
+
+std::optional<double> V4l2Camera::gain() {
+  auto v = getCtrl(V4L2_CID_GAIN);
+  if (!v) return std::nullopt;
+  return double(*v);
+}
+
 Result<void> V4l2Camera::setCtrl(uint32_t id, int64_t value, Control control) {
   if (fd_ < 0) return fail(ErrorCode::kInvalidInput, name() + ": not open");
   v4l2_queryctrl q{};

@@ -55,6 +55,9 @@ class V4l2Camera final : public Camera {
   // points into the mapped buffer when no conversion is needed.
   Result<const Frame*> capture(int timeout_ms) override;
   Result<void> setControl(Control control, double value) override;
+  // V4L2_CID_EXPOSURE_ABSOLUTE (100 us units) and V4L2_CID_GAIN (the device's unit).
+  std::optional<double> exposureSeconds() override;
+  std::optional<double> gain() override;
   int pollFd() const override { return fd_; }
   std::string name() const override { return "v4l2 " + options_.device; }
 
@@ -74,6 +77,7 @@ class V4l2Camera final : public Camera {
   // QUERYCTRL then S_CTRL; kNotSupported when the device has no such control.
   Result<void> setCtrl(uint32_t id, int64_t value, Control control);
   bool hasCtrl(uint32_t id);
+  std::optional<int64_t> getCtrl(uint32_t id);
   Error errnoError(int negErrno, const std::string& what) const;
 
   V4l2Options options_;

@@ -1,6 +1,7 @@
 #include "sim_plugin.hpp"
 
 #include <array>
+#include <cmath>
 #include <cstring>
 #include <exception>
 #include <memory>
@@ -268,8 +269,24 @@ int cameraCapture(void* self, int, procam_image* out, char* err, size_t len) {
 int cameraCheck(void* self, char* err, size_t len) {
   return presence(static_cast<Device*>(self)->name, err, len);
 }
-const procam_camera_ops kCameraOps = {PROCAM_CAMERA_OPS_VERSION, cameraFormat, cameraExposure,
-                                      cameraCapture, cameraCheck};
+// The scene's exposure is a factor on radiance, not a time: only the gain is told,
+// in dB of its amplitude factor.
+int cameraSettings(void* self, procam_camera_settings* out) {
+  auto* dev = static_cast<Device*>(self);
+  const CameraSpec* spec = cameraSpec(dev);
+  if (!spec) return PROCAM_ENODEV;
+  out->exposure_s = std::nan("");
+  out->gain = 20.0 * std::log10(spec->gain);
+  out->gain_db = 1;
+  return PROCAM_OK;
+}
+
+const procam_camera_ops kCameraOps = {PROCAM_CAMERA_OPS_VERSION,
+                                      cameraFormat,
+                                      cameraExposure,
+                                      cameraCapture,
+                                      cameraCheck,
+                                      cameraSettings};
 
 template <procam_family Family>
 int create(const procam_device_desc* d, const procam_config*, procam_device* out, char* err,

@@ -37,7 +37,7 @@ extern "C" {
 #define PROCAM_PLUGIN_ABI_VERSION 2u
 
 /* The operations table versions this header describes. */
-#define PROCAM_CAMERA_OPS_VERSION 1u
+#define PROCAM_CAMERA_OPS_VERSION 2u
 #define PROCAM_TILT_OPS_VERSION 2u
 #define PROCAM_TRACKER_OPS_VERSION 1u
 #define PROCAM_OUTPUT_OPS_VERSION 3u
@@ -105,6 +105,14 @@ typedef struct procam_image {
   uint64_t timestamp_ns; /* CLOCK_MONOTONIC */
 } procam_image;
 
+/* What a camera runs at now (procam_camera_ops::get_settings). NaN where the
+ * driver cannot tell. */
+typedef struct procam_camera_settings {
+  double exposure_s; /* exposure time, seconds */
+  double gain;       /* in the unit of the driver's `gain` option */
+  uint32_t gain_db;  /* 1 when `gain` is in dB, 0 for a device unit */
+} procam_camera_settings;
+
 /* Camera. `capture` fills `out` with a buffer owned by the driver that stays
  * valid until the next capture or destroy. */
 typedef struct procam_camera_ops {
@@ -118,6 +126,10 @@ typedef struct procam_camera_ops {
    * that delivered no frame for a second; without `check` it captures a frame,
    * which a camera that renders or transfers large frames pays for. */
   int (*check)(void* self, char* err, size_t err_len);
+  /* Version 2, optional (may be NULL): the exposure and gain the camera runs at,
+   * read from the device where it can tell (an installer aiming a camera wants
+   * the values in effect, automatic exposure included). */
+  int (*get_settings)(void* self, procam_camera_settings* out);
 } procam_camera_ops;
 
 /* Tilt sensor: specific force in the sensor frame (m/s^2). At rest it reads

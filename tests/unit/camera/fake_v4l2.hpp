@@ -239,6 +239,12 @@ class FakeV4l2 final : public V4l2Io {
         *q = it->second;
         return 0;
       }
+      case VIDIOC_G_CTRL: {
+        auto* c = static_cast<v4l2_control*>(arg);
+        if (!s_->controls.count(c->id)) return -EINVAL;
+        c->value = s_->values[c->id];
+        return 0;
+      }
       case VIDIOC_S_CTRL: {
         auto* c = static_cast<v4l2_control*>(arg);
         if (!s_->controls.count(c->id)) return -EINVAL;

@@ -221,6 +221,30 @@ TEST(V4l2Controls, ManualExposureGainPowerLineAndWhatIsMissing) {
   EXPECT_EQ(mono.setControl(Control::kExposure, 0.01).error().code, ErrorCode::kNotSupported);
 }
 
+// What `snapshot` reports: the values in effect, read from the device (the
+// camera's own changes included), nothing for a control it lacks.
+TEST(V4l2Controls, ExposureAndGainAreReadBackFromTheDevice) {
+  auto s = uvcLike();
+  auto cam = camera(s);
+  ASSERT_TRUE(cam.start());
+  ASSERT_TRUE(cam.exposureSeconds());
+  EXPECT_DOUBLE_EQ(*cam.exposureSeconds(), 0.0156);  // 156 x 100 µs
+  ASSERT_TRUE(cam.setControl(Control::kExposure, 0.02));
+  EXPECT_DOUBLE_EQ(*cam.exposureSeconds(), 0.02);
+  s->values[V4L2_CID_EXPOSURE_ABSOLUTE] = 333;  // automatic exposure moved it
+  EXPECT_DOUBLE_EQ(*cam.exposureSeconds(), 0.0333);
+  EXPECT_FALSE(cam.gain());
+  EXPECT_FALSE(cam.gainInDb());
+
+  auto m = monoCamera();
+  auto mono = camera(m);
+  ASSERT_TRUE(mono.start());
+  EXPECT_FALSE(mono.exposureSeconds());
+  ASSERT_TRUE(mono.setControl(Control::kGain, 42));
+  ASSERT_TRUE(mono.gain());
+  EXPECT_DOUBLE_EQ(*mono.gain(), 42.0);
+}
+
 TEST(V4l2Vanish, UnplugGivesNoDeviceAndACleanStop) {
   auto s = monoCamera();
   auto cam = camera(s);

@@ -214,8 +214,8 @@ inline int cameraCapture(void* self, int, procam_image* out, char* err, size_t l
   out->timestamp_ns = ++c->frames;
   return PROCAM_OK;
 }
-inline const procam_camera_ops kCameraOps = {PROCAM_CAMERA_OPS_VERSION, cameraFormat,
-                                             cameraExposure, cameraCapture, nullptr};
+inline const procam_camera_ops kCameraOps = {
+    PROCAM_CAMERA_OPS_VERSION, cameraFormat, cameraExposure, cameraCapture, nullptr, nullptr};
 
 inline int noFd(void*) {
   return -1;
@@ -255,8 +255,8 @@ inline int cameraCheck(void*, char* err, size_t len) {
   }
   return PROCAM_OK;
 }
-inline const procam_camera_ops kCheckedCameraOps = {PROCAM_CAMERA_OPS_VERSION, cameraFormat,
-                                                    cameraExposure, cameraCapture, cameraCheck};
+inline const procam_camera_ops kCheckedCameraOps = {
+    PROCAM_CAMERA_OPS_VERSION, cameraFormat, cameraExposure, cameraCapture, cameraCheck, nullptr};
 inline int createCheckedCamera(const procam_device_desc* d, const procam_config* c,
                                procam_device* out, char* err, size_t len) {
   const int rc = createCamera(d, c, out, err, len);
