@@ -498,6 +498,25 @@ tl::expected<std::vector<CalibrationOutcome>, CalibrationFailure> runBatchCalibr
       continue;
     }
     auto route = calib::solveStereoRoute(member.set, views[0], views[1], member.grid);
+    if (!route && route.error().code == ErrorCode::kCoplanar) {
+      // A planar scene fixes no projection matrix ([Raskar02] §4.1.1 needs relief), but
+      // the pair still measures the plane: the projector takes the plane route on it
+      // (§4.2.4), as with a plane an installer gives.
+      const std::optional<geom::Plane> prior =
+          member.scene_plane ? *member.scene_plane : std::optional<geom::Plane>();
+      auto fit = calib::triangulatedPlane(member.set, views[0], views[1], member.grid, prior);
+      if (!fit) {
+        return tl::unexpected(CalibrationFailure{
+            code::kFailed, route.error().message + "; as a plane: " + fit.error().message});
+      }
+      auto planar =
+          calib::solvePlaneHomographyRoute(member.set, views[0], fit->plane, {.step = member.grid});
+      if (!planar) return tl::unexpected(CalibrationFailure{code::kFailed, planar.error().message});
+      out.planar = std::move(*planar);
+      if (member.scene_plane) *member.scene_plane = fit->plane;
+      out.triangulated_plane = std::move(*fit);
+      continue;
+    }
     if (!route) return tl::unexpected(CalibrationFailure{code::kFailed, route.error().message});
     out.route = std::move(*route);
   }

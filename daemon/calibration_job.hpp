@@ -86,6 +86,10 @@ struct CalibrationPlan {
   std::optional<calib::BoardSpec> board;   // set: route (b′), the plane from this board
   std::string board_text;
   bool response = false;  // a grey ramp after the patterns: the projector's response
+  // Route (a) on a planar scene: the plane the run's projectors share, the rig's
+  // surface plane at the start (taken when the nodes lie on it), else the first one
+  // triangulated. One object for all plans of a run; only the run's worker touches it.
+  std::shared_ptr<std::optional<geom::Plane>> scene_plane;
 
   bool planar() const { return plane || board; }
 
@@ -119,9 +123,12 @@ struct CalibrationOutcome {
   calib::StereoRouteResult route;                      // route (a)
   std::optional<calib::PlaneHomographyResult> planar;  // route (b′)
   std::optional<calib::BoardPlane> board;              // route (b′) on a board's plane
-  std::optional<blend::ProjectorResponse> response;    // from the grey ramp
-  std::vector<int> decoded;                            // camera pixels decoded, per camera
-  int settle_frames = 0;                               // waited after every pattern
+  // Route (a) on a planar scene: the plane the two cameras triangulated, which the
+  // projector then takes route (b′) on.
+  std::optional<geom::PlaneFit> triangulated_plane;
+  std::optional<blend::ProjectorResponse> response;  // from the grey ramp
+  std::vector<int> decoded;                          // camera pixels decoded, per camera
+  int settle_frames = 0;                             // waited after every pattern
   nlohmann::json latency;  // the measured latency (auto_settle; latencyJson), else null
 };
 

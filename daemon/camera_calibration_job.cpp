@@ -63,7 +63,7 @@ tl::expected<CameraCalibrationArgs, std::string> parseCameraCalibrationArgs(cons
       !numberArg(request, "rms_px", 0.01, 100, a.rms_px, error) ||
       !numberArg(request, "timeout_s", 1, 3600, a.timeout_s, error) ||
       !numberArg(request, "interval_s", 0, 10, a.interval_s, error) ||
-      !numberArg(request, "min_shift", 0, 0.5, a.min_shift, error)) {
+      !numberArg(request, "min_shift", 0.005, 0.5, a.min_shift, error)) {
     return tl::unexpected(error);
   }
   if (views != std::floor(views)) return tl::unexpected(std::string("\"views\" must be whole"));
@@ -110,6 +110,12 @@ tl::expected<CameraCalibrationResult, CalibrationFailure> runCameraCalibration(
     auto frame = captureGray(plan.camera);
     if (!frame) return tl::unexpected(frame.error());
     ++status.frames;
+    if (frame->cols != plan.width || frame->rows != plan.height) {
+      return tl::unexpected(CalibrationFailure{
+          code::kFailed, "camera '" + plan.camera.name + "' changed its frame size to " +
+                             std::to_string(frame->cols) + "x" + std::to_string(frame->rows) +
+                             " during the calibration"});
+    }
     cv::Mat gray8 = *frame;
     if (gray8.depth() == CV_16U) gray8.convertTo(gray8, CV_8U, 1.0 / 257.0);
     auto view = calib::detectBoard(args.board, gray8);
@@ -142,6 +148,11 @@ tl::expected<CameraCalibrationResult, CalibrationFailure> runCameraCalibration(
     if (status.kept >= args.views && status.coverage >= args.coverage && solved &&
         status.rms_px <= args.rms_px) {
       result.stopped = "targets";
+      break;
+    }
+    // Bounded work and memory: twice the views asked for is enough to judge by.
+    if (status.kept >= 2 * args.views) {
+      result.stopped = "views";
       break;
     }
     if (!waitCancellable(args.interval_s, hooks)) continue;  // the loop's check answers

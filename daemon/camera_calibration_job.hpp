@@ -55,7 +55,7 @@ nlohmann::json cameraCalibrationJson(const CameraCalibrationStatus& status);
 struct CameraCalibrationResult {
   calib::CameraCalibration calibration;
   CameraCalibrationStatus status;
-  std::string stopped;  // "targets", "finish" or "timeout"
+  std::string stopped;  // "targets", "views" (twice the views asked), "finish" or "timeout"
 };
 
 // kFailed with the counts when fewer than 4 views were kept.

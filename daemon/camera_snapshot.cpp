@@ -70,7 +70,9 @@ tl::expected<Snapshot, CalibrationFailure> takeSnapshot(const CalibrationDevice&
     }
   }
   procam_image img{};
-  if (int rc = raw.ops.camera->capture(raw.self, 5000, &img, err, sizeof err - 1);
+  // 5 s, or long enough for two frames of a long exposure asked for.
+  const int timeout_ms = exposure_s ? std::max(5000, int(2000 * *exposure_s) + 1000) : 5000;
+  if (int rc = raw.ops.camera->capture(raw.self, timeout_ms, &img, err, sizeof err - 1);
       rc != PROCAM_OK) {
     return tl::unexpected(deviceFailure("camera", camera.name, rc, "capture", err));
   }

@@ -34,7 +34,8 @@ struct Snapshot {
 };
 
 // Sets the exposure first when one is given (the camera keeps it), then captures one
-// frame (5 s at most) and encodes it. Worker thread; the caller holds the camera.
+// frame (5 s at most, or two exposures and a second) and encodes it. Worker thread; the caller
+// holds the camera.
 tl::expected<Snapshot, CalibrationFailure> takeSnapshot(const CalibrationDevice& camera,
                                                         std::optional<double> exposure_s);
 

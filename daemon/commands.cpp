@@ -165,8 +165,8 @@ void Daemon::cmdWatch(ClientId client, const proto::Request& req) {
   replyTo(client, req, "WATCH",
           {{"enabled", enable},
            {"events",
-            {"device-added", "device-removed", "progress", "finished", "keystone", "pattern",
-             "content", "config", "warning"}}});
+            {"device-added", "device-removed", "progress", "finished", "views", "keystone",
+             "pattern", "content", "config", "warning"}}});
 }
 
 void Daemon::cmdCancel(ClientId client, const proto::Request& req) {

@@ -190,8 +190,17 @@ Learnt learntByStereoRoute(const CalibrationPlan& plan, const CalibrationOutcome
 // becomes the rig's surface, one read from the rig stays as it was.
 Learnt learntByPlaneRoute(const CalibrationPlan& plan, const CalibrationOutcome& result) {
   const calib::PlaneHomographyResult& route = *result.planar;
-  const std::optional<geom::Plane> plane = result.board ? result.board->plane : plan.plane;
-  const char* source = result.board ? "board" : plan.plane_from_rig ? "rig" : "request";
+  // Route (b′) always has a plane: the request's or the rig's (plan.plane), a board's,
+  // or the one two cameras triangulated.
+  geom::Plane plane = plan.plane.value_or(geom::Plane{});
+  const char* source = plan.plane_from_rig ? "rig" : "request";
+  if (result.board) {
+    plane = result.board->plane;
+    source = "board";
+  } else if (result.triangulated_plane) {
+    plane = result.triangulated_plane->plane;
+    source = "cameras";
+  }
   Learnt out;
   rig::RigProjector projector = projectorEntry(plan);
   projector.intrinsics_known = false;
@@ -199,14 +208,17 @@ Learnt learntByPlaneRoute(const CalibrationPlan& plan, const CalibrationOutcome&
   projector.plane_homography = route.projector_to_plane;
   projector.rms_px = route.rms_projector_px;
   projector.points = static_cast<long>(route.inliers);
-  projector.calibrated = {"structured light, route (b′): camera " + plan.cameras.at(0).device.name +
-                              ", plane from the " +
-                              (result.board          ? "board " + plan.board_text
-                               : plan.plane_from_rig ? std::string("rig model")
-                                                     : std::string("calibrate request")),
-                          utcNow()};
+  projector.calibrated = {
+      "structured light, route (b′): camera " + plan.cameras.at(0).device.name +
+          ", plane from the " +
+          (result.board                ? "board " + plan.board_text
+           : result.triangulated_plane ? "cameras " + plan.cameras.at(0).device.name + " and " +
+                                             plan.cameras.at(1).device.name + " (a planar scene)"
+           : plan.plane_from_rig ? std::string("rig model")
+                                 : std::string("calibrate request")),
+      utcNow()};
   out.update.projectors.push_back(projector);
-  if (!plan.plane_from_rig) out.update.surface.plane = plane;
+  if (!plan.plane_from_rig || result.triangulated_plane) out.update.surface.plane = plane;
   rig::RigModel shown = out.update;
   shown.surface.plane = plane;
   const json learnt = rig::rigToJson(shown);
@@ -223,6 +235,10 @@ Learnt learntByPlaneRoute(const CalibrationPlan& plan, const CalibrationOutcome&
                  {"coverage", route.coverage},
                  {"samples", route.samples},
                  {"inliers", route.inliers}}}};
+  if (result.triangulated_plane) {
+    out.reply["triangulated_plane"] = {{"rms_m", result.triangulated_plane->rms},
+                                       {"inliers", result.triangulated_plane->inliers.size()}};
+  }
   if (result.board) {
     out.reply["board"] = {{"spec", plan.board_text},
                           {"points", result.board->points},
@@ -300,6 +316,9 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
                    "(the plane goes into the rig model), then the others without it");
   }
   std::vector<std::shared_ptr<const CalibrationPlan>> plans;
+  // Projectors on one planar wall must share its plane (the tiled display joins them on
+  // it): the first one triangulated, or the rig's when the new nodes lie on it.
+  auto scene_plane = std::make_shared<std::optional<geom::Plane>>(rig_.surface.plane);
   for (const std::string& output : outputs) {
     CalibrationArgs one = *args;
     one.output = output;
@@ -309,6 +328,7 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
     }
     auto made = makePlan(devices_, one, config_.calibration, rig_);
     if (!made) return errorTo(client, req, made.error().code, made.error().message);
+    made->scene_plane = scene_plane;
     plans.push_back(std::make_shared<const CalibrationPlan>(std::move(*made)));
   }
   const auto& plan = plans.front();

@@ -30,6 +30,10 @@ json cameraJson(const rig::RigCamera& c) {
 }  // namespace
 
 void Daemon::cmdCalibrateCamera(ClientId client, const proto::Request& req) {
+  if (req.body.contains("action") && !req.body["action"].is_string()) {
+    return errorTo(client, req, code::kBadArgument,
+                   "\"action\" is \"start\" (the default) or \"finish\"");
+  }
   if (req.body.value("action", "") == "finish") {
     json finishing = json::array();
     for (auto& [id, op] : operations_) {
@@ -167,6 +171,8 @@ void Daemon::cmdCalibrateCamera(ClientId client, const proto::Request& req) {
                         {"reprojection_rms_px", camera.rms_px}});
           rig::RigModel update;
           update.cameras.push_back(camera);
+          // Past cancelling: the result is being written.
+          operations_.erase(op_id);
           io_worker_->submit(
               [this, dir = options_.state_dir, update, reply, end] {
                 auto merged = mergeIntoRig(dir, update, {});

@@ -61,18 +61,19 @@ void Daemon::cmdSnapshot(ClientId client, const proto::Request& req) {
   }
   if (!args.ok()) return errorTo(client, req, code::kBadArgument, args.error());
   if (!calibration_.op.empty()) {
-    return errorTo(client, req, code::kBusy,
-                   calibration_.op + " holds the devices; wait for it or cancel it");
+    return errorTo(client, req, code::kBusy, calibration_.op + " holds the devices; try again");
   }
   const DeviceEntry* cam = name ? devices_.find(*name) : devices_.firstUsable(PROCAM_FAMILY_CAMERA);
   if (!cam || !cam->usable() || cam->description.family != PROCAM_FAMILY_CAMERA) {
     return errorTo(client, req, code::kUnavailable,
                    name ? "no usable camera named '" + *name + "'" : "no usable camera");
   }
+  if (refuseOverJobLimit(client, req)) return;
   const CalibrationDevice camera{cam->name, cam->device.share()};
   const std::string op_id = "snapshot-" + std::to_string(next_operation_++);
   const ReadFence fence = device_manager_->readFence({camera.name});
   beginCalibrationOp(op_id, {camera.name});
+  server_->hold(client);  // the reply comes from the worker; answerFailure releases too
   const std::string dir = options_.state_dir + "/snapshots";
   compute_worker_->submit(
       [this, client, req, camera, exposure, fence, dir] {
@@ -90,6 +91,7 @@ void Daemon::cmdSnapshot(ClientId client, const proto::Request& req) {
         }
         return [this, client, req, camera, shot, written, path = file.path()] {
           calibration_.op.clear();
+          server_->release(client);
           if (!shot) {
             logWarning("snapshot of '" + camera.name + "': " + shot.error().message);
             errorTo(client, req, shot.error().code, shot.error().message);

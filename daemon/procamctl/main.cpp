@@ -327,7 +327,9 @@ json calibrateCameraRequest(const std::vector<std::string>& a) {
 // the file the user asked for.
 int saveSnapshot(const Options& o, const json& reply, std::string file) {
   const std::string from = reply.value("path", "");
-  if (file.empty()) file = reply.value("camera", "snapshot") + ".png";
+  // The daemon's file name is the camera's made safe for a file system.
+  if (file.empty()) file = std::filesystem::path(from).filename().string();
+  if (file.empty()) file = "snapshot.png";
   std::error_code ec;
   std::filesystem::copy_file(from, file, std::filesystem::copy_options::overwrite_existing, ec);
   if (ec) {
@@ -437,7 +439,10 @@ static int run(int argc, char** argv) {
   if (cmd == "content" && request.value("action", "") == "load") {
     return runOperation(o, *client, request);
   }
-  auto reply = client->call(request, o.timeout);
+  // A long exposure asked for takes its time before the daemon can answer.
+  const auto timeout = std::max(o.timeout, std::chrono::milliseconds(static_cast<int64_t>(
+                                               2000 * request.value("exposure_s", 0.0) + 6000)));
+  auto reply = client->call(request, cmd == "snapshot" ? timeout : o.timeout);
   if (!reply) return fail(reply.error());
   print(o, *reply, false);
   if (cmd == "snapshot" && exitFor(*reply) == 0) return saveSnapshot(o, *reply, snapshot_file);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <opencv2/imgproc.hpp>
 
 namespace procam::calib {
@@ -10,18 +11,21 @@ namespace {
 
 constexpr std::size_t kMinPoints = 6;
 
+// A board point as a key: micrometres, exact for the boards' metric grid.
+std::pair<long long, long long> key(const Vec3& p) {
+  return {std::llround(p.x() * 1e6), std::llround(p.y() * 1e6)};
+}
+
 // The mean distance between the image points of the board points `a` and `b` share;
 // infinity when they share fewer than kMinPoints (partial boards: ChArUco, AprilGrid).
-double meanShift(const BoardView& a, const BoardView& b) {
+double meanShift(const BoardView& a, const std::map<std::pair<long long, long long>, Vec2>& b) {
   double sum = 0;
   std::size_t shared = 0;
   for (std::size_t i = 0; i < a.board.size(); ++i) {
-    for (std::size_t j = 0; j < b.board.size(); ++j) {
-      if ((a.board[i] - b.board[j]).norm() > 1e-9) continue;
-      sum += (a.image[i] - b.image[j]).norm();
-      ++shared;
-      break;
-    }
+    auto it = b.find(key(a.board[i]));
+    if (it == b.end()) continue;
+    sum += (a.image[i] - it->second).norm();
+    ++shared;
   }
   return shared < kMinPoints ? INFINITY : sum / double(shared);
 }
@@ -61,10 +65,12 @@ ViewVerdict BoardViewSet::offer(const BoardView& view) {
       return ViewVerdict::kOutside;
     }
   }
-  for (const auto& kept : views_) {
+  for (const auto& kept : keyed_) {
     if (meanShift(view, kept) < min_shift_px_) return ViewVerdict::kRepeated;
   }
   views_.push_back(view);
+  auto& keyed = keyed_.emplace_back();
+  for (std::size_t i = 0; i < view.board.size(); ++i) keyed[key(view.board[i])] = view.image[i];
   std::vector<cv::Point2f> points, hull;
   for (const auto& p : view.image) points.emplace_back(float(p.x()), float(p.y()));
   cv::convexHull(points, hull);

@@ -4,7 +4,9 @@
 // orientations, and the image covered, for the distortion to be observed
 // everywhere): a view is kept unless it repeats one already kept, and the set
 // reports how much of the image its views cover.
+#include <map>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "calibration/board.hpp"
@@ -37,6 +39,8 @@ class BoardViewSet {
   double min_shift_px_;
   int cells_x_, cells_y_;
   std::vector<BoardView> views_;
+  // Each kept view's image points by board point, for the repeat test.
+  std::vector<std::map<std::pair<long long, long long>, Vec2>> keyed_;
   std::vector<unsigned char> covered_;  // cells_y_ x cells_x_
 };
 

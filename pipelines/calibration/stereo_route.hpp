@@ -8,8 +8,10 @@
 
 #include "calibration/projector_calibration.hpp"
 #include "geometry/camera_model.hpp"
+#include "geometry/plane_fit.hpp"
 #include "structured_light/decoder.hpp"
 #include "structured_light/pattern_set.hpp"
+#include "surface/stereo_points.hpp"
 #include "surface/surface_model.hpp"
 
 namespace procam::calib {
@@ -30,6 +32,24 @@ struct StereoRouteResult {
 // Inverse-map neighbourhood for a pattern set: Gray-only correspondences are cell
 // centres, so it spans several cells; phase-shifted ones are continuous.
 double sampleRadius(const sl::PatternSet& set);
+
+// The projector grid nodes (every `step` projector pixels) both cameras decoded,
+// triangulated. kInvalidInput when a decoded map's size is not its camera's;
+// kTooFewPoints below 20 nodes.
+Result<surface::SurfacePoints> triangulateNodes(const sl::PatternSet& set, const DecodedView& a,
+                                                const DecodedView& b, int step);
+
+// A planar scene (solveStereoRoute's kCoplanar): the plane the two cameras
+// triangulate, for the plane route (solvePlaneHomographyRoute): RANSAC with five
+// times the nodes' own noise (from second differences along the projector grid, at
+// least 0.5 mm) as the threshold; kDegenerate when fewer than 90 % of the nodes lie
+// on it (not one plane after all). solveStereoRoute answers kCoplanar by the same rule.
+// `prior` (the plane other projectors of the wall were calibrated on) is returned,
+// with the nodes' residuals, when 90 % of them lie within the threshold of it: every
+// projector of one wall then maps onto the same plane.
+Result<geom::PlaneFit> triangulatedPlane(const sl::PatternSet& set, const DecodedView& a,
+                                         const DecodedView& b, int step,
+                                         const std::optional<geom::Plane>& prior = {});
 
 // `step`: projector pixels between grid nodes. kInvalidInput when a decoded map's
 // size is not its camera's; kTooFewPoints below 20 triangulated nodes; the errors of

@@ -26,6 +26,12 @@ Result<std::vector<NamedCamera>> camerasFromJson(const nlohmann::json& doc,
   for (const auto& c : doc["cameras"]) {
     auto cam = cameraFromJson(c, where_doc + " camera " + std::to_string(out.size()), out.size());
     if (!cam) return tl::unexpected(cam.error());
+    // A camera calibrated alone (procamd calibrate-camera) has no pose to offer.
+    if (!cam->pose_known)
+      return fail(ErrorCode::kInvalidInput,
+                  where_doc + ": camera '" + cam->name +
+                      "' has intrinsics but no pose (pose_known false): calibrate the pair "
+                      "with procam-calibrate stereo first");
     out.push_back({cam->name, cam->model, -1});
   }
   return out;

@@ -12,7 +12,7 @@ trap 'rm -rf "$work"' EXIT
 for tool in dpkg-deb cpack; do
   command -v $tool >/dev/null || { echo "$tool not installed"; exit 77; }
 done
-fail() { echo "package: $*"; exit 1; }
+fail() { echo "package: $*" >&2; exit 1; }
 
 (cd "$src" && ./procam --no-deps package) >"$work/package.log" 2>&1 ||
   { tail -40 "$work/package.log"; fail "./procam package failed"; }

@@ -394,6 +394,53 @@ TEST(SimTiledWall, OtherOutputsAreBlackWhileOneIsCalibrated) {
   EXPECT_GE((*done)["homography"]["samples"].get<int>(), 0.95 * (1280 / 8) * (800 / 8));
 }
 
+// Two calibrated cameras and no plane: route (a) finds the wall coplanar (no projection
+// matrix follows from a plane), triangulates it instead and takes route (b′) on it.
+// With Gray codes alone the pair triangulates a node to about 2 mm RMS; over the
+// ~4,000 nodes of one projector the fitted plane's noise averages out (0.03 mm), and
+// 1 mm and 0.05 degrees leave room for the bias all nodes share (Gray codes decode
+// cell centres).
+TEST(SimTiledWall, TwoCamerasOnThePlanarWallTakeThePlaneTheyTriangulate) {
+  TempDir dir;
+  DaemonProcess d(dir, simWithTruth(dir, "tiled_wall", TruthParts::kCamerasOnly));
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  // Gray codes alone on a 16 px grid: the fewest captures that still give thousands of
+  // nodes (the plane is what is judged here, not the decoding's resolution).
+  const json request = {
+      {"cmd", "calibrate"}, {"id", 1},    {"output", "proj_tl"}, {"cameras", {"cam_a", "cam_b"}},
+      {"mode", "gray"},     {"grid", 16}, {"settle_frames", 0}};
+  auto started = c.call(request);
+  ASSERT_TRUE(started && (*started)["class"] == "CALIBRATE")
+      << (started ? started->dump() : "none");
+  EXPECT_EQ((*started)["route"], "a");
+  auto done = finalReply(c, 1, 600s);
+  ASSERT_TRUE(done) << d.log();
+  ASSERT_EQ((*done)["class"], "CALIBRATE") << done->dump();
+  EXPECT_EQ((*done)["route"], "b'");
+  EXPECT_EQ((*done)["plane_source"], "cameras");
+  const json& plane = (*done)["surface"]["plane"];
+  ASSERT_EQ(plane.size(), 4u) << done->dump();
+  const Vec3 n(plane[0].get<double>(), plane[1].get<double>(), plane[2].get<double>());
+  const double angle_deg = std::acos(std::min(1.0, n.normalized().dot(Vec3::UnitY()))) * 180 / M_PI;
+  const double offset_mm = std::abs(plane[3].get<double>() / n.norm() + 3.0) * 1000;
+  std::printf(
+      "[ figures  ] proj_tl, two cameras, no plane: wall triangulated from %d nodes "
+      "(RMS %.3f mm), normal %.4f deg and %.3f mm off the truth; collineation RMS %.4f px\n",
+      (*done)["triangulated_plane"]["inliers"].get<int>(),
+      1000 * (*done)["triangulated_plane"]["rms_m"].get<double>(), angle_deg, offset_mm,
+      (*done)["homography"]["rms_projector_px"].get<double>());
+  EXPECT_LT(angle_deg, 0.05);
+  EXPECT_LT(offset_mm, 1.0);
+  // The plane is the rig's surface now, and the projector has its collineation.
+  std::ifstream in(dir.file("state/rig.json"));
+  const json rig = json::parse(in, nullptr, false);
+  ASSERT_TRUE(rig.is_object());
+  EXPECT_EQ(rig["surface"]["plane"], plane);
+  ASSERT_EQ(rig["projectors"].size(), 1u);
+  EXPECT_TRUE(rig["projectors"][0].contains("plane_homography"));
+}
+
 // A display rectangle from the configuration ([keystone] display_centre, display_size:
 // world metres) instead of the largest one, on the true rig handed over explicitly (its
 // projectors have intrinsics and poses and the wall is a plane: each one's collineation
