@@ -497,14 +497,16 @@ tl::expected<std::vector<CalibrationOutcome>, CalibrationFailure> runBatchCalibr
       out.planar = std::move(*planar);
       continue;
     }
-    auto route = calib::solveStereoRoute(member.set, views[0], views[1], member.grid);
+    auto nodes = calib::triangulateNodes(member.set, views[0], views[1], member.grid);
+    if (!nodes) return tl::unexpected(CalibrationFailure{code::kFailed, nodes.error().message});
+    auto route = calib::solveStereoRoute(*nodes);
     if (!route && route.error().code == ErrorCode::kCoplanar) {
       // A planar scene fixes no projection matrix ([Raskar02] §4.1.1 needs relief), but
       // the pair still measures the plane: the projector takes the plane route on it
       // (§4.2.4), as with a plane an installer gives.
       const std::optional<geom::Plane> prior =
           member.scene_plane ? *member.scene_plane : std::optional<geom::Plane>();
-      auto fit = calib::triangulatedPlane(member.set, views[0], views[1], member.grid, prior);
+      auto fit = calib::triangulatedPlane(*nodes, prior);
       if (!fit) {
         return tl::unexpected(CalibrationFailure{
             code::kFailed, route.error().message + "; as a plane: " + fit.error().message});

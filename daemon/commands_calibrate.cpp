@@ -257,6 +257,55 @@ json responseJson(const blend::ProjectorResponse& r, const CalibrationCamera& ca
 
 }  // namespace
 
+CalibrationFailure Daemon::stoppedRun(const CalibrationFailure* error,
+                                      const char* cancelled) const {
+  CalibrationFailure f = error ? *error : CalibrationFailure{code::kCancelled, cancelled};
+  if (f.code == code::kCancelled && !calibration_.removed.empty()) f.message = calibration_.removed;
+  return f;
+}
+
+void Daemon::endDeviceOp(ClientId client, const proto::Request& req, const std::string& op_id,
+                         const char* kind, const char* reply_class, const json& reply,
+                         const CalibrationFailure* failure) {
+  operations_.erase(op_id);
+  calibration_.op.clear();
+  json finished = {{"operation", op_id}, {"kind", kind}, {"ok", failure == nullptr}};
+  if (failure) {
+    finished["error"] = failure->message;
+    logWarning(std::string(kind) + " " + op_id + ": " + failure->message);
+    errorTo(client, req, failure->code, failure->message);
+  } else {
+    replyTo(client, req, reply_class, reply);
+  }
+  operationEvent(client, "finished", finished);
+  server_->release(client);  // after the reply: a half-closed client may close now
+  // The device manager closes a lost device and retries it (or an ended one).
+  if (failure && closesDevice(failure->rc)) {
+    device_manager_->report(failure->device, failure->rc, failure->message);
+  }
+}
+
+void Daemon::writeRig(rig::RigModel update, std::map<std::string, std::string> meshes,
+                      std::function<void(const Result<std::string>&)> done) {
+  io_worker_->submit(
+      [this, dir = options_.state_dir, update = std::move(update), meshes = std::move(meshes),
+       done] {
+        auto merged = mergeIntoRig(dir, update, meshes);
+        return [this, merged, done, path = rigStateFile(dir).path()] {
+          if (!merged) {
+            return done(fail(ErrorCode::kIo, "rig.json not written: " + merged.error().message));
+          }
+          rig_ = *merged;
+          logInfo("rig model written to " + path);
+          done(path);
+          onRigChanged();
+        };
+      },
+      [done](const std::string& what) {
+        done(fail(ErrorCode::kIo, "rig.json not written: " + what));
+      });
+}
+
 void Daemon::beginCalibrationOp(const std::string& op_id, std::vector<std::string> devices) {
   calibration_ = {op_id, std::move(devices), "", calibration_.hooked};
   if (!calibration_.hooked) {
@@ -474,31 +523,12 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
         const json scanned = {{"batches", std::move(batches)}, {"captures", done}};
         return [this, client, req, op_id, cancelled, plans, result, progress, captures, scanned] {
           auto finish = [this, client, req, op_id](const json& reply, const Failure* failure) {
-            operations_.erase(op_id);
-            calibration_.op.clear();
-            json finished = {
-                {"operation", op_id}, {"kind", "calibrate"}, {"ok", failure == nullptr}};
-            if (failure) {
-              finished["error"] = failure->message;
-              logWarning("calibration " + op_id + ": " + failure->message);
-              errorTo(client, req, failure->code, failure->message);
-            } else {
-              replyTo(client, req, "CALIBRATE", reply);
-            }
-            operationEvent(client, "finished", finished);
-            server_->release(client);  // after the reply: a half-closed client may close now
-            // The device manager closes a lost device and retries it (or an ended one).
-            if (failure && closesDevice(failure->rc)) {
-              device_manager_->report(failure->device, failure->rc, failure->message);
-            }
+            endDeviceOp(client, req, op_id, "calibrate", "CALIBRATE", reply, failure);
             refreshOutputs();  // what the outputs showed before the pattern frames
           };
           if (!result || cancelled->load()) {
-            Failure f =
-                result ? Failure{code::kCancelled, "calibration cancelled"} : result.error();
-            if (f.code == code::kCancelled && !calibration_.removed.empty()) {
-              f.message = calibration_.removed;
-            }
+            const Failure f =
+                stoppedRun(result ? nullptr : &result.error(), "calibration cancelled");
             return finish({}, &f);
           }
           // From here on the result is written: a cancel no longer finds the operation.
@@ -532,39 +562,22 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
           }
           reply["operation"] = op_id;
           reply["state"] = "done";
-          // fsync may block: the I/O worker writes the meshes first, then rig.json
-          // (the previous versions stay as .bak; a failure leaves rig.json as it was).
-          io_worker_->submit(
-              [this, dir = options_.state_dir, update = std::move(update),
-               meshes = std::move(meshes), reply, finish] {
-                auto merged = mergeIntoRig(dir, update, meshes);
-                return [this, merged, reply, finish, path = rigStateFile(dir).path()]() mutable {
-                  if (!merged) {
-                    const Failure f{code::kIo, "rig.json not written: " + merged.error().message};
-                    return finish({}, &f);
-                  }
-                  rig_ = *merged;
-                  reply["path"] = path;
-                  reply["rig"] = {{"cameras", rig_.cameras.size()},
-                                  {"projectors", rig_.projectors.size()}};
-                  logInfo("calibration written to " + path);
-                  finish(reply, nullptr);
-                  onRigChanged();
-                };
-              },
-              [finish](const std::string& what) {
-                const Failure f{code::kIo, "rig.json not written: " + what};
-                finish({}, &f);
-              });
+          writeRig(std::move(update), std::move(meshes),
+                   [this, reply, finish](const Result<std::string>& path) mutable {
+                     if (!path) {
+                       const Failure f{code::kIo, path.error().message};
+                       return finish({}, &f);
+                     }
+                     reply["path"] = *path;
+                     reply["rig"] = {{"cameras", rig_.cameras.size()},
+                                     {"projectors", rig_.projectors.size()}};
+                     finish(reply, nullptr);
+                   });
         };
       },
       [this, client, req, op_id](const std::string& what) {
-        operations_.erase(op_id);
-        calibration_.op.clear();
-        operationEvent(
-            client, "finished",
-            {{"operation", op_id}, {"kind", "calibrate"}, {"ok", false}, {"error", what}});
-        answerFailure(client, req)(what);
+        const Failure f{code::kInternal, "the job failed: " + what};
+        endDeviceOp(client, req, op_id, "calibrate", "CALIBRATE", {}, &f);
         refreshOutputs();
       },
       client);

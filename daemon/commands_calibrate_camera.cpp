@@ -7,7 +7,7 @@
 #include "daemon.hpp"
 #include "device_manager.hpp"
 #include "log.hpp"
-#include "rig_store.hpp"
+#include "rig_store.hpp"  // utcNow
 
 namespace procam::daemon {
 
@@ -116,23 +116,8 @@ void Daemon::cmdCalibrateCamera(ClientId client, const proto::Request& req) {
                 {"stage", p.stage}};
   };
   const CalibrationHooks hooks = operationHooks(client, op_id, cancelled, progress);
-  auto end = [this, client, req, op_id](const std::optional<CalibrationFailure>& failure,
-                                        const json& reply) {
-    operations_.erase(op_id);
-    calibration_.op.clear();
-    json finished = {{"operation", op_id}, {"kind", "calibrate-camera"}, {"ok", !failure}};
-    if (failure) {
-      finished["error"] = failure->message;
-      logWarning("calibrate-camera " + op_id + ": " + failure->message);
-      errorTo(client, req, failure->code, failure->message);
-    } else {
-      replyTo(client, req, "CALIBRATE-CAMERA", reply);
-    }
-    operationEvent(client, "finished", finished);
-    server_->release(client);
-    if (failure && closesDevice(failure->rc)) {
-      device_manager_->report(failure->device, failure->rc, failure->message);
-    }
+  auto end = [this, client, req, op_id](const CalibrationFailure* failure, const json& reply) {
+    endDeviceOp(client, req, op_id, "calibrate-camera", "CALIBRATE-CAMERA", reply, failure);
   };
   compute_worker_->submit(
       [this, plan, hooks, on_frame, fence, cancelled, end, op_id] {
@@ -140,13 +125,9 @@ void Daemon::cmdCalibrateCamera(ClientId client, const proto::Request& req) {
         auto result = runCameraCalibration(*plan, hooks, on_frame);
         return [this, plan, result, cancelled, end, op_id] {
           if (!result || cancelled->load()) {
-            CalibrationFailure f =
-                result ? CalibrationFailure{code::kCancelled, "camera calibration cancelled"}
-                       : result.error();
-            if (f.code == code::kCancelled && !calibration_.removed.empty()) {
-              f.message = calibration_.removed;
-            }
-            return end(f, {});
+            const CalibrationFailure f =
+                stoppedRun(result ? nullptr : &result.error(), "camera calibration cancelled");
+            return end(&f, {});
           }
           // The camera keeps the pose the rig model has for it (its intrinsics refined);
           // a camera new to the rig has none until a pair calibration gives it one.
@@ -173,29 +154,19 @@ void Daemon::cmdCalibrateCamera(ClientId client, const proto::Request& req) {
           update.cameras.push_back(camera);
           // Past cancelling: the result is being written.
           operations_.erase(op_id);
-          io_worker_->submit(
-              [this, dir = options_.state_dir, update, reply, end] {
-                auto merged = mergeIntoRig(dir, update, {});
-                return [this, merged, reply, end, path = rigStateFile(dir).path()]() mutable {
-                  if (!merged) {
-                    return end(CalibrationFailure{code::kIo, "rig.json not written: " +
-                                                                 merged.error().message},
-                               {});
-                  }
-                  rig_ = *merged;
-                  reply["path"] = path;
-                  logInfo("camera calibration written to " + path);
-                  end(std::nullopt, reply);
-                  onRigChanged();
-                };
-              },
-              [end](const std::string& what) {
-                end(CalibrationFailure{code::kIo, "rig.json not written: " + what}, {});
-              });
+          writeRig(std::move(update), {}, [reply, end](const Result<std::string>& path) mutable {
+            if (!path) {
+              const CalibrationFailure f{code::kIo, path.error().message};
+              return end(&f, {});
+            }
+            reply["path"] = *path;
+            end(nullptr, reply);
+          });
         };
       },
       [end](const std::string& what) {
-        end(CalibrationFailure{code::kInternal, what}, {});
+        const CalibrationFailure f{code::kInternal, "the job failed: " + what};
+        end(&f, {});
       },
       client);
 }

@@ -104,43 +104,24 @@ void Daemon::cmdLatency(ClientId client, const proto::Request& req) {
         fence.wait();
         auto result = runLatencyProbe(*plan, hooks);
         return [this, client, req, op_id, cancelled, plan, result] {
-          operations_.erase(op_id);
-          calibration_.op.clear();
-          std::optional<CalibrationFailure> failure;
           if (!result || cancelled->load()) {
-            failure = result ? CalibrationFailure{code::kCancelled, "latency measurement cancelled"}
-                             : result.error();
-            if (failure->code == code::kCancelled && !calibration_.removed.empty()) {
-              failure->message = calibration_.removed;
-            }
-          }
-          json finished = {{"operation", op_id}, {"kind", "latency"}, {"ok", !failure}};
-          if (failure) {
-            finished["error"] = failure->message;
-            logWarning("latency " + op_id + ": " + failure->message);
-            errorTo(client, req, failure->code, failure->message);
+            const CalibrationFailure f =
+                stoppedRun(result ? nullptr : &result.error(), "latency measurement cancelled");
+            endDeviceOp(client, req, op_id, "latency", "LATENCY", {}, &f);
           } else {
             json reply = latencyJson(*result, *plan);
             reply["operation"] = op_id;
             reply["state"] = "done";
             logInfo("latency " + op_id + ": " + std::to_string(result->latency_s) + " s, settle " +
                     std::to_string(result->settle_frames) + " frames");
-            replyTo(client, req, "LATENCY", reply);
-          }
-          operationEvent(client, "finished", finished);
-          server_->release(client);
-          if (failure && closesDevice(failure->rc)) {
-            device_manager_->report(failure->device, failure->rc, failure->message);
+            endDeviceOp(client, req, op_id, "latency", "LATENCY", reply, nullptr);
           }
           refreshOutputs();  // what the output showed before the black and white frames
         };
       },
       [this, client, req, op_id](const std::string& what) {
-        operations_.erase(op_id);
-        calibration_.op.clear();
-        operationEvent(client, "finished",
-                       {{"operation", op_id}, {"kind", "latency"}, {"ok", false}, {"error", what}});
-        answerFailure(client, req)(what);
+        const CalibrationFailure f{code::kInternal, "the job failed: " + what};
+        endDeviceOp(client, req, op_id, "latency", "LATENCY", {}, &f);
         refreshOutputs();
       },
       client);

@@ -17,6 +17,7 @@
 #include "content_mesh.hpp"
 #include "daemon.hpp"
 #include "geometry/intersect.hpp"
+#include "json_matrix.hpp"
 #include "render/cpu_renderer.hpp"
 #include "render/projective_mesh.hpp"
 #include "render/viewer_view.hpp"
@@ -350,10 +351,6 @@ bool isMeshFile(const std::string& path) {
 
 namespace {
 
-nlohmann::json vec3Json(const Vec3& v) {
-  return {v.x(), v.y(), v.z()};
-}
-
 struct ViewerImage {
   std::shared_ptr<const cv::Mat> image;
   content::PlanarView view;  // the placement plane
@@ -464,8 +461,8 @@ tl::expected<PreparedMesh, MeshFailure> prepareMeshContent(const ContentAccess& 
       json matrix = json::array();
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 4; ++c) matrix.push_back(drawn->view.projector(r, c));
-      out.placement[o.name] = {{"plane_point", vec3Json(drawn->view.plane_point)},
-                               {"plane_normal", vec3Json(drawn->view.plane_normal)},
+      out.placement[o.name] = {{"plane_point", vectorJson(drawn->view.plane_point)},
+                               {"plane_normal", vectorJson(drawn->view.plane_normal)},
                                {"viewer_matrix", matrix},
                                {"size", {drawn->view.size.width, drawn->view.size.height}}};
       out.eye = *eye;

@@ -34,7 +34,8 @@
 
 namespace procam::daemon {
 
-struct CalibrationHooks;  // calibration_job.hpp
+struct CalibrationHooks;    // calibration_job.hpp
+struct CalibrationFailure;  // calibration_job.hpp
 struct CalibrationProgress;
 
 struct DaemonOptions {
@@ -200,6 +201,20 @@ class Daemon {
   CalibrationHooks operationHooks(
       ClientId client, const std::string& op_id, std::shared_ptr<std::atomic<bool>> cancelled,
       std::function<nlohmann::json(const CalibrationProgress&)> progress);
+  // Why a run that held devices stopped: its error, else `cancelled` (a cancel), with
+  // the device that went away named when one did.
+  CalibrationFailure stoppedRun(const CalibrationFailure* error, const char* cancelled) const;
+  // The end of such a run (calibrate, latency, calibrate-camera): the devices are free,
+  // the client gets `reply` as `reply_class` or the failure, the finished event goes
+  // out, the client is released and a lost device goes to the device manager.
+  void endDeviceOp(ClientId client, const proto::Request& req, const std::string& op_id,
+                   const char* kind, const char* reply_class, const nlohmann::json& reply,
+                   const CalibrationFailure* failure);
+  // Merges `update` and its meshes into rig.json on the I/O worker (fsync may block; a
+  // failure leaves rig.json as it was), then on the loop takes the merged model and
+  // calls `done` with rig.json's path or the error; onRigChanged() follows a success.
+  void writeRig(rig::RigModel update, std::map<std::string, std::string> meshes,
+                std::function<void(const Result<std::string>&)> done);
   void loadContentAtStart();
   nlohmann::json outputsJson() const;
   Result<void> reloadConfig();

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "daemon.hpp"
+#include "json_matrix.hpp"
 #include "log.hpp"
 #include "request_args.hpp"
 
@@ -32,10 +33,6 @@ StateFile trackerFile(const std::string& state_dir) {
 // The tracker's sample rate, as its driver reports it (procam_tracker_ops::get_rate).
 double trackerPollHz(const DeviceEntry& e) {
   return plugins::trackerRate(e.device.raw()).value_or(kDefaultTrackerPollHz);
-}
-
-json vec3(const Vec3& v) {
-  return {v.x(), v.y(), v.z()};
 }
 
 const char* errorCode(ErrorCode c) {
@@ -140,7 +137,7 @@ json Daemon::viewerJson() const {
     if (e.description.family != PROCAM_FAMILY_TRACKER) continue;
     auto it = trackers_.latest.find(e.name);
     if (it == trackers_.latest.end()) continue;
-    return {{"position", vec3(it->second.world)},
+    return {{"position", vectorJson(it->second.world)},
             {"source", "tracker"},
             {"tracker", e.name},
             {"registered", trackers_.registrations.count(e.name) > 0},
@@ -165,8 +162,8 @@ json Daemon::trackersJson() const {
     t["registration"] =
         reg == trackers_.registrations.end() ? json(nullptr) : registrationJson(reg->second);
     if (auto it = trackers_.latest.find(e.name); it != trackers_.latest.end()) {
-      t["position"] = vec3(it->second.world);
-      t["raw"] = vec3(it->second.raw);
+      t["position"] = vectorJson(it->second.world);
+      t["raw"] = vectorJson(it->second.raw);
       t["age_s"] = ageSeconds(it->second.received);
     } else {
       t["position"] = t["raw"] = nullptr;

@@ -1,10 +1,19 @@
 #pragma once
-// Matrices as the protocol writes them: row-major JSON arrays of numbers.
+// Vectors and matrices as the protocol writes them: JSON arrays of numbers, matrices
+// row-major.
 #include <nlohmann/json.hpp>
 
 #include "core/types.hpp"
 
 namespace procam::daemon {
+
+inline nlohmann::json vectorJson(const Vec2& v) {
+  return {v.x(), v.y()};
+}
+
+inline nlohmann::json vectorJson(const Vec3& v) {
+  return {v.x(), v.y(), v.z()};
+}
 
 inline nlohmann::json rowMajor(const Mat34& m) {
   nlohmann::json v = nlohmann::json::array();

@@ -10,14 +10,6 @@
 #include "render/viewer_view.hpp"
 
 namespace procam::daemon {
-namespace {
-
-// A mesh named in rig.json is a file in the state directory, never a path out of it.
-bool plainFileName(const std::string& name) {
-  return !name.empty() && name.find('/') == std::string::npos && name[0] != '.';
-}
-
-}  // namespace
 
 void Daemon::loadRigSurfaces() {
   const uint64_t generation = ++rig_generation_;
@@ -33,7 +25,7 @@ void Daemon::loadRigSurfaces() {
             std::make_shared<std::map<std::string, std::shared_ptr<const RigSurfaceMesh>>>();
         auto problems = std::make_shared<std::vector<std::string>>();
         for (const auto& [projector, file] : files) {
-          if (!plainFileName(file)) {
+          if (!rig::RigSurface::isPlainFileName(file)) {
             problems->push_back("surface mesh '" + file +
                                 "' is not a file name in the state directory");
             continue;

@@ -7,6 +7,7 @@
 #include "blend/rig_tiles.hpp"
 #include "blend/tile_frames.hpp"
 #include "content/mesh_content.hpp"
+#include "json_matrix.hpp"
 #include "mpcdi_zip.hpp"
 #include "replace_file.hpp"
 
@@ -15,18 +16,7 @@ namespace procam::render_cli {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-namespace {
-
-// A mesh named in rig.json is a file beside it, never a path out of its folder.
-bool plainFileName(const std::string& name) {
-  return !name.empty() && name.find('/') == std::string::npos && name[0] != '.';
-}
-
-json vec3(const Vec3& v) {
-  return {v.x(), v.y(), v.z()};
-}
-
-}  // namespace
+namespace {}  // namespace
 
 Result<json> renderCurved(const CurvedRenderInput& in) {
   const rig::RigModel& rig = *in.rig;
@@ -54,7 +44,7 @@ Result<json> renderCurved(const CurvedRenderInput& in) {
       return fail(
           ErrorCode::kInvalidInput,
           "projector name '" + p.name + "' cannot name a file (1-128 of A-Z a-z 0-9 . _ -)");
-    if (!plainFileName(file))
+    if (!rig::RigSurface::isPlainFileName(file))
       return fail(ErrorCode::kInvalidInput,
                   "surface mesh '" + file + "' is not a file name beside the rig model");
     auto mesh = content::loadMeshContent(dir / file);
@@ -117,7 +107,7 @@ Result<json> renderCurved(const CurvedRenderInput& in) {
   for (int i = 0; i < 12; ++i) viewer_matrix.push_back(d.viewer(i / 4, i % 4));
   json doc = {{"display",
                {{"surface", "mesh"},
-                {"viewer", {{"position", vec3(*eye)}, {"source", eye_source}}},
+                {"viewer", {{"position", daemon::vectorJson(*eye)}, {"source", eye_source}}},
                 {"viewer_matrix", viewer_matrix},
                 {"rect_tan",
                  {{"centre", {d.rect.centre.x(), d.rect.centre.y()}},

@@ -12,6 +12,7 @@
 #include "blend/tiled_blend.hpp"
 #include "content/image_header.hpp"
 #include "curved_render.hpp"
+#include "json_matrix.hpp"
 #include "mpcdi_zip.hpp"
 #include "replace_file.hpp"
 #include "rig/rig_model.hpp"
@@ -91,19 +92,6 @@ std::string utcNow() {
   char buf[32];
   std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M:%S", &tm);
   return buf;
-}
-
-json vec(const Vec2& v) {
-  return {v.x(), v.y()};
-}
-json vec(const Vec3& v) {
-  return {v.x(), v.y(), v.z()};
-}
-
-json rowMajor(const Mat3& m) {
-  json a = json::array();
-  for (int i = 0; i < 9; ++i) a.push_back(m(i / 3, i % 3));
-  return a;
 }
 
 }  // namespace
@@ -268,13 +256,14 @@ Result<json> runRender(const RenderArgs& args) {
         return tl::unexpected(ok.error());
     }
     json footprint = json::array();
-    for (const Vec2& q : d.footprints[t]) footprint.push_back(vec(d.basis.toWorld(q)));
+    for (const Vec2& q : d.footprints[t])
+      footprint.push_back(daemon::vectorJson(d.basis.toWorld(q)));
     projectors.push_back({{"name", chosen[t]->name},
                           {"output", chosen[t]->output},
                           {"file", file},
                           {"size", {tiles[t].width, tiles[t].height}},
                           {"path", "homography"},
-                          {"homography", rowMajor(d.content_to_framebuffer[t])},
+                          {"homography", daemon::rowMajor(d.content_to_framebuffer[t])},
                           {"footprint_world", footprint},
                           {"response_gamma", made->gamma[t]},
                           {"gain", made->gain[t]}});
@@ -285,11 +274,14 @@ Result<json> runRender(const RenderArgs& args) {
       {"bit_depth", args.bit_depth},
       {"geometry_only", args.geometry_only},
       {"display",
-       {{"centre_world", vec(d.basis.toWorld(d.rect.centre))},
+       {{"centre_world", daemon::vectorJson(d.basis.toWorld(d.rect.centre))},
         {"size_m", {2 * d.rect.half_width, 2 * d.rect.half_height}},
         {"rect_source", args.rect ? "given" : "largest"},
-        {"basis", {{"origin", vec(d.basis.origin)}, {"u", vec(d.basis.u)}, {"v", vec(d.basis.v)}}},
-        {"rect_in_basis", {{"centre", vec(d.rect.centre)}}},
+        {"basis",
+         {{"origin", daemon::vectorJson(d.basis.origin)},
+          {"u", daemon::vectorJson(d.basis.u)},
+          {"v", daemon::vectorJson(d.basis.v)}}},
+        {"rect_in_basis", {{"centre", daemon::vectorJson(d.rect.centre)}}},
         {"union_area_m2", d.union_area_m2}}},
       {"blend",
        {{"weights", args.geometry_only ? "none" : "feathered"},

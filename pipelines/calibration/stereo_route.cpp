@@ -123,16 +123,13 @@ std::string millimetres(double metres) {
 
 }  // namespace
 
-Result<geom::PlaneFit> triangulatedPlane(const sl::PatternSet& set, const DecodedView& a,
-                                         const DecodedView& b, int step,
+Result<geom::PlaneFit> triangulatedPlane(const surface::SurfacePoints& nodes,
                                          const std::optional<geom::Plane>& prior) {
-  auto points = triangulateNodes(set, a, b, step);
-  if (!points) return tl::unexpected(points.error());
   if (prior && prior->n.allFinite() && std::isfinite(prior->d) && prior->n.norm() > 0.5) {
-    PlaneShare on = onPlane(*points, *prior, planeThreshold(*points, prior->n));
+    PlaneShare on = onPlane(nodes, *prior, planeThreshold(nodes, prior->n));
     if (on.share >= kPlaneShare) return std::move(on.fit);
   }
-  auto best = bestPlane(*points);
+  auto best = bestPlane(nodes);
   if (!best) return tl::unexpected(best.error());
   if (best->share < kPlaneShare)
     return fail(ErrorCode::kDegenerate,
@@ -146,23 +143,27 @@ Result<StereoRouteResult> solveStereoRoute(const sl::PatternSet& set, const Deco
                                            const DecodedView& b, int step) {
   auto points = triangulateNodes(set, a, b, step);
   if (!points) return tl::unexpected(points.error());
+  return solveStereoRoute(*points);
+}
+
+Result<StereoRouteResult> solveStereoRoute(const surface::SurfacePoints& nodes) {
   StereoRouteResult out;
-  out.triangulated = points->world.size();
+  out.triangulated = nodes.world.size();
   // A plane within the noise leaves the projection matrix undetermined
   // ([Raskar02] §4.1.1), however thick the noise makes it look to the DLT's own check.
-  if (auto best = bestPlane(*points); best && best->share >= kPlaneShare) {
+  if (auto best = bestPlane(nodes); best && best->share >= kPlaneShare) {
     return fail(ErrorCode::kCoplanar,
                 std::to_string(int(100 * best->share)) + " % of the " +
-                    std::to_string(points->world.size()) + " triangulated nodes lie within " +
+                    std::to_string(nodes.world.size()) + " triangulated nodes lie within " +
                     millimetres(best->threshold) +
                     " (five times their noise) of one plane: a planar scene gives "
                     "no projection matrix; add relief (a second wall at an angle) or take the "
                     "plane route");
   }
-  auto projector = calibrateProjectorFromSurface(*points);
+  auto projector = calibrateProjectorFromSurface(nodes);
   if (!projector) return tl::unexpected(projector.error());
   // The surface from the points consistent with the calibrated projector.
-  const surface::SurfacePoints kept = surface::keepPoints(*points, projector->inliers);
+  const surface::SurfacePoints kept = surface::keepPoints(nodes, projector->inliers);
   out.consistent = kept.world.size();
   auto model = surface::buildSurface(kept);
   if (!model) return tl::unexpected(model.error());

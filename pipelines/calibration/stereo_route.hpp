@@ -47,8 +47,7 @@ Result<surface::SurfacePoints> triangulateNodes(const sl::PatternSet& set, const
 // `prior` (the plane other projectors of the wall were calibrated on) is returned,
 // with the nodes' residuals, when 90 % of them lie within the threshold of it: every
 // projector of one wall then maps onto the same plane.
-Result<geom::PlaneFit> triangulatedPlane(const sl::PatternSet& set, const DecodedView& a,
-                                         const DecodedView& b, int step,
+Result<geom::PlaneFit> triangulatedPlane(const surface::SurfacePoints& nodes,
                                          const std::optional<geom::Plane>& prior = {});
 
 // `step`: projector pixels between grid nodes. kInvalidInput when a decoded map's
@@ -56,5 +55,7 @@ Result<geom::PlaneFit> triangulatedPlane(const sl::PatternSet& set, const Decode
 // calibrateProjectorFromSurface (kCoplanar for a planar scene) and buildSurface.
 Result<StereoRouteResult> solveStereoRoute(const sl::PatternSet& set, const DecodedView& a,
                                            const DecodedView& b, int step);
+// The same from nodes triangulateNodes gave (kCoplanar as above).
+Result<StereoRouteResult> solveStereoRoute(const surface::SurfacePoints& nodes);
 
 }  // namespace procam::calib

@@ -82,6 +82,10 @@ struct RigSurface {
   std::string unified_mesh;
 
   bool empty() const { return !plane && meshes.empty() && unified_mesh.empty(); }
+  // A mesh named in rig.json is a file beside it, never a path out of its folder.
+  static bool isPlainFileName(const std::string& name) {
+    return !name.empty() && name.find('/') == std::string::npos && name[0] != '.';
+  }
 };
 
 // The viewer: a static sweet spot, or the tracker that reports them.

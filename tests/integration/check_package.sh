@@ -84,20 +84,20 @@ for f in "$root"/usr/share/bash-completion/completions/*; do bash -n "$f" || fai
 
 # Maintainer scripts, against stand-ins that log their arguments.
 for s in postinst prerm postrm; do sh -n "$work/control/$s" || fail "$s does not parse"; done
-stubs=$work/stubs
-mkdir -p "$stubs"
+standins=$work/standins
+mkdir -p "$standins"
 for cmd in addgroup adduser udevadm systemctl deb-systemd-helper deb-systemd-invoke; do
-  printf '#!/bin/sh\necho "%s $*" >>"%s"\nexit 0\n' "$cmd" "$work/calls" >"$stubs/$cmd"
+  printf '#!/bin/sh\necho "%s $*" >>"%s"\nexit 0\n' "$cmd" "$work/calls" >"$standins/$cmd"
 done
 # getent: nothing exists yet, unless PROCAM_TEST_USERS says so.
-printf '#!/bin/sh\n[ -n "$PROCAM_TEST_USERS" ]\n' >"$stubs/getent"
+printf '#!/bin/sh\n[ -n "$PROCAM_TEST_USERS" ]\n' >"$standins/getent"
 # deb-systemd-helper was-enabled: as PROCAM_TEST_ENABLED says.
 printf '#!/bin/sh\necho "deb-systemd-helper $*" >>"%s"\n[ "$2" = was-enabled ] && [ -z "$PROCAM_TEST_ENABLED" ] && exit 1\nexit 0\n' \
-  "$work/calls" >"$stubs/deb-systemd-helper"
-chmod +x "$stubs"/*
+  "$work/calls" >"$standins/deb-systemd-helper"
+chmod +x "$standins"/*
 run() {  # SCRIPT ARGS...: the script's calls, one per line
   : >"$work/calls"
-  env PATH="$stubs:$PATH" "$work/control/$1" "${@:2}" || fail "$1 $* exited $?"
+  env PATH="$standins:$PATH" "$work/control/$1" "${@:2}" || fail "$1 $* exited $?"
   cat "$work/calls"
 }
 calls=$(run postinst configure)
