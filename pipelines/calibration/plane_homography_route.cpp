@@ -20,8 +20,10 @@ std::vector<cv::Point2d> cvPoints(const Points2& p) {
   return out;
 }
 
-// Convex hull area of `points` over the w x h frame.
-double coverage(const Points2& points, int w, int h) {
+}  // namespace
+
+double coverageOf(const Points2& points, int w, int h) {
+  if (points.size() < 3 || w <= 0 || h <= 0) return 0;
   std::vector<cv::Point2f> pts;
   pts.reserve(points.size());
   for (const Vec2& p : points)
@@ -31,12 +33,8 @@ double coverage(const Points2& points, int w, int h) {
   return hull.size() < 3 ? 0.0 : cv::contourArea(hull) / (double(w) * double(h));
 }
 
-}  // namespace
-
-Result<PlaneHomographyResult> solvePlaneHomographyRoute(const sl::PatternSet& set,
-                                                        const DecodedView& view,
-                                                        const geom::Plane& plane_in,
-                                                        const PlaneHomographyOptions& o) {
+Result<CollineationNodes> collineationNodes(const sl::PatternSet& set, const DecodedView& view,
+                                            const PlaneHomographyOptions& o) {
   const geom::CameraModel& camera = view.camera;
   if (view.decoded.u.cols != camera.width || view.decoded.u.rows != camera.height)
     return fail(ErrorCode::kInvalidInput,
@@ -44,10 +42,6 @@ Result<PlaneHomographyResult> solvePlaneHomographyRoute(const sl::PatternSet& se
                     std::to_string(view.decoded.u.cols) + "x" +
                     std::to_string(view.decoded.u.rows) + " but its calibration is " +
                     std::to_string(camera.width) + "x" + std::to_string(camera.height));
-  const double n_norm = plane_in.n.norm();
-  if (!plane_in.n.allFinite() || !std::isfinite(plane_in.d) || !(n_norm > 1e-9))
-    return fail(ErrorCode::kInvalidInput, "the display plane must be finite with a normal");
-  const geom::Plane plane{plane_in.n / n_norm, plane_in.d / n_norm};
   const int pw = set.options.width, ph = set.options.height;
 
   // Projector nodes and the camera pixels that see them ([Raskar02] §4.1.1), the
@@ -62,34 +56,82 @@ Result<PlaneHomographyResult> solvePlaneHomographyRoute(const sl::PatternSet& se
     proj.push_back(samples->projector[i]);
     cam.push_back(*ideal);
   }
-  PlaneHomographyResult out;
+  CollineationNodes out;
   out.samples = proj.size();
   if (proj.size() < o.min_points)
     return fail(ErrorCode::kTooFewPoints,
                 "camera '" + view.name + "' saw only " + std::to_string(proj.size()) +
                     " projector nodes (need " + std::to_string(o.min_points) + ")");
 
-  // Robust support (RANSAC), then the Hartley-normalised DLT and the ML refinement
-  // of the camera-side error on the inliers alone.
+  // Robust support (RANSAC); the caller fits the inliers alone.
   std::vector<unsigned char> mask;
   const cv::Mat H0 = cv::findHomography(cvPoints(proj), cvPoints(cam), cv::RANSAC,
                                         o.ransac_threshold_px, mask, 2000, 0.999);
   if (H0.empty())
     return fail(ErrorCode::kDegenerate,
                 "camera '" + view.name + "': no collineation fits the projector nodes it saw");
-  Points2 proj_in, cam_in;
   for (std::size_t i = 0; i < proj.size(); ++i) {
     if (!mask[i]) continue;
-    proj_in.push_back(proj[i]);
-    cam_in.push_back(cam[i]);
+    out.projector.push_back(proj[i]);
+    out.camera.push_back(cam[i]);
   }
-  out.inliers = proj_in.size();
-  if (out.inliers < o.min_points)
+  if (out.projector.size() < o.min_points)
     return fail(ErrorCode::kTooFewPoints,
-                "only " + std::to_string(out.inliers) + " of " + std::to_string(proj.size()) +
-                    " projector nodes fit one collineation (need " + std::to_string(o.min_points) +
-                    "): is the surface planar?");
-  out.coverage = coverage(proj_in, pw, ph);
+                "only " + std::to_string(out.projector.size()) + " of " +
+                    std::to_string(proj.size()) + " projector nodes fit one collineation (need " +
+                    std::to_string(o.min_points) + "): is the surface planar?");
+  return out;
+}
+
+Result<geom::PlaneHomography> planeFromCamera(const geom::CameraModel& camera,
+                                              const geom::Plane& plane, const Points2& seen,
+                                              const std::string& name) {
+  // The plane in the upright basis seen from the camera, centred where the camera
+  // saw the projection; the camera's rays through `seen` must reach it in front.
+  const Vec3 centre = camera.pose.center();
+  auto basis = geom::uprightBasis(plane, centre, centre);
+  if (!basis) return tl::unexpected(basis.error());
+  auto plane_to_camera = geom::planeToImage(camera.K, camera.pose, *basis);
+  if (!plane_to_camera) return tl::unexpected(plane_to_camera.error());
+  const Mat3 camera_to_plane = plane_to_camera->inverse();
+  Vec2 mean = Vec2::Zero();
+  const Mat3 Kinv = camera.K.matrix().inverse();
+  for (const Vec2& c : seen) {
+    const Vec3 dir = camera.pose.R.transpose() * (Kinv * c.homogeneous());
+    const double along = plane.n.dot(dir);
+    const double t = std::abs(along) > 1e-12 ? -plane.signedDistance(centre) / along : -1.0;
+    if (!(t > 0))
+      return fail(ErrorCode::kDegenerate,
+                  "camera '" + name +
+                      "' sees the projection where the given plane is not in front of it: "
+                      "the plane is not the lit surface");
+    mean += (camera_to_plane * c.homogeneous()).hnormalized();
+  }
+  if (!seen.empty()) mean /= double(seen.size());
+  basis->origin = basis->toWorld(mean);
+  Mat3 shift = Mat3::Identity();
+  shift.topRightCorner<2, 1>() = -mean;
+  return geom::PlaneHomography{*basis, shift * camera_to_plane};
+}
+
+Result<PlaneHomographyResult> solvePlaneHomographyRoute(const sl::PatternSet& set,
+                                                        const DecodedView& view,
+                                                        const geom::Plane& plane_in,
+                                                        const PlaneHomographyOptions& o) {
+  const geom::CameraModel& camera = view.camera;
+  const double n_norm = plane_in.n.norm();
+  if (!plane_in.n.allFinite() || !std::isfinite(plane_in.d) || !(n_norm > 1e-9))
+    return fail(ErrorCode::kInvalidInput, "the display plane must be finite with a normal");
+  const geom::Plane plane{plane_in.n / n_norm, plane_in.d / n_norm};
+  const int pw = set.options.width, ph = set.options.height;
+  auto nodes = collineationNodes(set, view, o);
+  if (!nodes) return tl::unexpected(nodes.error());
+  const Points2& proj_in = nodes->projector;
+  const Points2& cam_in = nodes->camera;
+  PlaneHomographyResult out;
+  out.samples = nodes->samples;
+  out.inliers = proj_in.size();
+  out.coverage = coverageOf(proj_in, pw, ph);
   if (out.coverage < o.min_coverage)
     return fail(ErrorCode::kDegenerate,
                 "camera '" + view.name + "' sees " + std::to_string(100 * out.coverage) +
@@ -109,37 +151,14 @@ Result<PlaneHomographyResult> solvePlaneHomographyRoute(const sl::PatternSet& se
   }
   out.rms_projector_px = std::sqrt(sum / double(proj_in.size()));
 
-  // The plane in the upright basis seen from the camera, centred where the camera
-  // saw the projection; the camera's rays through the inliers must reach it in front.
-  const Vec3 centre = camera.pose.center();
-  auto basis = geom::uprightBasis(plane, centre, centre);
-  if (!basis) return tl::unexpected(basis.error());
-  auto plane_to_camera = geom::planeToImage(camera.K, camera.pose, *basis);
-  if (!plane_to_camera) return tl::unexpected(plane_to_camera.error());
-  const Mat3 camera_to_plane = plane_to_camera->inverse();
-  Vec2 mean = Vec2::Zero();
-  const Mat3 Kinv = camera.K.matrix().inverse();
-  for (const Vec2& c : cam_in) {
-    const Vec3 dir = camera.pose.R.transpose() * (Kinv * c.homogeneous());
-    const double along = plane.n.dot(dir);
-    const double t = std::abs(along) > 1e-12 ? -plane.signedDistance(centre) / along : -1.0;
-    if (!(t > 0))
-      return fail(ErrorCode::kDegenerate,
-                  "camera '" + view.name +
-                      "' sees the projection where the given plane is not in front of it: "
-                      "the plane is not the lit surface");
-    mean += (camera_to_plane * c.homogeneous()).hnormalized();
-  }
-  mean /= double(cam_in.size());
-  basis->origin = basis->toWorld(mean);
-  Mat3 shift = Mat3::Identity();
-  shift.topRightCorner<2, 1>() = -mean;
-  Mat3 H = shift * camera_to_plane * fit->H;  // [Raskar02] §4.2.4: A_wp = A_wc^-1 A_cp
+  auto on_plane = planeFromCamera(camera, plane, cam_in, view.name);
+  if (!on_plane) return tl::unexpected(on_plane.error());
+  Mat3 H = on_plane->H * fit->H;  // [Raskar02] §4.2.4: A_wp = A_wc^-1 A_cp
   H /= H.norm();
   if (H(2, 2) < 0) H = -H;
   if (!H.allFinite())
     return fail(ErrorCode::kIllConditioned, "the projector-to-plane collineation is not finite");
-  out.projector_to_plane = {*basis, H};
+  out.projector_to_plane = {on_plane->basis, H};
   return out;
 }
 

@@ -10,6 +10,7 @@
 // The plane is what an installer gives (measured, or from fiducials of known size):
 // one camera cannot measure the depth of a plane it sees, only its collineation.
 #include <cstddef>
+#include <string>
 
 #include "calibration/stereo_route.hpp"
 #include "core/error.hpp"
@@ -43,6 +44,31 @@ struct PlaneHomographyResult {
   std::size_t samples = 0;  // projector nodes the camera saw
   std::size_t inliers = 0;
 };
+
+// The projector nodes (every options.step px) a camera saw and where (ideal, undistorted
+// camera pixels), those that fit one collineation (RANSAC with
+// options.ransac_threshold_px). kInvalidInput for a decoded map whose size is not its
+// camera's; kTooFewPoints below options.min_points nodes or inliers; kDegenerate when
+// no collineation fits.
+struct CollineationNodes {
+  Points2 projector, camera;  // inliers, one to one
+  std::size_t samples = 0;    // nodes seen, before RANSAC
+};
+Result<CollineationNodes> collineationNodes(const sl::PatternSet& set, const DecodedView& view,
+                                            const PlaneHomographyOptions& options = {});
+
+// The convex hull of `points` (projector pixels) over the w x h frame: how much of a
+// projector's image its nodes span.
+double coverageOf(const Points2& points, int w, int h);
+
+// The plane's upright basis seen from `camera` (geom::uprightBasis), its origin where
+// the camera saw `seen` (ideal pixels) on average, and the collineation from the
+// camera's ideal pixels to it (A_wc^-1 of [Raskar02] §4.2.4). kDegenerate when a ray
+// through `seen` meets the plane behind the camera (named `name` in the message), the
+// camera lies on the plane or the plane is horizontal. `plane` has a unit normal.
+Result<geom::PlaneHomography> planeFromCamera(const geom::CameraModel& camera,
+                                              const geom::Plane& plane, const Points2& seen,
+                                              const std::string& name);
 
 // kInvalidInput for a decoded map whose size is not its camera's, a non-finite or
 // zero-normal plane; kTooFewPoints below min_points inliers; kDegenerate when the
