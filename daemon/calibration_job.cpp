@@ -174,13 +174,20 @@ tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const json& requ
     a.response = it->get<bool>();
   }
   if (auto it = request.find("cameras"); it != request.end()) {
-    const bool names = it->is_array() && (it->size() == 1 || it->size() == 2) &&
+    const bool names = it->is_array() && !it->empty() && it->size() <= kMaxCalibrationCameras &&
                        std::all_of(it->begin(), it->end(), [](const json& n) {
                          return n.is_string() && !n.get<std::string>().empty();
                        });
-    if (!names || (it->size() == 2 && (*it)[0] == (*it)[1])) {
+    bool distinct = true;
+    for (std::size_t i = 0; names && i < it->size(); ++i) {
+      for (std::size_t j = 0; j < i; ++j) distinct = distinct && (*it)[i] != (*it)[j];
+    }
+    if (!names || !distinct) {
       return tl::unexpected(
-          std::string("\"cameras\" must name one camera (route b′) or two different ones"));
+          "\"cameras\" must name one camera (route b′), two (route a, or route b′ from both "
+          "with \"plane\") or up to " +
+          std::to_string(kMaxCalibrationCameras) +
+          " different ones (route b′ from cameras at several positions)");
     }
     for (const auto& n : *it) a.cameras.push_back(n.get<std::string>());
   }
@@ -198,10 +205,6 @@ tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const json& requ
           "\"plane\" must be 4 finite numbers [a, b, c, d] (a x + b y + c z + d = 0, world "
           "metres) with a non-zero normal"));
     }
-    if (a.cameras.size() == 2) {
-      return tl::unexpected(
-          std::string("\"plane\" is for route (b′) with one camera; \"cameras\" names two"));
-    }
     a.plane = geom::Plane{n / n.norm(), (*it)[3].get<double>() / n.norm()};
   }
   if (auto it = request.find("board"); it != request.end()) {
@@ -211,9 +214,9 @@ tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const json& requ
       return tl::unexpected(
           std::string("give either \"plane\" or \"board\": both say where the display plane is"));
     }
-    if (a.cameras.size() == 2) {
+    if (a.cameras.size() >= 2) {
       return tl::unexpected(
-          std::string("\"board\" is for route (b′) with one camera; \"cameras\" names two"));
+          std::string("\"board\" is for route (b′) with one camera; \"cameras\" names more"));
     }
     a.board = *spec;
     a.board_text = it->get<std::string>();
@@ -460,10 +463,14 @@ tl::expected<std::vector<CalibrationOutcome>, CalibrationFailure> runBatchCalibr
       out.latency = outcome.latency;
     }
     std::vector<calib::DecodedView> views;
+    // Cameras at several positions: each sees only some projectors, so a camera that
+    // decoded none of this one is no failure; the run's projectors are solved together
+    // once all are scanned (solveWallViews).
+    const bool wall_views = member.wallViews();
     for (std::size_t c = 0; c < member.cameras.size(); ++c) {
       sl::Decoded d =
           maskedToFootprint(decoded[c], footprints.empty() ? cv::Mat() : footprints[m][c]);
-      if (d.decoded == 0) {
+      if (d.decoded == 0 && !wall_views) {
         return tl::unexpected(CalibrationFailure{
             code::kFailed, "camera '" + member.cameras[c].device.name +
                                "' decoded no pixel of output '" + member.output.name +
@@ -472,15 +479,32 @@ tl::expected<std::vector<CalibrationOutcome>, CalibrationFailure> runBatchCalibr
       out.decoded.push_back(d.decoded);
       if (c == 0 && !ramp.empty()) {
         auto response = rampResponse(ramp, d.flags);
-        if (!response) {
+        // Responses are compared within one camera's exposure: with several cameras
+        // only the reference camera measures them, and a projector it sees too little
+        // of is left unmeasured (the reply has no response for it).
+        if (response) {
+          out.response = *response;
+        } else if (wall_views) {
+          out.response_note = "not measured: camera '" + member.cameras[0].device.name +
+                              "' sees too little of it (" + response.error().message + ")";
+        } else {
           return tl::unexpected(CalibrationFailure{
               code::kFailed, "the response of output '" + member.output.name +
                                  "' seen by camera '" + member.cameras[0].device.name +
                                  "': " + response.error().message});
         }
-        out.response = *response;
       }
       views.push_back({member.cameras[c].device.name, member.cameras[c].model, std::move(d)});
+    }
+    if (wall_views) {
+      for (const calib::DecodedView& view : views) {
+        auto nodes = calib::collineationNodes(member.set, view, {.step = member.grid});
+        if (!nodes && nodes.error().code == ErrorCode::kInvalidInput) {
+          return tl::unexpected(CalibrationFailure{code::kFailed, nodes.error().message});
+        }
+        out.wall_nodes.push_back(nodes ? std::optional(std::move(*nodes)) : std::nullopt);
+      }
+      continue;
     }
     if (member.planar()) {
       if (member.board && !outcome.board) {
@@ -527,31 +551,43 @@ tl::expected<std::vector<CalibrationOutcome>, CalibrationFailure> runBatchCalibr
 
 namespace {
 
-// Camera pixels a projector lights: white minus black above 5 % of its 99.5th
-// percentile (the projector's light, whatever the exposure: the dim far or grazing parts
-// of a curved wall stay in, the camera's noise out), specks opened away, then
-// dilated by 4 pixels for the blur of its edge. Empty (all zero) when the camera sees
-// too little of it: a 99.5th percentile under 5 % of the white view's.
-cv::Mat litPixels(const cv::Mat& white, const cv::Mat& black) {
+float percentile(const cv::Mat& m, double q) {
+  std::vector<float> v;
+  for (int y = 0; y < m.rows; y += 2) {
+    const float* r = m.ptr<float>(y);
+    for (int x = 0; x < m.cols; x += 2) v.push_back(r[x]);
+  }
+  if (v.empty()) return 0.0f;
+  const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(q * v.size()));
+  std::nth_element(v.begin(), v.begin() + k, v.end());
+  return v[k];
+}
+
+cv::Mat lightOf(const cv::Mat& white, const cv::Mat& black) {
   cv::Mat w, b, diff;
   white.convertTo(w, CV_32F);
   black.convertTo(b, CV_32F);
   cv::subtract(w, b, diff);
-  auto percentile = [](const cv::Mat& m, double q) {
-    std::vector<float> v;
-    for (int y = 0; y < m.rows; y += 2) {
-      const float* r = m.ptr<float>(y);
-      for (int x = 0; x < m.cols; x += 2) v.push_back(r[x]);
-    }
-    if (v.empty()) return 0.0f;
-    const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(q * v.size()));
-    std::nth_element(v.begin(), v.begin() + k, v.end());
-    return v[k];
-  };
-  const float top = percentile(diff, 0.995), bright = percentile(w, 0.995);
-  cv::Mat mask(diff.size(), CV_8UC1, cv::Scalar(0));
-  if (!(top > 0.05f * bright) || !(top > 0)) return mask;
-  mask = diff > 0.05f * top;
+  return diff;
+}
+
+// Camera pixels a projector lights: white minus black (`light`, lightOf) above 5 % of its
+// 99.5th percentile (the projector's light, whatever the exposure: the dim far or
+// grazing parts of a curved wall stay in, the camera's noise out), specks opened away,
+// then dilated by 4 pixels for the blur of its edge. Empty (all zero) when the camera
+// sees too little of it: a 99.5th percentile under 5 % of the white view's. With a
+// `level` (> 0) the threshold is 5 % of it instead, whatever share of the view the
+// light covers: cameras at several positions compare a projector's sliver at the edge
+// of one camera's view with the level of the projectors it sees whole.
+cv::Mat litPixels(const cv::Mat& white, const cv::Mat& light, float level = 0) {
+  const float top = level > 0 ? level : percentile(light, 0.995);
+  cv::Mat mask(light.size(), CV_8UC1, cv::Scalar(0));
+  if (level <= 0) {
+    cv::Mat w;
+    white.convertTo(w, CV_32F);
+    if (!(top > 0.05f * percentile(w, 0.995)) || !(top > 0)) return mask;
+  }
+  mask = light > 0.05f * top;
   const cv::Mat k3 = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
   cv::morphologyEx(mask, mask, cv::MORPH_OPEN, k3);
   cv::dilate(mask, mask, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(9, 9)));
@@ -600,6 +636,11 @@ tl::expected<ScanBatches, CalibrationFailure> planScanBatches(
     black.push_back(std::move(*gray));
   }
   out.footprints.resize(plans.size());
+  // Cameras at several positions: each projector's light is kept until its level in
+  // every camera is known (litPixels' `level`).
+  const bool shared_level = first.wallViews();
+  std::vector<std::vector<cv::Mat>> lights(plans.size(), std::vector<cv::Mat>(cams));
+  std::vector<float> level(cams, 0.0f);
   for (std::size_t i = 0; i < plans.size(); ++i) {
     const CalibrationPlan& p = *plans[i];
     const cv::Mat white(p.set.options.height, p.set.options.width, CV_8UC3, cv::Scalar::all(255));
@@ -614,14 +655,34 @@ tl::expected<ScanBatches, CalibrationFailure> planScanBatches(
       }
       auto gray = captureGray(p.cameras[c].device);
       if (!gray) return tl::unexpected(gray.error());
-      out.footprints[i].push_back(gray->size() == black[c].size() ? litPixels(*gray, black[c])
-                                                                  : cv::Mat());
+      if (gray->size() != black[c].size()) {
+        out.footprints[i].emplace_back();
+        continue;
+      }
+      cv::Mat light = lightOf(*gray, black[c]);
+      if (shared_level) {
+        level[c] = std::max(level[c], percentile(light, 0.995));
+        lights[i][c] = std::move(light);
+        out.footprints[i].emplace_back();  // below, once every level is known
+      } else {
+        out.footprints[i].push_back(litPixels(*gray, light));
+      }
     }
     if (auto ok = blankOutput(p); !ok) return tl::unexpected(ok.error());
     hooks.progress(
         {double(i + 1) / plans.size(), "finding overlaps", static_cast<int>((i + 2) * cams)});
   }
   out.captures = static_cast<int>((plans.size() + 1) * cams);
+  for (std::size_t i = 0; shared_level && i < plans.size(); ++i) {
+    for (std::size_t c = 0; c < cams; ++c) {
+      const cv::Mat& light = lights[i][c];
+      if (light.empty()) continue;
+      // A camera none of the projectors lights: nothing of this one either.
+      out.footprints[i][c] = level[c] > 0 ? litPixels(cv::Mat(), light, level[c])
+                                          : cv::Mat(light.size(), CV_8UC1, cv::Scalar(0));
+    }
+    lights[i].clear();
+  }
   // Overlap: the (dilated) lit pixels of two projectors meet in some camera.
   auto overlap = [&](std::size_t i, std::size_t j) {
     for (std::size_t c = 0; c < cams; ++c) {
@@ -633,12 +694,16 @@ tl::expected<ScanBatches, CalibrationFailure> planScanBatches(
     return false;
   };
   // Seen: every camera sees some of its light (one that does not is scanned alone, and
-  // fails or succeeds as it would have).
+  // fails or succeeds as it would have); with cameras at several positions, some camera
+  // does (each sees only part of the wall).
   auto seen = [&](std::size_t i) {
+    bool any = false, all = !out.footprints[i].empty();
     for (const cv::Mat& m : out.footprints[i]) {
-      if (m.empty() || cv::countNonZero(m) == 0) return false;
+      const bool lit = !m.empty() && cv::countNonZero(m) > 0;
+      any = any || lit;
+      all = all && lit;
     }
-    return !out.footprints[i].empty();
+    return plans[i]->wallViews() ? any : all;
   };
   for (std::size_t i = 0; i < plans.size(); ++i) {
     bool placed = false;
@@ -656,6 +721,75 @@ tl::expected<ScanBatches, CalibrationFailure> planScanBatches(
     if (!placed) out.batches.push_back({i});
   }
   return out;
+}
+
+tl::expected<calib::WallViewsResult, CalibrationFailure> solveWallViewsRun(
+    std::span<const CalibrationPlan* const> plans, std::span<CalibrationOutcome> outcomes) {
+  if (plans.empty() || plans.size() != outcomes.size() || !plans.front()->wallViews()) {
+    return tl::unexpected(
+        CalibrationFailure{code::kFailed, "internal: no run of cameras at several positions"});
+  }
+  const CalibrationPlan& first = *plans.front();
+  std::vector<std::pair<int, int>> sizes;
+  std::vector<calib::WallNodes> nodes;
+  for (std::size_t p = 0; p < plans.size(); ++p) {
+    const CalibrationPlan& plan = *plans[p];
+    if (!plan.wallViews() || plan.cameras.size() != first.cameras.size() ||
+        outcomes[p].wall_nodes.size() != plan.cameras.size()) {
+      return tl::unexpected(
+          CalibrationFailure{code::kFailed, "internal: the run's projectors differ in cameras"});
+    }
+    sizes.emplace_back(plan.set.options.width, plan.set.options.height);
+    for (std::size_t c = 0; c < plan.cameras.size(); ++c) {
+      if (outcomes[p].wall_nodes[c]) nodes.push_back({p, c, *outcomes[p].wall_nodes[c]});
+    }
+  }
+  calib::WallViewsOptions options{.nodes = {.step = first.grid}, .reference_camera = 0};
+  for (const auto& c : first.cameras)
+    options.camera_names.push_back("camera '" + c.device.name + "'");
+  for (const CalibrationPlan* p : plans) {
+    options.projector_names.push_back("output '" + p->output.name + "'");
+  }
+  auto solved = calib::solveWallViews(sizes, first.cameras.size(), nodes, first.cameras[0].model,
+                                      first.cameras[0].device.name, *first.plane, options);
+  if (!solved) return tl::unexpected(CalibrationFailure{code::kFailed, solved.error().message});
+  for (std::size_t p = 0; p < plans.size(); ++p) {
+    calib::PlaneHomographyResult planar;
+    planar.projector_to_plane = solved->projector_to_plane[p];
+    const auto& stats = solved->projectors[p];
+    planar.rms_camera_px = stats.rms_px;
+    planar.coverage = stats.coverage;
+    planar.samples = stats.samples;
+    planar.inliers = stats.nodes;
+    planar.rms_projector_px = stats.rms_projector_px;
+    outcomes[p].planar = std::move(planar);
+  }
+  return std::move(*solved);
+}
+
+nlohmann::json wallViewsJson(const calib::WallViewsResult& result,
+                             std::span<const CalibrationPlan* const> plans) {
+  nlohmann::json cameras = nlohmann::json::array();
+  for (const auto& c : plans.front()->cameras) cameras.push_back(c.device.name);
+  nlohmann::json links = nlohmann::json::array();
+  for (std::size_t p = 0; p < result.projectors.size() && p < plans.size(); ++p) {
+    links.push_back(
+        {{"output", plans[p]->output.name},
+         {"cameras", result.projectors[p].cameras},
+         {"nodes", result.projectors[p].nodes},
+         {"rms_camera_px", result.projectors[p].rms_px},
+         {"coverage", result.projectors[p].coverage},
+         {"chain_cameras", p < result.tree.chain_views.size() ? result.tree.chain_views[p] : 0}});
+  }
+  return {{"reference_camera", plans.front()->cameras.front().device.name},
+          {"cameras", cameras},
+          {"links", result.tree.links},
+          {"nodes", result.tree.matches},
+          {"rms_camera_px", result.tree.rms_px},
+          {"chain_rms_camera_px", result.tree.chain_rms_px},
+          {"iterations", result.tree.iterations},
+          {"converged", result.tree.converged},
+          {"projectors", links}};
 }
 
 }  // namespace procam::daemon

@@ -19,6 +19,7 @@
 #include "calibration/board_plane.hpp"
 #include "calibration/plane_homography_route.hpp"
 #include "calibration/stereo_route.hpp"
+#include "calibration/wall_views_route.hpp"
 #include "config.hpp"
 #include "driver.hpp"
 #include "geometry/camera_model.hpp"
@@ -26,6 +27,9 @@
 #include "tl/expected.hpp"
 
 namespace procam::daemon {
+
+// Cameras one calibrate request may name.
+inline constexpr std::size_t kMaxCalibrationCameras = 8;
 
 // The calibrate request's arguments (PROTOCOL.md).
 struct CalibrationArgs {
@@ -40,7 +44,10 @@ struct CalibrationArgs {
   // usable output); empty: `output` alone.
   std::vector<std::string> outputs;
   bool all_outputs = false;
-  std::vector<std::string> cameras;  // empty: the first usable ones; one name: route (b′)
+  // Empty: the first usable ones; one name: route (b′); two: route (a), or route (b′)
+  // from both with `plane`; more: route (b′) from cameras at several positions, the
+  // first the calibrated reference (the plane given or the rig's).
+  std::vector<std::string> cameras;
   std::optional<geom::Plane> plane;  // the display plane (world): route (b′)
   // Route (b′) with the display plane found from this board fixed flat on it
   // (calib::parseBoard form), seen by the camera in the white frame.
@@ -80,10 +87,12 @@ struct CalibrationPlan {
   CalibrationConfig latency;  // margin_frames, latency_repeats, latency_timeout_s
   double refresh_hz = 60;
   CalibrationDevice output;
-  std::vector<CalibrationCamera> cameras;  // two: route (a); one: route (b′)
-  std::optional<geom::Plane> plane;        // set: route (b′) on this display plane (world)
-  bool plane_from_rig = false;             // the rig model's surface plane, not an argument
-  std::optional<calib::BoardSpec> board;   // set: route (b′), the plane from this board
+  // Two: route (a); one: route (b′); several with a plane: route (b′) from cameras at
+  // several positions (wallViews).
+  std::vector<CalibrationCamera> cameras;
+  std::optional<geom::Plane> plane;       // set: route (b′) on this display plane (world)
+  bool plane_from_rig = false;            // the rig model's surface plane, not an argument
+  std::optional<calib::BoardSpec> board;  // set: route (b′), the plane from this board
   std::string board_text;
   bool response = false;  // a grey ramp after the patterns: the projector's response
   // Route (a) on a planar scene: the plane the run's projectors share, the rig's
@@ -92,6 +101,10 @@ struct CalibrationPlan {
   std::shared_ptr<std::optional<geom::Plane>> scene_plane;
 
   bool planar() const { return plane || board; }
+  // Route (b′) with cameras at several positions: the first camera is the calibrated
+  // reference, the others need only their intrinsics; the run's projectors are solved
+  // together (calib::solveWallViews) after the last scan.
+  bool wallViews() const { return plane && !board && cameras.size() > 1; }
 
   int captures() const {
     return static_cast<int>(set.frames.size() * cameras.size()) +
@@ -127,10 +140,22 @@ struct CalibrationOutcome {
   // projector then takes route (b′) on.
   std::optional<geom::PlaneFit> triangulated_plane;
   std::optional<blend::ProjectorResponse> response;  // from the grey ramp
-  std::vector<int> decoded;                          // camera pixels decoded, per camera
-  int settle_frames = 0;                             // waited after every pattern
-  nlohmann::json latency;  // the measured latency (auto_settle; latencyJson), else null
+  std::string response_note;                         // why a ramp gave no response
+  // Route (b′) from cameras at several positions: per camera, the projector nodes it
+  // saw (none: too few); the planar result comes from solveWallViewsRun.
+  std::vector<std::optional<calib::CollineationNodes>> wall_nodes;
+  std::vector<int> decoded;  // camera pixels decoded, per camera
+  int settle_frames = 0;     // waited after every pattern
+  nlohmann::json latency;    // the measured latency (auto_settle; latencyJson), else null
 };
+
+// Route (b′) from cameras at several positions: the projectors of a run, scanned (their
+// outcomes' wall_nodes), solved together through the homography tree; each outcome gets
+// its `planar` result. The reply part of the tree: `wall` (wallViewsJson).
+tl::expected<calib::WallViewsResult, CalibrationFailure> solveWallViewsRun(
+    std::span<const CalibrationPlan* const> plans, std::span<CalibrationOutcome> outcomes);
+nlohmann::json wallViewsJson(const calib::WallViewsResult& result,
+                             std::span<const CalibrationPlan* const> plans);
 
 // Shared with the latency probe (latency_probe.hpp).
 CalibrationFailure deviceFailure(const char* family, const std::string& name, int rc,

@@ -40,6 +40,18 @@ tl::expected<geom::CameraModel, Failure> cameraModel(const DeviceEntry& e,
                               "the result with procamd --rig)"});
 }
 
+// A camera of route (b′) from several positions other than the reference: its K and
+// distortion are enough (it is registered through the projectors it shares).
+tl::expected<geom::CameraModel, Failure> cameraIntrinsics(const DeviceEntry& e,
+                                                          const rig::RigModel& rig) {
+  if (const rig::RigCamera* c = rig.camera(e.name)) return c->model;
+  return tl::unexpected(Failure{
+      code::kUnavailable, "camera '" + e.name +
+                              "' is not calibrated: the rig model has no camera of that name "
+                              "(calibrate it with procam-calibrate camera or calibrate-camera "
+                              "and install the result with procamd --rig)"});
+}
+
 // The devices and camera models of a run; everything but the capture itself.
 tl::expected<CalibrationPlan, Failure> makePlan(DeviceSet& devices, const CalibrationArgs& args,
                                                 const CalibrationConfig& latency,
@@ -67,9 +79,23 @@ tl::expected<CalibrationPlan, Failure> makePlan(DeviceSet& devices, const Calibr
   for (const auto& e : devices.entries()) {
     usable += e.description.family == PROCAM_FAMILY_CAMERA && e.usable();
   }
-  const bool planar = args.plane || args.board || args.cameras.size() == 1 ||
+  // Several cameras on a plane: route (b′) from cameras at several positions, the first
+  // one the calibrated reference (wall_views_route.hpp).
+  const bool several =
+      !args.board && ((args.plane && args.cameras.size() > 1) || args.cameras.size() > 2);
+  const bool planar = several || args.plane || args.board || args.cameras.size() == 1 ||
                       (args.cameras.empty() && usable == 1 && rig.surface.plane);
-  const std::size_t wanted = planar ? 1 : 2;
+  const std::size_t wanted = several ? args.cameras.size() : planar ? 1 : 2;
+  if (several && args.auto_settle) {
+    // The probe times every camera against the projector it scans; at several positions
+    // a camera may not see that projector at all.
+    return tl::unexpected(Failure{
+        code::kBadArgument,
+        "settle_frames \"auto\" (the request's, or [calibration] settle_frames of procamd.toml "
+        "when the request gives none) times every camera on each projector, and cameras at "
+        "several positions do not all see every projector: give settle_frames as a number "
+        "(latency measures it per output and camera)"});
+  }
   std::vector<const DeviceEntry*> cams;
   for (std::size_t i = 0; i < wanted; ++i) {
     const std::string name = args.cameras.empty() ? "" : args.cameras[i];
@@ -96,9 +122,11 @@ tl::expected<CalibrationPlan, Failure> makePlan(DeviceSet& devices, const Calibr
     if (!plan.plane) {
       return tl::unexpected(
           Failure{code::kUnavailable,
-                  "route (b′) with one camera needs the display plane: give \"plane\" [a, b, c, d] "
-                  "(world, metres), or \"board\" (a calibration board fixed flat on it, e.g. "
-                  "\"aprilgrid:6x4:0.15\"), or put surface.plane in the rig model"});
+                  std::string(several ? "route (b′) from cameras at several positions"
+                                      : "route (b′) with one camera") +
+                      " needs the display plane: give \"plane\" [a, b, c, d] "
+                      "(world, metres), or \"board\" (a calibration board fixed flat on it, e.g. "
+                      "\"aprilgrid:6x4:0.15\"), or put surface.plane in the rig model"});
     }
   }
   uint32_t w = 0, h = 0;
@@ -123,7 +151,7 @@ tl::expected<CalibrationPlan, Failure> makePlan(DeviceSet& devices, const Calibr
   plan.latency = latency;
   plan.output = {out->name, out->device.share()};
   for (const DeviceEntry* c : cams) {
-    auto model = cameraModel(*c, rig);
+    auto model = c == cams.front() ? cameraModel(*c, rig) : cameraIntrinsics(*c, rig);
     if (!model) return tl::unexpected(model.error());
     plan.cameras.push_back({{c->name, c->device.share()}, *model});
   }
@@ -208,9 +236,15 @@ Learnt learntByPlaneRoute(const CalibrationPlan& plan, const CalibrationOutcome&
   projector.plane_homography = route.projector_to_plane;
   projector.rms_px = route.rms_projector_px;
   projector.points = static_cast<long>(route.inliers);
+  std::string cameras = "camera " + plan.cameras.at(0).device.name;
+  if (plan.wallViews()) {
+    cameras = "cameras at several positions, " + plan.cameras.at(0).device.name + " (reference)";
+    for (std::size_t c = 1; c < plan.cameras.size(); ++c) {
+      cameras += ", " + plan.cameras[c].device.name;
+    }
+  }
   projector.calibrated = {
-      "structured light, route (b′): camera " + plan.cameras.at(0).device.name +
-          ", plane from the " +
+      "structured light, route (b′): " + cameras + ", plane from the " +
           (result.board                ? "board " + plan.board_text
            : result.triangulated_plane ? "cameras " + plan.cameras.at(0).device.name + " and " +
                                              plan.cameras.at(1).device.name + " (a planar scene)"
@@ -474,6 +508,19 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
           } else {
             result = tl::unexpected(planned.error());
           }
+          // Cameras at several positions: a projector no camera sees ends the run now,
+          // not after every other projector's scan.
+          for (std::size_t i = 0; result && plans.front()->wallViews() && i < plans.size(); ++i) {
+            bool lit = false;
+            for (const cv::Mat& m : scan.footprints[i])
+              lit = lit || (!m.empty() && cv::countNonZero(m) > 0);
+            if (!lit) {
+              result = tl::unexpected(Failure{
+                  code::kFailed, "output '" + plans[i]->output.name +
+                                     "': none of the cameras sees its light (the coarse pass "
+                                     "showed it white alone)"});
+            }
+          }
         } else {
           for (std::size_t i = 0; i < plans.size(); ++i) scan.batches.push_back({i});
         }
@@ -514,6 +561,19 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
         if (result) {
           for (auto& o : by_plan) result->push_back(std::move(*o));
         }
+        // Cameras at several positions: every projector scanned, all solved at once.
+        json wall;
+        if (result && !cancelled->load() && plans.front()->wallViews()) {
+          hooks.progress({0.97, "solving", done});
+          std::vector<const CalibrationPlan*> all;
+          for (const auto& p : plans) all.push_back(p.get());
+          auto solved = solveWallViewsRun(all, *result);
+          if (solved) {
+            wall = wallViewsJson(*solved, all);
+          } else {
+            result = tl::unexpected(solved.error());
+          }
+        }
         json batches = json::array();
         for (const auto& batch : scan.batches) {
           json names = json::array();
@@ -521,7 +581,8 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
           batches.push_back(std::move(names));
         }
         const json scanned = {{"batches", std::move(batches)}, {"captures", done}};
-        return [this, client, req, op_id, cancelled, plans, result, progress, captures, scanned] {
+        return [this, client, req, op_id, cancelled, plans, result, progress, captures, scanned,
+                wall] {
           auto finish = [this, client, req, op_id](const json& reply, const Failure* failure) {
             endDeviceOp(client, req, op_id, "calibrate", "CALIBRATE", reply, failure);
             refreshOutputs();  // what the outputs showed before the pattern frames
@@ -546,6 +607,8 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
               const json photometric = responseJson(*outcome.response, plans[i]->cameras[0]);
               for (auto& p : learnt.update.projectors) p.photometric = photometric;
               learnt.reply["response"] = photometric;
+            } else if (!outcome.response_note.empty()) {
+              learnt.reply["response"] = {{"measured", false}, {"why", outcome.response_note}};
             }
             update = rig::mergeRig(std::move(update), learnt.update);
             meshes.merge(learnt.meshes);
@@ -560,6 +623,7 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
             reply["outputs"] = per_output;
             reply["scan"] = scanned;
           }
+          if (!wall.is_null()) reply["wall"] = wall;
           reply["operation"] = op_id;
           reply["state"] = "done";
           writeRig(std::move(update), std::move(meshes),

@@ -121,4 +121,11 @@ Result<std::pair<int, int>> toSize(const std::string& text, const std::string& w
   return std::pair{w, h};
 }
 
+bool isFileSafeName(const std::string& name) {
+  return !name.empty() && name.size() <= 128 && name[0] != '.' &&
+         name.find_first_not_of(
+             "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789._-") ==
+             std::string::npos;
+}
+
 }  // namespace procam::cli

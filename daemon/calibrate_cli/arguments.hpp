@@ -43,4 +43,8 @@ Result<double> toDouble(const std::string& text, const std::string& what);
 // "WxH"
 Result<std::pair<int, int>> toSize(const std::string& text, const std::string& what);
 
+// A projector name that becomes part of a file name beside rig.json: 1-128 of
+// A-Z a-z 0-9 . _ -, not starting with a dot.
+bool isFileSafeName(const std::string& name);
+
 }  // namespace procam::cli

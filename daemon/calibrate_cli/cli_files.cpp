@@ -5,6 +5,7 @@
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 
+#include "commands.hpp"
 #include "core/pfm.hpp"
 
 namespace procam::cli {
@@ -162,6 +163,22 @@ Result<std::vector<fs::path>> listImages(const fs::path& dir) {
   }
   std::sort(out.begin(), out.end());
   return out;
+}
+
+Result<sl::Decoded> decodeDir(const sl::PatternSet& set, const std::string& dir, std::size_t i,
+                              std::size_t n) {
+  progress("decoding captures " + std::to_string(i + 1) + "/" + std::to_string(n) + " (" + dir +
+           ", " + std::to_string(set.frames.size()) + " frames)");
+  auto frames = readCaptures(set, dir);
+  if (!frames) return tl::unexpected(frames.error());
+  auto d = sl::decode(set, *frames);
+  if (!d) return d;
+  progress("  " + std::to_string(d->decoded) + " camera pixels decoded");
+  if (d->decoded == 0)
+    return fail(ErrorCode::kTooFewPoints, "no camera pixel of " + dir +
+                                              " could be decoded (projector not visible, or "
+                                              "captures in the wrong order?)");
+  return d;
 }
 
 }  // namespace procam::cli

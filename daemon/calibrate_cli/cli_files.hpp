@@ -25,6 +25,11 @@ Result<sl::PatternSet> readSequence(const fs::path& dir);
 // Loads DIR/<frame name>.png for every frame (8 or 16 bit, as stored).
 Result<std::vector<cv::Mat>> readCaptures(const sl::PatternSet& set, const fs::path& dir);
 
+// Decodes the captures of DIR (the i-th of n, for the progress line) with `set`.
+// kTooFewPoints when no camera pixel decodes (the projector was not in view).
+Result<sl::Decoded> decodeDir(const sl::PatternSet& set, const std::string& dir, std::size_t i,
+                              std::size_t n);
+
 // 3-channel PFM: u, v, confidence; rows bottom to top, little-endian; -1 undecoded.
 Result<void> writeCorrespondencePfm(const sl::Decoded& decoded, const fs::path& file);
 

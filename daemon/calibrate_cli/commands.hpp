@@ -14,6 +14,7 @@ Result<void> runStereo(const Arguments& args);
 Result<void> runSolve(const Arguments& args);
 Result<void> runSolvePlanes(const Arguments& args);
 Result<void> runSolveFiducials(const Arguments& args);
+Result<void> runSolveWall(const Arguments& args);
 
 // One progress line on stderr.
 void progress(const std::string& line);

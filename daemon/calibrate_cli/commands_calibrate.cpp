@@ -42,22 +42,6 @@ Result<std::vector<calib::BoardView>> detectAll(const calib::BoardSpec& spec, co
   return views;
 }
 
-Result<sl::Decoded> decodeDir(const sl::PatternSet& set, const std::string& dir, std::size_t i,
-                              std::size_t n) {
-  progress("decoding captures " + std::to_string(i + 1) + "/" + std::to_string(n) + " (" + dir +
-           ", " + std::to_string(set.frames.size()) + " frames)");
-  auto frames = readCaptures(set, dir);
-  if (!frames) return tl::unexpected(frames.error());
-  auto d = sl::decode(set, *frames);
-  if (!d) return d;
-  progress("  " + std::to_string(d->decoded) + " camera pixels decoded");
-  if (d->decoded == 0)
-    return fail(ErrorCode::kTooFewPoints, "no camera pixel of " + dir +
-                                              " could be decoded (projector not visible, or "
-                                              "captures in the wrong order?)");
-  return d;
-}
-
 // Route (a) from the captures of the first two cameras (the i-th directory the i-th's).
 Result<calib::StereoRouteResult> stereoRoute(const sl::PatternSet& set,
                                              const std::vector<std::string>& dirs,
@@ -179,11 +163,7 @@ Result<void> runSolveProjectors(const Arguments& a) {
     for (const auto* r : {&name, &patterns})
       if (!*r) return asVoid(*r);
     // The name becomes a file name beside rig.json.
-    if (name->empty() || name->size() > 128 ||
-        name->find_first_not_of(
-            "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789._-") !=
-            std::string::npos ||
-        (*name)[0] == '.')
+    if (!isFileSafeName(*name))
       return fail(ErrorCode::kInvalidInput,
                   kCommandLine + "--projector '" + *name + "': 1-128 of A-Z a-z 0-9 . _ -");
     if (meshes.contains(*name))

@@ -24,6 +24,9 @@ constexpr const char* kUsage = R"(usage: procam-calibrate COMMAND [options]
            [--camera NAME] [--plane-distance M] [--principal-x PX] --out rig.json (route b)
   solve-fiducials --fiducials points.json --projector WxH --out rig.json
            [--cameras cameras.json] [--name NAME]                          (route c)
+  solve-wall --cameras cameras.json --plane A,B,C,D --out rig.json [--reference CAMERA]
+           [--step K] --projector NAME --patterns DIR --captures CAPDIR|- [...]
+           [--projector ...]                 (route b', cameras at several positions)
 
 Boards: checker:COLSxROWS:SQUARE_M (inner corners), charuco:COLSxROWS:SQUARE_M:MARKER_M,
 aprilgrid:COLSxROWS:TAG_M[:GAP_M]. See README.md for the file formats.
@@ -46,11 +49,13 @@ static int run(int argc, char** argv) {
                   {"stereo", procam::cli::runStereo},
                   {"solve", procam::cli::runSolve},
                   {"solve-planes", procam::cli::runSolvePlanes},
-                  {"solve-fiducials", procam::cli::runSolveFiducials}};
+                  {"solve-fiducials", procam::cli::runSolveFiducials},
+                  {"solve-wall", procam::cli::runSolveWall}};
   for (const auto& c : commands) {
     if (std::strcmp(argv[1], c.name) != 0) continue;
-    // solve takes one --projector NAME --patterns DIR --captures A B group per projector.
-    auto args = std::strcmp(c.name, "solve") == 0
+    // solve and solve-wall take one --projector NAME --patterns DIR --captures ... group
+    // per projector.
+    auto args = std::strcmp(c.name, "solve") == 0 || std::strcmp(c.name, "solve-wall") == 0
                     ? procam::cli::Arguments::parseGrouped(argc, argv, 2, "projector",
                                                            {"patterns", "captures"})
                     : procam::cli::Arguments::parse(argc, argv, 2);

@@ -51,17 +51,24 @@ Result<CollineationNodes> collineationNodes(const sl::PatternSet& set, const Dec
   if (!samples) return tl::unexpected(samples.error());
   Points2 proj, cam;
   for (std::size_t i = 0; i < samples->camera.size(); ++i) {
-    auto ideal = camera.undistortPixel(samples->camera[i]);
+    const Vec2& seen = samples->camera[i];
+    const double m = o.edge_margin_px;
+    if (seen.x() < m || seen.y() < m || seen.x() > camera.width - 1 - m ||
+        seen.y() > camera.height - 1 - m)
+      continue;
+    auto ideal = camera.undistortPixel(seen);
     if (!ideal) continue;
     proj.push_back(samples->projector[i]);
     cam.push_back(*ideal);
   }
   CollineationNodes out;
   out.samples = proj.size();
-  if (proj.size() < o.min_points)
+  // A collineation needs four points (and OpenCV's RANSAC refuses fewer).
+  const std::size_t min_points = std::max<std::size_t>(o.min_points, 4);
+  if (proj.size() < min_points)
     return fail(ErrorCode::kTooFewPoints,
                 "camera '" + view.name + "' saw only " + std::to_string(proj.size()) +
-                    " projector nodes (need " + std::to_string(o.min_points) + ")");
+                    " projector nodes (need " + std::to_string(min_points) + ")");
 
   // Robust support (RANSAC); the caller fits the inliers alone.
   std::vector<unsigned char> mask;
@@ -75,11 +82,11 @@ Result<CollineationNodes> collineationNodes(const sl::PatternSet& set, const Dec
     out.projector.push_back(proj[i]);
     out.camera.push_back(cam[i]);
   }
-  if (out.projector.size() < o.min_points)
+  if (out.projector.size() < min_points)
     return fail(ErrorCode::kTooFewPoints,
                 "only " + std::to_string(out.projector.size()) + " of " +
                     std::to_string(proj.size()) + " projector nodes fit one collineation (need " +
-                    std::to_string(o.min_points) + "): is the surface planar?");
+                    std::to_string(min_points) + "): is the surface planar?");
   return out;
 }
 

@@ -17,6 +17,8 @@ Result<WallViewsResult> solveWallViews(std::span<const std::pair<int, int>> proj
   if (options.reference_camera >= cameras)
     return fail(ErrorCode::kInvalidInput, "the reference camera is out of range");
   const std::size_t projectors = projector_sizes.size();
+  // A collineation needs four points; the tree links no fewer.
+  const std::size_t min_points = std::max<std::size_t>(options.nodes.min_points, 4);
   WallViewsResult out;
   out.projectors.resize(projectors);
   std::vector<Points2> seen_of(projectors);
@@ -27,13 +29,14 @@ Result<WallViewsResult> solveWallViews(std::span<const std::pair<int, int>> proj
       return fail(ErrorCode::kInvalidInput, "a sighting's projector or camera is out of range");
     if (n.nodes.projector.size() != n.nodes.camera.size())
       return fail(ErrorCode::kInvalidInput, "a sighting's node lists differ in length");
-    if (n.nodes.projector.size() < options.nodes.min_points) continue;
+    if (n.nodes.projector.size() < min_points) continue;
     if (n.camera == options.reference_camera) {
       reference_seen.insert(reference_seen.end(), n.nodes.camera.begin(), n.nodes.camera.end());
     }
     Points2& seen = seen_of[n.projector];
     seen.insert(seen.end(), n.nodes.projector.begin(), n.nodes.projector.end());
     ++out.projectors[n.projector].cameras;
+    out.projectors[n.projector].samples += n.nodes.samples;
     matches.push_back({n.camera, n.projector, n.nodes.projector, n.nodes.camera});
   }
   for (std::size_t p = 0; p < projectors; ++p) {
@@ -42,13 +45,16 @@ Result<WallViewsResult> solveWallViews(std::span<const std::pair<int, int>> proj
     stats.coverage = coverageOf(seen_of[p], projector_sizes[p].first, projector_sizes[p].second);
     if (stats.cameras > 0 && stats.coverage < options.nodes.min_coverage)
       return fail(ErrorCode::kDegenerate,
-                  "projector " + std::to_string(p) + ": the cameras see " +
-                      std::to_string(100 * stats.coverage) +
+                  (p < options.projector_names.size() ? options.projector_names[p]
+                                                      : "projector " + std::to_string(p)) +
+                      ": the cameras see " + std::to_string(100 * stats.coverage) +
                       " % of its image; its collineation would be extrapolated");
   }
-  auto tree = geom::solveHomographyTree(
-      matches, cameras, projectors,
-      {.reference_view = options.reference_camera, .min_matches = options.nodes.min_points});
+  auto tree = geom::solveHomographyTree(matches, cameras, projectors,
+                                        {.reference_view = options.reference_camera,
+                                         .min_matches = min_points,
+                                         .view_names = options.camera_names,
+                                         .projector_names = options.projector_names});
   if (!tree) return tl::unexpected(tree.error());
   // [Raskar02] §4.2.4: A_wp = A_wc^-1 A_cp, the reference camera's A_wc.
   auto on_plane = planeFromCamera(reference, plane, reference_seen, reference_name);

@@ -37,6 +37,8 @@ struct WallNodes {
 struct WallViewsOptions {
   PlaneHomographyOptions nodes;      // node step, RANSAC threshold, min_points per sighting
   std::size_t reference_camera = 0;  // the calibrated one
+  // For messages (empty, or one per camera / projector): "projector 2" otherwise.
+  std::vector<std::string> camera_names = {}, projector_names = {};
 };
 
 struct WallViewsResult {
@@ -44,6 +46,7 @@ struct WallViewsResult {
   std::vector<geom::PlaneHomography> projector_to_plane;
   struct Projector {
     std::size_t nodes = 0;        // matched nodes over every camera that saw it
+    std::size_t samples = 0;      // nodes seen before RANSAC
     double rms_px = 0;            // their residuals, camera pixels
     double rms_projector_px = 0;  // the same transferred into the projector
     double coverage = 0;          // their convex hull over the projector frame

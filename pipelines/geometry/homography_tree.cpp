@@ -213,14 +213,21 @@ Result<HomographyTree> solveHomographyTree(std::span<const ViewProjectorMatches>
     l.projector_px.insert(l.projector_px.end(), m.projector_px.begin(), m.projector_px.end());
     l.view_px.insert(l.view_px.end(), m.view_px.begin(), m.view_px.end());
   }
+  auto view_name = [&](std::size_t v) {
+    return v < options.view_names.size() ? options.view_names[v] : "view " + std::to_string(v);
+  };
+  auto projector_name = [&](std::size_t p) {
+    return p < options.projector_names.size() ? options.projector_names[p]
+                                              : "projector " + std::to_string(p);
+  };
+  const std::size_t min_matches = std::max<std::size_t>(options.min_matches, 4);
   std::vector<Link> links;
   for (auto& [key, l] : joined) {
-    if (l.projector_px.size() < std::max<std::size_t>(options.min_matches, 4)) continue;
+    if (l.projector_px.size() < min_matches) continue;
     auto fit = fitHomography(l.projector_px, l.view_px);
     if (!fit) {
-      return fail(fit.error().code, "homography tree: view " + std::to_string(l.view) +
-                                        ", projector " + std::to_string(l.projector) + ": " +
-                                        fit.error().message);
+      return fail(fit.error().code, "homography tree: " + view_name(l.view) + " seeing " +
+                                        projector_name(l.projector) + ": " + fit.error().message);
     }
     l.H = fit->H;
     links.push_back(std::move(l));
@@ -259,10 +266,11 @@ Result<HomographyTree> solveHomographyTree(std::span<const ViewProjectorMatches>
   HomographyTree out;
   for (std::size_t p = 0; p < projectors; ++p) {
     if (depth[views + p] < 0) {
-      return fail(ErrorCode::kDegenerate, "homography tree: projector " + std::to_string(p) +
+      return fail(ErrorCode::kDegenerate, "homography tree: " + projector_name(p) +
                                               " is seen (with at least " +
-                                              std::to_string(options.min_matches) +
-                                              " matches) by no view linked to the reference view");
+                                              std::to_string(min_matches) + " matches) by no " +
+                                              (options.view_names.empty() ? "view" : "camera") +
+                                              " linked to " + view_name(options.reference_view));
     }
     out.chain_views.push_back(depth[views + p]);
   }
@@ -289,7 +297,7 @@ Result<HomographyTree> solveHomographyTree(std::span<const ViewProjectorMatches>
       auto t = detail::hartley<2>(ppts[p]);
       if (!t)
         return fail(ErrorCode::kDegenerate,
-                    "homography tree: projector " + std::to_string(p) + ": " + t.error().message);
+                    "homography tree: " + projector_name(p) + ": " + t.error().message);
       tp[p] = *t;
     }
     std::vector<int> view_param(views, -1);
@@ -299,7 +307,7 @@ Result<HomographyTree> solveHomographyTree(std::span<const ViewProjectorMatches>
       auto t = detail::hartley<2>(vpts[v]);
       if (!t)
         return fail(ErrorCode::kDegenerate,
-                    "homography tree: view " + std::to_string(v) + ": " + t.error().message);
+                    "homography tree: " + view_name(v) + ": " + t.error().message);
       tv[v] = *t;
     }
     const Mat3 Tref = tv[options.reference_view].matrix();

@@ -4,14 +4,14 @@
 // and collineations chain). A view v sees projector p through the collineation H_vp
 // (projector pixels -> view pixels); a projector seen by the reference view maps into it
 // directly, any other through the views and projectors between them: the homography
-// tree of Chen et al., "Scalable alignment of large-format multi-projector displays
-// using camera homography trees", IEEE Visualization 2002. A chain accumulates the
+// tree of [Chen02]. A chain accumulates the
 // error of every link, so the tree is only the start: one least-squares refinement over
 // every observation (each view's sightings of each projector) moves all collineations
 // at once, and the error of a projector far down the chain stays that of its
 // neighbours.
 #include <cstddef>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "core/error.hpp"
@@ -33,12 +33,14 @@ struct HomographyTreeOptions {
   std::size_t min_matches = 16;
   // Points per view/projector pair in the refinement: spread over the pair's matches,
   // each placed where the pair's own collineation puts it and weighted for the matches
-  // it stands for, so every match counts (the residuals reported cover them all). A
-  // collineation has 8 degrees of freedom; 200 points of it are exact to working
-  // precision and keep the normal equations of a 16-projector wall under a second.
+  // it stands for, so every match counts (the residuals reported cover them all). The
+  // spread approximates the pair's own weighting of its frame; 200 points keep the
+  // normal equations of a 16-projector wall under a second.
   std::size_t refine_matches = 200;
   int max_iterations = 50;
   bool refine = true;  // false: the tree's chained collineations only
+  // Names for messages (empty, or one per view / projector): "view 3" otherwise.
+  std::vector<std::string> view_names = {}, projector_names = {};
 };
 
 struct HomographyTree {

@@ -319,6 +319,8 @@ void plot(const std::filesystem::path& out) {
      << "set key top left\n"
      << "one(c) = strcol(3) eq 'one' ? column(c) : 1/0\n"
      << "views(c) = strcol(3) eq 'views_2x2' ? column(c) : 1/0\n"
+     << "onev(x) = strcol(3) eq 'one' ? x : 1/0\n"
+     << "viewsv(x) = strcol(3) eq 'views_2x2' ? x : 1/0\n"
      << "plot '" << csv << "' skip 1 using 1:(one(9)) with linespoints title 'one camera: RMS', "
      << "'' skip 1 using 1:(one(10)) with linespoints title 'one camera: max', "
      << "'' skip 1 using 1:(views(9)) with linespoints title '2x2 views, refined: RMS', "
@@ -326,9 +328,9 @@ void plot(const std::filesystem::path& out) {
      << "'' skip 1 using 1:(views(12)) with linespoints title '2x2 views, chain: RMS'\n"
      << "set ylabel 'seconds / capture frames'\nset logscale y\n"
      << "plot '" << csv
-     << "' skip 1 using 1:(one($6+$7)) with linespoints title 'one camera: "
+     << "' skip 1 using 1:(onev($6+$7)) with linespoints title 'one camera: "
         "compute (s)', "
-     << "'' skip 1 using 1:(views($6+$7)) with linespoints title '2x2 views: compute (s)', "
+     << "'' skip 1 using 1:(viewsv($6+$7)) with linespoints title '2x2 views: compute (s)', "
      << "'' skip 1 using 1:(one(4)) with linespoints title 'capture frames', "
      << "'' skip 1 using 1:(one(5)) with linespoints title 'capture frames, batched'\n"
      << "unset multiplot\n";

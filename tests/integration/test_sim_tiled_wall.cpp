@@ -23,6 +23,7 @@
 #include "sim/renderer.hpp"
 #include "sim/scene_library.hpp"
 #include "truth_rig_file.hpp"
+#include "unit/calibration/plane_corners.hpp"
 
 namespace procam::itest {
 namespace {
@@ -48,6 +49,77 @@ Vec3 onTheWall(const geom::CameraModel& p, const Vec2& x) {
   const Vec3 centre = p.pose.center();
   const Vec3 dir = Rt * p.K.matrix().inverse() * x.homogeneous();
   return centre + dir * ((3.0 - centre.y()) / dir.y());
+}
+
+// calibrate of every projector on the wall's plane through `cameras`: Gray + 3-step phase,
+// nodes every 8 px, no settle frames (the virtual rig shows a frame at once); id 1.
+json calibrateEveryProjector(const json& cameras) {
+  return {{"cmd", "calibrate"},  {"id", 1},
+          {"projectors", "all"}, {"cameras", cameras},
+          {"plane", kWallPlane}, {"mode", "gray+phase"},
+          {"phase_steps", 3},    {"grid", 8},
+          {"settle_frames", 0}};
+}
+
+// The homographies the outputs draw a kW x kH content with once `count` of them show
+// their tile of the display (`display`: the keystone's display record); fewer when they
+// do not within 30 s.
+std::map<std::string, Mat3> tiles(Connection& c, int kW, int kH, std::size_t count, json& display) {
+  std::map<std::string, Mat3> H;
+  eventually(
+      [&] {
+        auto s = c.call({{"cmd", "status"}});
+        if (!s) return false;
+        display = (*s)["keystone"].value("display", json());
+        H.clear();
+        for (const json& o : (*s)["outputs"]["shown"]) {
+          if (o["source"] == "content" && o.contains("display") && o.contains("homography") &&
+              display.is_object() && display.value("content_size", json()) == json({kW, kH})) {
+            H[o["name"].get<std::string>()] = rowMajor3(o["homography"]);
+          }
+        }
+        return H.size() == count;
+      },
+      30s);
+  return H;
+}
+
+// Seams: a content point (every 10 content px) lit by two projectors lands, through the
+// TRUE rig, where the other projector puts the same content point; the distance in the
+// other projector's pixels.
+struct Seams {
+  double rms = 0, max = 0;
+  int pairs = 0;
+};
+Seams seamsOnTheTruth(const std::map<std::string, Mat3>& H,
+                      const std::map<std::string, geom::CameraModel>& truth, int kW, int kH) {
+  Seams out;
+  double sq = 0;
+  for (int y = 0; y < kH; y += 10) {
+    for (int x = 0; x < kW; x += 10) {
+      const Vec3 content(x, y, 1);
+      for (const auto& [a, Ha] : H) {
+        const geom::CameraModel& ta = truth.at(a);
+        const Vec2 pa = (Ha * content).hnormalized();
+        if (!inFrame(ta, pa, 1)) continue;
+        const Vec3 wall = onTheWall(ta, pa);
+        for (const auto& [b, Hb] : H) {
+          if (a >= b) continue;
+          const geom::CameraModel& tb = truth.at(b);
+          const Vec2 pb = (Hb * content).hnormalized();
+          if (!inFrame(tb, pb, 1)) continue;
+          const double e = (*tb.project(wall) - pb).norm();
+          sq += e * e;
+          out.max = std::max(out.max, e);
+          ++out.pairs;
+        }
+      }
+    }
+  }
+  out.rms = out.pairs ? std::sqrt(sq / out.pairs) : 0;
+  std::printf("[ figures  ] seams: %d content points lit twice, RMS %.3f px, max %.3f px\n",
+              out.pairs, out.rms, out.max);
+  return out;
 }
 
 // The display as the daemon reports it: per output its homography, the display
@@ -190,12 +262,7 @@ TEST(SimTiledWall, FourProjectorsCalibratedIntoOneSeamlessDisplay) {
   // Every projector, one after the other, through the camera that sees the whole wall;
   // one rig model written at the end.
   const auto t0 = std::chrono::steady_clock::now();
-  const json request = {{"cmd", "calibrate"},  {"id", 1},
-                        {"projectors", "all"}, {"cameras", {"cam_a"}},
-                        {"plane", kWallPlane}, {"mode", "gray+phase"},
-                        {"phase_steps", 3},    {"grid", 8},
-                        {"settle_frames", 0}};
-  auto started = c.call(request);
+  auto started = c.call(calibrateEveryProjector(json({"cam_a"})));
   ASSERT_TRUE(started);
   ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
   EXPECT_EQ((*started)["outputs"], json({"proj_tl", "proj_tr", "proj_bl", "proj_br"}));
@@ -239,24 +306,9 @@ TEST(SimTiledWall, FourProjectorsCalibratedIntoOneSeamlessDisplay) {
   ASSERT_EQ((*on)["class"], "KEYSTONE") << on->dump();
 
   // Every output draws its tile of the display.
-  std::map<std::string, Mat3> H;
   json display;
-  const bool tiled = eventually(
-      [&] {
-        auto s = c.call({{"cmd", "status"}});
-        if (!s) return false;
-        display = (*s)["keystone"].value("display", json());
-        H.clear();
-        for (const json& o : (*s)["outputs"]["shown"]) {
-          if (o["source"] == "content" && o.contains("display") && o.contains("homography") &&
-              display.is_object() && display.value("content_size", json()) == json({kW, kH})) {
-            H[o["name"].get<std::string>()] = rowMajor3(o["homography"]);
-          }
-        }
-        return H.size() == 4;
-      },
-      30s);
-  ASSERT_TRUE(tiled) << display.dump() << "\n" << d.log();
+  std::map<std::string, Mat3> H = tiles(c, kW, kH, 4, display);
+  ASSERT_EQ(H.size(), 4u) << display.dump() << "\n" << d.log();
   EXPECT_EQ(display["outputs"].size(), 4u);
   // Brightness matched to the dimmest projector: gains follow the true brightness
   // (9, 10, 11, 13) to within the projectors' different views of the camera (2 %).
@@ -271,37 +323,11 @@ TEST(SimTiledWall, FourProjectorsCalibratedIntoOneSeamlessDisplay) {
     EXPECT_NEAR(t["gain"].get<double>(), expected, 0.02) << name;
   }
 
-  // Seams: a content point lit by two projectors lands, through the TRUE rig, where the
-  // other projector puts the same content point: within 0.3 px RMS, 1 px at most (in
-  // the other projector's pixels).
-  double sq = 0, worst = 0;
-  int pairs = 0;
-  for (int y = 0; y < kH; y += 10) {
-    for (int x = 0; x < kW; x += 10) {
-      const Vec3 content(x, y, 1);
-      for (const char* a : kOutputs) {
-        const Vec2 pa = (H[a] * content).hnormalized();
-        if (!inFrame(truth[a], pa, 1)) continue;
-        const Vec3 wall = onTheWall(truth[a], pa);
-        for (const char* b : kOutputs) {
-          if (std::string(a) >= b) continue;
-          const Vec2 pb = (H[b] * content).hnormalized();
-          if (!inFrame(truth[b], pb, 1)) continue;
-          const Vec2 seen = *truth[b].project(wall);
-          const double e = (seen - pb).norm();
-          sq += e * e;
-          worst = std::max(worst, e);
-          ++pairs;
-        }
-      }
-    }
-  }
-  ASSERT_GT(pairs, 1000);
-  const double rms = std::sqrt(sq / pairs);
-  std::printf("[ figures  ] seams: %d content points lit twice, RMS %.3f px, max %.3f px\n", pairs,
-              rms, worst);
-  EXPECT_LE(rms, 0.3);
-  EXPECT_LE(worst, 1.0);
+  // Seams: within 0.3 px RMS, 1 px at most (ARCHITECTURE.md).
+  const Seams seams = seamsOnTheTruth(H, truth, kW, kH);
+  ASSERT_GT(seams.pairs, 1000);
+  EXPECT_LE(seams.rms, 0.3);
+  EXPECT_LE(seams.max, 1.0);
 
   // The display on the TRUE wall: its corners through a projector that shows them.
   auto wallPoint = [&](const Vec2& content) -> std::optional<Vec3> {
@@ -482,6 +508,106 @@ TEST(SimTiledWall, ConfiguredDisplayRectangleIsUsed) {
                 display["rect_m"]["centre"][1].get<double>() * b["v"][i].get<double>();
   }
   EXPECT_NEAR((centre - Vec3(0.1, 3.0, 1.45)).norm(), 0, 1e-9) << centre.transpose();
+}
+
+// Cameras at several positions (wall_views): cam_l sees most of proj_l and nothing of
+// proj_r, cam_r sees proj_r whole and a fifth of proj_l, and only cam_l has a pose in
+// the rig; cam_r is known by its intrinsics alone. calibrate registers cam_r through
+// the projector both see ([Chen02]'s homography tree) and maps both projectors onto the
+// wall; the display they make is judged with the TRUE projectors.
+TEST(SimWallViews, CamerasThatEachSeeOneProjectorCalibrateTheDisplayTogether) {
+  auto scene = sim::resolveScene("wall_views");
+  ASSERT_TRUE(scene) << scene.error().message;
+  std::map<std::string, geom::CameraModel> truth;
+  for (const auto& p : scene->at(0).projectors) truth[p.spec.name] = p.model;
+  TempDir dir;
+  // cam_l posed; cam_r by its intrinsics alone.
+  DaemonProcess d(dir, simWithTruth(dir, "wall_views", TruthParts::kFirstCameraPosed));
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  // The reference camera must have a pose; cam_r has none.
+  auto refused = c.call({{"cmd", "calibrate"},
+                         {"projectors", "all"},
+                         {"cameras", {"cam_r", "cam_l"}},
+                         {"plane", kWallPlane}});
+  ASSERT_TRUE(refused);
+  EXPECT_EQ((*refused)["code"], "unavailable") << refused->dump();
+  EXPECT_NE((*refused)["message"].get<std::string>().find("cam_r"), std::string::npos);
+  // A measured settle time would time cam_r on proj_l, which it barely sees.
+  auto unmeasurable = c.call({{"cmd", "calibrate"},
+                              {"projectors", "all"},
+                              {"cameras", {"cam_l", "cam_r"}},
+                              {"plane", kWallPlane},
+                              {"settle_frames", "auto"}});
+  ASSERT_TRUE(unmeasurable);
+  EXPECT_EQ((*unmeasurable)["code"], "bad-argument") << unmeasurable->dump();
+
+  auto started = c.call(calibrateEveryProjector(json({"cam_l", "cam_r"})));
+  ASSERT_TRUE(started);
+  ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
+  EXPECT_EQ((*started)["route"], "b'");
+  auto done = finalReply(c, 1, 600s);
+  ASSERT_TRUE(done) << d.log();
+  ASSERT_EQ((*done)["class"], "CALIBRATE") << done->dump();
+  const json& wall = (*done)["wall"];
+  ASSERT_TRUE(wall.is_object()) << done->dump();
+  EXPECT_EQ(wall["reference_camera"], "cam_l");
+  std::printf(
+      "[ figures  ] wall views: %d links, %d nodes, residual %.4f camera px (chain %.4f), %d "
+      "iterations\n",
+      wall["links"].get<int>(), wall["nodes"].get<int>(), wall["rms_camera_px"].get<double>(),
+      wall["chain_rms_camera_px"].get<double>(), wall["iterations"].get<int>());
+  for (const json& p : wall["projectors"]) {
+    std::printf("[ figures  ] %s: %d cameras, %d nodes, %.4f camera px, coverage %.3f\n",
+                p["output"].get<std::string>().c_str(), p["cameras"].get<int>(),
+                p["nodes"].get<int>(), p["rms_camera_px"].get<double>(),
+                p["coverage"].get<double>());
+  }
+  // proj_l is seen by both cameras; proj_r by cam_r only, two cameras down the chain
+  // from cam_l.
+  ASSERT_EQ(wall["projectors"].size(), 2u);
+  EXPECT_EQ(wall["projectors"][0]["cameras"], 2) << wall.dump();
+  EXPECT_EQ(wall["projectors"][1]["cameras"], 1) << wall.dump();
+  EXPECT_EQ(wall["projectors"][1]["chain_cameras"], 2) << wall.dump();
+  for (const json& o : (*done)["outputs"]) {
+    EXPECT_NE(o["projector"]["calibrated"]["method"].get<std::string>().find("several positions"),
+              std::string::npos)
+        << o.dump();
+  }
+  // Every corner of both images within the keystone bound (0.5 px) of the TRUE
+  // projector's, proj_r's through cam_r alone.
+  std::ifstream written(dir.path() + "/state/rig.json");
+  auto calibrated = rig::rigFromJson(json::parse(written, nullptr, false), "rig.json");
+  ASSERT_TRUE(calibrated) << calibrated.error().message;
+  for (const auto& [name, model] : truth) {
+    const rig::RigProjector* p = calibrated->projectorForOutput(name);
+    ASSERT_TRUE(p && p->plane_homography) << name;
+    const double corner = procam::testing::planeCornerErrorPx(*p->plane_homography, model);
+    std::printf("[ figures  ] %s: corners within %.3f px of the truth\n", name.c_str(), corner);
+    EXPECT_LE(corner, 0.5) << name;
+  }
+  // The response ramp is measured by the reference camera, which sees nothing of proj_r.
+  EXPECT_TRUE((*done)["outputs"][0]["response"].contains("response_gamma")) << done->dump();
+  EXPECT_EQ((*done)["outputs"][1]["response"]["measured"], false) << done->dump();
+  // The two images overlap: one at a time.
+  EXPECT_EQ((*done)["scan"]["batches"].size(), 2u) << done->dump();
+
+  constexpr int kW = 1600, kH = 900;
+  const std::string png = contentFile(dir, "slide.png");
+  ASSERT_TRUE(cv::imwrite(png, cv::Mat(kH, kW, CV_8UC3, cv::Scalar(255, 255, 255))));
+  auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", png}}, 30s);
+  ASSERT_TRUE(load && (*load)["class"] == "CONTENT") << (load ? load->dump() : "none");
+  auto on = c.call({{"cmd", "keystone"}, {"action", "rig"}, {"enable", true}});
+  ASSERT_TRUE(on && (*on)["class"] == "KEYSTONE") << (on ? on->dump() : "none");
+  json display;
+  const std::map<std::string, Mat3> H = tiles(c, kW, kH, 2, display);
+  ASSERT_EQ(H.size(), 2u) << display.dump() << "\n" << d.log();
+  // Seams within 0.3 px RMS, 1 px at most (ARCHITECTURE.md), where proj_r is placed
+  // through cam_r's view of proj_l alone.
+  const Seams seams = seamsOnTheTruth(H, truth, kW, kH);
+  ASSERT_GT(seams.pairs, 1000);
+  EXPECT_LE(seams.rms, 0.3);
+  EXPECT_LE(seams.max, 1.0);
 }
 
 }  // namespace

@@ -15,6 +15,9 @@ namespace procam::itest {
 enum class TruthParts {
   kAll,          // cameras, projectors (with tilt mounts), surface plane, viewer
   kCamerasOnly,  // what an offline camera calibration gives: calibrate finds the rest
+  // Cameras at several positions: every camera's intrinsics, a pose for the first one
+  // only (the others calibrated alone from board views).
+  kFirstCameraPosed,
 };
 
 // Writes the truth of `scene` (a shipped name or a file) at time 0 as `name` in
@@ -32,10 +35,14 @@ inline std::string truthRigFile(const TempDir& dir, const std::string& scene,
     ADD_FAILURE() << rig.error().message;
     return "";
   }
-  if (parts == TruthParts::kCamerasOnly) {
+  if (parts != TruthParts::kAll) {
     rig->projectors.clear();
     rig->surface = {};
     rig->viewer = {};
+  }
+  for (std::size_t c = 1; parts == TruthParts::kFirstCameraPosed && c < rig->cameras.size(); ++c) {
+    rig->cameras[c].pose_known = false;
+    rig->cameras[c].model.pose = geom::Pose{};
   }
   dir.write(name, rig::rigToJson(*rig).dump(2) + "\n");
   return dir.file(name);

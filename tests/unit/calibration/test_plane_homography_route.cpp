@@ -9,6 +9,7 @@
 #include <random>
 
 #include "calibration/plane_homography_route.hpp"
+#include "plane_corners.hpp"
 #include "structured_light/pattern_set.hpp"
 #include "synthetic_rig.hpp"
 
@@ -72,16 +73,7 @@ sl::Decoded copyOf(const sl::Decoded& d) {
 // Largest distance, in projector pixels, between each framebuffer corner and where
 // the true projector sees the plane point the route maps it to.
 double cornerErrorPx(const calib::PlaneHomographyResult& r, const geom::CameraModel& projector) {
-  const double w = projector.width, h = projector.height;
-  double worst = 0;
-  for (const Vec2& c :
-       {Vec2(-0.5, -0.5), Vec2(w - 0.5, -0.5), Vec2(w - 0.5, h - 0.5), Vec2(-0.5, h - 0.5)}) {
-    const Vec2 ab = (r.projector_to_plane.H * c.homogeneous()).hnormalized();
-    auto seen = projector.project(r.projector_to_plane.basis.toWorld(ab));
-    if (!seen) return 1e9;
-    worst = std::max(worst, (*seen - c).norm());
-  }
-  return worst;
+  return procam::testing::planeCornerErrorPx(r.projector_to_plane, projector);
 }
 
 TEST(PlaneHomographyRoute, ExactMapGivesTheProjectorsCollineation) {

@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "calibration/wall_views_route.hpp"
+#include "plane_corners.hpp"
 #include "rig_capture.hpp"
 #include "structured_light/decoder.hpp"
 
@@ -110,15 +111,8 @@ TEST(WallViewsRoute, TwoCamerasThatEachSeeHalfCalibrateTheWholeWall) {
   // the calibrated camera sees only a fifth of.
   double worst_corner = 0;
   for (std::size_t p = 0; p < state.projectors.size(); ++p) {
-    const geom::CameraModel& truth = state.projectors[p].model;
-    const auto& est = r->projector_to_plane[p];
-    const double w = truth.width, h = truth.height;
-    for (const Vec2& c :
-         {Vec2(-0.5, -0.5), Vec2(w - 0.5, -0.5), Vec2(w - 0.5, h - 0.5), Vec2(-0.5, h - 0.5)}) {
-      auto seen = truth.project(est.basis.toWorld((est.H * c.homogeneous()).hnormalized()));
-      ASSERT_TRUE(seen);
-      worst_corner = std::max(worst_corner, (*seen - c).norm());
-    }
+    worst_corner = std::max(worst_corner, procam::testing::planeCornerErrorPx(
+                                              r->projector_to_plane[p], state.projectors[p].model));
   }
   // Seams: plane points (every 2 mm) two projectors show by the estimate; where the
   // true projectors put the two pixels, apart, in the first one's pixels.

@@ -83,8 +83,9 @@ TEST(HomographyTree, GlobalRefinementKeepsSixteenProjectorsSeamless) {
   EXPECT_LE(seam.max_px, 1.0);
   EXPECT_LT(seam.rms_px, chain_seam.rms_px);
   // The residual of a maximum-likelihood fit is the noise: sqrt(2) sigma per 2D match,
-  // less a fraction for the fitted parameters (~150 against ~60 000 coordinates).
-  EXPECT_NEAR(refined->rms_px, noise * std::sqrt(2.0), 0.01);
+  // less a fraction for the fitted parameters (192 against ~1.7 million coordinates);
+  // over ~870 000 matches its own sampling spread is ~1e-4 px.
+  EXPECT_NEAR(refined->rms_px, noise * std::sqrt(2.0), 0.003);
   EXPECT_LT(refined->rms_px, refined->chain_rms_px);
 }
 
