@@ -77,6 +77,12 @@ void accumulateBit(const T* __restrict p, const T* __restrict q, U* __restrict c
   }
 }
 
+// std::lround's rounding (halves away from zero) for the small magnitudes of pixel
+// codes (|v| < 2^23), without its library call: the conversion truncates towards zero.
+inline int roundHalfAway(float v) {
+  return static_cast<int>(v + std::copysign(0.5f, v));
+}
+
 template <class T>
 class RowDecoder {
   using W = std::conditional_t<sizeof(T) == 1, std::int16_t, std::int32_t>;
@@ -130,10 +136,10 @@ class RowDecoder {
         }
         const float tol =
             static_cast<float>(o_.range_tolerance) * std::max(contrast, 0.0f) + tol_abs;
-        s.hi[x] = static_cast<W>(std::lround(static_cast<float>(w[x]) + tol));
-        s.lo[x] = static_cast<W>(std::lround(static_cast<float>(b[x]) - tol));
+        s.hi[x] = static_cast<W>(roundHalfAway(static_cast<float>(w[x]) + tol));
+        s.lo[x] = static_cast<W>(roundHalfAway(static_cast<float>(b[x]) - tol));
         s.firm[x] = static_cast<W>(
-            std::lround(static_cast<float>(o_.bit_contrast) * std::max(contrast, 0.0f)));
+            roundHalfAway(static_cast<float>(o_.bit_contrast) * std::max(contrast, 0.0f)));
         confidence[x] = 1.0f;
       }
       decodeAxis(axes_[0], y, s, flags, confidence.data(), out_.u.ptr<float>(y));
@@ -328,75 +334,81 @@ void dropUnreliable(Decoded& d, const cv::Mat& white, const cv::Mat& black, floa
                     float tol_v, int needed, float partial, float margin) {
   const int w = d.u.cols, h = d.u.rows;
   cv::Mat drop(d.u.size(), CV_8U, cv::Scalar(0));
-  cv::parallel_for_(cv::Range(0, h), [&](const cv::Range& rows) {
-    // Rows y-2 .. y+2 padded by two pixels each side: out-of-image neighbours are
-    // undecoded with zero contrast, so the inner loop has no bounds tests.
-    const int pw = w + 4;
-    std::vector<float> contrast(5 * static_cast<std::size_t>(pw)), u(contrast.size()),
-        v(contrast.size());
-    std::vector<std::uint8_t> ok(contrast.size());
-    auto load = [&](int y, int slot) {
-      float* c = contrast.data() + slot * pw;
-      float* uu = u.data() + slot * pw;
-      float* vv = v.data() + slot * pw;
-      std::uint8_t* o = ok.data() + slot * pw;
-      std::fill(c, c + pw, 0.0f);
-      std::fill(o, o + pw, std::uint8_t{0});
-      if (y < 0 || y >= h) return;
-      const T* wh = white.ptr<T>(y);
-      const T* bl = black.ptr<T>(y);
-      const std::uint8_t* f = d.flags.ptr<std::uint8_t>(y);
-      const float* su = d.u.ptr<float>(y);
-      const float* sv = d.v.ptr<float>(y);
-      for (int x = 0; x < w; ++x) {
-        c[x + 2] = static_cast<float>(wh[x]) - static_cast<float>(bl[x]);
-        o[x + 2] = f[x] == 0;
-        uu[x + 2] = su[x];
-        vv[x + 2] = sv[x];
-      }
-    };
-    for (int y = rows.start; y < rows.end; ++y) {
-      for (int k = -2; k <= 2; ++k) load(y + k, k + 2);
-      std::uint8_t* out = drop.ptr<std::uint8_t>(y);
-      const int at = 2 * pw + 2;  // row y, x = 0
-      const float* c = contrast.data() + at;
-      const float* uc = u.data() + at;
-      const float* vc = v.data() + at;
-      const std::uint8_t* oc = ok.data() + at;
-      // Three decoded pixels in a line at x + a*off, x + (a+1)*off, x + (a+2)*off whose
-      // second difference stays within the tolerance.
-      auto straight = [&](int i, int off, int a) {
-        const int p = i + a * off, q = p + off, r = q + off;
-        return oc[p] && oc[q] && oc[r] && std::abs(uc[p] + uc[r] - 2 * uc[q]) <= 2 * tol_u &&
-               std::abs(vc[p] + vc[r] - 2 * vc[q]) <= 2 * tol_v;
-      };
-      for (int x = 0; x < w; ++x) {
-        if (!oc[x]) continue;
-        std::uint8_t flag = 0;
-        if (needed > 0) {
-          // Second differences along each image axis: the first-order change between
-          // neighbours (the projector pixels one camera pixel spans, several when the
-          // camera is coarser than the projector) cancels, so the tolerance holds at
-          // any footprint while a slipped code (a Gray cell or a phase period) shows
-          // twice over (once when the pixel ends the line, at the edge of the
-          // decoded area). Each agreeing axis counts as two neighbours.
-          int n = 0;
-          for (const int off : {1, pw}) {
-            const bool centred = oc[x - off] && oc[x + off];
-            n += (centred ? straight(x, off, -1) : straight(x, off, 0) || straight(x, off, -2)) ? 2
-                                                                                                : 0;
+  cv::parallel_for_(
+      cv::Range(0, h),
+      [&](const cv::Range& rows) {
+        // The stripe's rows and two above and below, each loaded once, padded by two
+        // pixels each side: out-of-image neighbours are undecoded with zero contrast, so
+        // the inner loop has no bounds tests.
+        const int pw = w + 4, first = rows.start - 2, count = rows.end - rows.start + 4;
+        std::vector<float> contrast(static_cast<std::size_t>(count) * pw), u(contrast.size()),
+            v(contrast.size());
+        std::vector<std::uint8_t> ok(contrast.size());
+        for (int slot = 0; slot < count; ++slot) {
+          const int y = first + slot;
+          float* c = contrast.data() + static_cast<std::size_t>(slot) * pw;
+          float* uu = u.data() + static_cast<std::size_t>(slot) * pw;
+          float* vv = v.data() + static_cast<std::size_t>(slot) * pw;
+          std::uint8_t* o = ok.data() + static_cast<std::size_t>(slot) * pw;
+          std::fill(c, c + pw, 0.0f);
+          std::fill(o, o + pw, std::uint8_t{0});
+          if (y < 0 || y >= h) continue;
+          const T* wh = white.ptr<T>(y);
+          const T* bl = black.ptr<T>(y);
+          const std::uint8_t* f = d.flags.ptr<std::uint8_t>(y);
+          const float* su = d.u.ptr<float>(y);
+          const float* sv = d.v.ptr<float>(y);
+          for (int x = 0; x < w; ++x) {
+            c[x + 2] = static_cast<float>(wh[x]) - static_cast<float>(bl[x]);
+            o[x + 2] = f[x] == 0;
+            uu[x + 2] = su[x];
+            vv[x + 2] = sv[x];
           }
-          if (n < needed) flag |= kInconsistent;
         }
-        if (partial > 0) {
-          const float brightest =
-              std::max(std::max(c[x - 1], c[x + 1]), std::max(c[x - pw], c[x + pw]));
-          if (c[x] < partial * brightest - margin) flag |= kShadow;
+        for (int y = rows.start; y < rows.end; ++y) {
+          std::uint8_t* out = drop.ptr<std::uint8_t>(y);
+          const std::size_t at = static_cast<std::size_t>(y - first) * pw + 2;  // row y, x = 0
+          const float* c = contrast.data() + at;
+          const float* uc = u.data() + at;
+          const float* vc = v.data() + at;
+          const std::uint8_t* oc = ok.data() + at;
+          // Three decoded pixels in a line at x + a*off, x + (a+1)*off, x + (a+2)*off whose
+          // second difference stays within the tolerance.
+          auto straight = [&](int i, int off, int a) {
+            const int p = i + a * off, q = p + off, r = q + off;
+            return oc[p] && oc[q] && oc[r] && std::abs(uc[p] + uc[r] - 2 * uc[q]) <= 2 * tol_u &&
+                   std::abs(vc[p] + vc[r] - 2 * vc[q]) <= 2 * tol_v;
+          };
+          for (int x = 0; x < w; ++x) {
+            if (!oc[x]) continue;
+            std::uint8_t flag = 0;
+            if (needed > 0) {
+              // Second differences along each image axis: the first-order change between
+              // neighbours (the projector pixels one camera pixel spans, several when the
+              // camera is coarser than the projector) cancels, so the tolerance holds at
+              // any footprint while a slipped code (a Gray cell or a phase period) shows
+              // twice over (once when the pixel ends the line, at the edge of the
+              // decoded area). Each agreeing axis counts as two neighbours.
+              int n = 0;
+              for (const int off : {1, pw}) {
+                const bool centred = oc[x - off] && oc[x + off];
+                n += (centred ? straight(x, off, -1) : straight(x, off, 0) || straight(x, off, -2))
+                         ? 2
+                         : 0;
+              }
+              if (n < needed) flag |= kInconsistent;
+            }
+            if (partial > 0) {
+              const float brightest =
+                  std::max(std::max(c[x - 1], c[x + 1]), std::max(c[x - pw], c[x + pw]));
+              if (c[x] < partial * brightest - margin) flag |= kShadow;
+            }
+            out[x] = flag;
+          }
         }
-        out[x] = flag;
-      }
-    }
-  });
+      },
+      // Stripes of ~32 rows: each reloads only its four border rows.
+      std::max(1, h / 32));
   for (int y = 0; y < h; ++y) {
     const std::uint8_t* dr = drop.ptr<std::uint8_t>(y);
     std::uint8_t* f = d.flags.ptr<std::uint8_t>(y);
