@@ -153,7 +153,7 @@ struct Refinement {
     for (iterations = 0; iterations < max_iterations;) {
       normalEquations(A, g);
       ++iterations;
-      bool accepted = false;
+      bool accepted = false, tried = false;
       while (!accepted && lambda < 1e12) {
         Eigen::MatrixXd damped = A;
         damped.diagonal() += lambda * A.diagonal().cwiseMax(1e-12);
@@ -162,6 +162,7 @@ struct Refinement {
           lambda *= 10;
           continue;
         }
+        tried = true;
         std::vector<Mat3> p(P.size()), q(Q.size());
         for (std::size_t i = 0; i < P.size(); ++i) p[i] = updated(P[i], step, kFree * i);
         for (std::size_t v = 0; v < Q.size(); ++v) q[v] = updated(Q[v], step, viewOffset(int(v)));
@@ -181,8 +182,10 @@ struct Refinement {
           lambda *= 10;
         }
       }
-      if (!accepted) {  // no step lowers the cost: at the minimum to working precision
-        converged = true;
+      if (!accepted) {
+        // No step lowers the cost: at the minimum to working precision, unless no
+        // finite step could be solved for at all (the equations were not).
+        converged = tried;
         return;
       }
     }
