@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
-#include <set>
 #include <span>
 #include <thread>
 
@@ -17,47 +16,6 @@
 namespace procam::daemon {
 
 namespace code = proto::code;
-using nlohmann::json;
-
-namespace {
-
-// An integer argument in [lo, hi]; false (with `error` set) when present and wrong.
-bool integerArg(const json& request, const char* key, int lo, int hi, int& out,
-                std::string& error) {
-  auto it = request.find(key);
-  if (it == request.end()) return true;
-  if (!it->is_number_integer() || it->get<int64_t>() < lo || it->get<int64_t>() > hi) {
-    error = std::string("\"") + key + "\" must be an integer from " + std::to_string(lo) + " to " +
-            std::to_string(hi);
-    return false;
-  }
-  out = it->get<int>();
-  return true;
-}
-
-}  // namespace
-
-tl::expected<calib::BoardSpec, std::string> boardArg(const json& value) {
-  const std::string text = value.is_string() ? value.get<std::string>() : std::string();
-  auto spec = !text.empty() && text.size() <= 64
-                  ? calib::parseBoard(text)
-                  : Result<calib::BoardSpec>(tl::unexpect, Error{ErrorCode::kParse, "not a board"});
-  if (!spec) {
-    return tl::unexpected(
-        "\"board\" must be a board: aprilgrid:COLSxROWS:TAG_M[:GAP_M], "
-        "checker:COLSxROWS:SQUARE_M or charuco:COLSxROWS:SQUARE_M:MARKER_M (metres): " +
-        spec.error().message);
-  }
-  // Bounded: the detector's work and memory grow with the board's cells.
-  if (spec->cols > 64 || spec->rows > 64 || !(spec->square_m >= 0.001 && spec->square_m <= 10) ||
-      !(spec->gap_m >= 0 && spec->gap_m <= 10 * spec->square_m) ||
-      (spec->kind == calib::BoardKind::kAprilGrid && spec->cols * spec->rows > 587)) {
-    return tl::unexpected(
-        std::string("\"board\" must have at most 64 x 64 cells of 1 mm to 10 m, a gap of at "
-                    "most 10 cells and, for aprilgrid, at most 587 tags (tag36h11)"));
-  }
-  return *spec;
-}
 
 CalibrationFailure deviceFailure(const char* family, const std::string& name, int rc,
                                  const char* what, const char* reason) {
@@ -100,128 +58,6 @@ bool waitCancellable(double seconds, const CalibrationHooks& hooks) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   return !hooks.cancelled();
-}
-
-tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const json& request,
-                                                                const CalibrationConfig& defaults) {
-  CalibrationArgs a;
-  a.settle_frames = defaults.settle_frames;
-  a.auto_settle = defaults.auto_settle;
-  static const char* const kKeys[] = {"mode",          "step",       "phase_steps", "grid",
-                                      "settle_frames", "output",     "cameras",     "plane",
-                                      "board",         "projectors", "response"};
-  for (const auto& [key, value] : request.items()) {
-    if (key == "cmd" || key == "id") continue;
-    bool known = false;
-    for (const char* k : kKeys) known = known || key == k;
-    if (!known) return tl::unexpected("unknown argument \"" + key + "\" for calibrate");
-  }
-  std::string error;
-  if (auto it = request.find("mode"); it != request.end()) {
-    auto mode = it->is_string() ? sl::parseMode(it->get<std::string>()) : Result<sl::Mode>{};
-    if (!it->is_string() || !mode) {
-      return tl::unexpected(std::string("\"mode\" must be \"gray\" or \"gray+phase\""));
-    }
-    a.mode = *mode;
-  }
-  if (!integerArg(request, "step", 1, 256, a.step, error) ||
-      !integerArg(request, "phase_steps", 3, 64, a.phase_steps, error) ||
-      !integerArg(request, "grid", 1, 1024, a.grid, error)) {
-    return tl::unexpected(error);
-  }
-  if (auto it = request.find("settle_frames"); it != request.end() && *it == "auto") {
-    a.auto_settle = true;
-  } else if (!integerArg(request, "settle_frames", 0, 600, a.settle_frames, error)) {
-    return tl::unexpected(error + " or \"auto\"");
-  } else if (it != request.end()) {
-    a.auto_settle = false;
-  }
-  if (request.contains("phase_steps") && a.mode != sl::Mode::kGrayPhase) {
-    return tl::unexpected(std::string("\"phase_steps\" needs \"mode\": \"gray+phase\""));
-  }
-  if (auto it = request.find("output"); it != request.end()) {
-    if (!it->is_string() || it->get<std::string>().empty()) {
-      return tl::unexpected(std::string("\"output\" must be a device name"));
-    }
-    a.output = it->get<std::string>();
-  }
-  if (auto it = request.find("projectors"); it != request.end()) {
-    // The outputs the projectors are bound to, at most 64, no name twice; or "all".
-    if (*it == "all") {
-      a.all_outputs = true;
-    } else {
-      const bool names = it->is_array() && !it->empty() && it->size() <= 64 &&
-                         std::all_of(it->begin(), it->end(), [](const json& n) {
-                           return n.is_string() && !n.get<std::string>().empty() &&
-                                  n.get<std::string>().size() <= 256;
-                         });
-      std::set<std::string> seen;
-      if (names) {
-        for (const auto& n : *it) seen.insert(n.get<std::string>());
-      }
-      if (!names || seen.size() != it->size()) {
-        return tl::unexpected(std::string(
-            "\"projectors\" must be \"all\" or a list of 1 to 64 different output names"));
-      }
-      for (const auto& n : *it) a.outputs.push_back(n.get<std::string>());
-    }
-    if (request.contains("output")) {
-      return tl::unexpected(std::string("give either \"output\" or \"projectors\""));
-    }
-  }
-  if (auto it = request.find("response"); it != request.end()) {
-    if (!it->is_boolean()) return tl::unexpected(std::string("\"response\" must be true or false"));
-    a.response = it->get<bool>();
-  }
-  if (auto it = request.find("cameras"); it != request.end()) {
-    const bool names = it->is_array() && !it->empty() && it->size() <= kMaxCalibrationCameras &&
-                       std::all_of(it->begin(), it->end(), [](const json& n) {
-                         return n.is_string() && !n.get<std::string>().empty();
-                       });
-    bool distinct = true;
-    for (std::size_t i = 0; names && i < it->size(); ++i) {
-      for (std::size_t j = 0; j < i; ++j) distinct = distinct && (*it)[i] != (*it)[j];
-    }
-    if (!names || !distinct) {
-      return tl::unexpected(
-          "\"cameras\" must name one camera (route b′), two (route a, or route b′ from both "
-          "with \"plane\") or up to " +
-          std::to_string(kMaxCalibrationCameras) +
-          " different ones (route b′ from cameras at several positions)");
-    }
-    for (const auto& n : *it) a.cameras.push_back(n.get<std::string>());
-  }
-  if (auto it = request.find("plane"); it != request.end()) {
-    // a x + b y + c z + d = 0 in the world frame, as rig.json's surface.plane.
-    const bool numbers =
-        it->is_array() && it->size() == 4 && std::all_of(it->begin(), it->end(), [](const json& v) {
-          return v.is_number() && std::isfinite(v.get<double>());
-        });
-    const Vec3 n =
-        numbers ? Vec3((*it)[0].get<double>(), (*it)[1].get<double>(), (*it)[2].get<double>())
-                : Vec3::Zero();
-    if (!numbers || !(n.norm() > 1e-9)) {
-      return tl::unexpected(std::string(
-          "\"plane\" must be 4 finite numbers [a, b, c, d] (a x + b y + c z + d = 0, world "
-          "metres) with a non-zero normal"));
-    }
-    a.plane = geom::Plane{n / n.norm(), (*it)[3].get<double>() / n.norm()};
-  }
-  if (auto it = request.find("board"); it != request.end()) {
-    auto spec = boardArg(*it);
-    if (!spec) return tl::unexpected(spec.error());
-    if (a.plane) {
-      return tl::unexpected(
-          std::string("give either \"plane\" or \"board\": both say where the display plane is"));
-    }
-    if (a.cameras.size() >= 2) {
-      return tl::unexpected(
-          std::string("\"board\" is for route (b′) with one camera; \"cameras\" names more"));
-    }
-    a.board = *spec;
-    a.board_text = it->get<std::string>();
-  }
-  return a;
 }
 
 tl::expected<cv::Mat, CalibrationFailure> captureGray(const CalibrationDevice& cam) {
@@ -571,27 +407,27 @@ cv::Mat lightOf(const cv::Mat& white, const cv::Mat& black) {
   return diff;
 }
 
-// Camera pixels a projector lights: white minus black (`light`, lightOf) above 5 % of its
-// 99.5th percentile (the projector's light, whatever the exposure: the dim far or
-// grazing parts of a curved wall stay in, the camera's noise out), specks opened away,
-// then dilated by 4 pixels for the blur of its edge. Empty (all zero) when the camera
-// sees too little of it: a 99.5th percentile under 5 % of the white view's. With a
-// `level` (> 0) the threshold is 5 % of it instead, whatever share of the view the
-// light covers: cameras at several positions compare a projector's sliver at the edge
-// of one camera's view with the level of the projectors it sees whole.
-cv::Mat litPixels(const cv::Mat& white, const cv::Mat& light, float level = 0) {
-  const float top = level > 0 ? level : percentile(light, 0.995);
-  cv::Mat mask(light.size(), CV_8UC1, cv::Scalar(0));
-  if (level <= 0) {
-    cv::Mat w;
-    white.convertTo(w, CV_32F);
-    if (!(top > 0.05f * percentile(w, 0.995)) || !(top > 0)) return mask;
-  }
-  mask = light > 0.05f * top;
+// The camera pixels whose `light` (lightOf) exceeds `threshold`, specks opened away,
+// then dilated by 4 pixels for the blur of the light's edge.
+cv::Mat litMask(const cv::Mat& light, float threshold) {
+  cv::Mat mask = light > threshold;
   const cv::Mat k3 = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
   cv::morphologyEx(mask, mask, cv::MORPH_OPEN, k3);
   cv::dilate(mask, mask, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(9, 9)));
   return mask;
+}
+
+// Camera pixels a projector lights: its light above 5 % of the light's own 99.5th
+// percentile (the projector's light, whatever the exposure: the dim far or grazing parts
+// of a curved wall stay in, the camera's noise out). Empty (all zero) when the camera
+// sees too little of it: a 99.5th percentile under 5 % of the white view's.
+cv::Mat litPixels(const cv::Mat& white, const cv::Mat& light) {
+  const float top = percentile(light, 0.995);
+  cv::Mat w;
+  white.convertTo(w, CV_32F);
+  if (!(top > 0.05f * percentile(w, 0.995)) || !(top > 0))
+    return cv::Mat(light.size(), CV_8UC1, cv::Scalar(0));
+  return litMask(light, 0.05f * top);
 }
 
 // Whether two plans can share a batch: the same frames on the same cameras, one route.
@@ -636,8 +472,10 @@ tl::expected<ScanBatches, CalibrationFailure> planScanBatches(
     black.push_back(std::move(*gray));
   }
   out.footprints.resize(plans.size());
-  // Cameras at several positions: each projector's light is kept until its level in
-  // every camera is known (litPixels' `level`).
+  // Cameras at several positions: each projector's light is kept until the brightest
+  // projector's level in every camera is known, and thresholded at 5 % of that level
+  // (litPixels' rule would drop a projector's sliver at the edge of a camera's view,
+  // under 0.5 % of its pixels, and with it an overlap in that camera).
   const bool shared_level = first.wallViews();
   std::vector<std::vector<cv::Mat>> lights(plans.size(), std::vector<cv::Mat>(cams));
   std::vector<float> level(cams, 0.0f);
@@ -678,7 +516,7 @@ tl::expected<ScanBatches, CalibrationFailure> planScanBatches(
       const cv::Mat& light = lights[i][c];
       if (light.empty()) continue;
       // A camera none of the projectors lights: nothing of this one either.
-      out.footprints[i][c] = level[c] > 0 ? litPixels(cv::Mat(), light, level[c])
+      out.footprints[i][c] = level[c] > 0 ? litMask(light, 0.05f * level[c])
                                           : cv::Mat(light.size(), CV_8UC1, cv::Scalar(0));
     }
     lights[i].clear();
@@ -706,6 +544,14 @@ tl::expected<ScanBatches, CalibrationFailure> planScanBatches(
     return plans[i]->wallViews() ? any : all;
   };
   for (std::size_t i = 0; i < plans.size(); ++i) {
+    // At several positions a projector no camera sees ends the run here, not after
+    // every other projector's scan.
+    if (plans[i]->wallViews() && !seen(i)) {
+      return tl::unexpected(CalibrationFailure{
+          code::kFailed, "output '" + plans[i]->output.name +
+                             "': none of the cameras sees its light (the coarse pass showed "
+                             "it white alone)"});
+    }
     bool placed = false;
     for (auto& batch : out.batches) {
       bool fits = seen(i);
@@ -721,75 +567,6 @@ tl::expected<ScanBatches, CalibrationFailure> planScanBatches(
     if (!placed) out.batches.push_back({i});
   }
   return out;
-}
-
-tl::expected<calib::WallViewsResult, CalibrationFailure> solveWallViewsRun(
-    std::span<const CalibrationPlan* const> plans, std::span<CalibrationOutcome> outcomes) {
-  if (plans.empty() || plans.size() != outcomes.size() || !plans.front()->wallViews()) {
-    return tl::unexpected(
-        CalibrationFailure{code::kFailed, "internal: no run of cameras at several positions"});
-  }
-  const CalibrationPlan& first = *plans.front();
-  std::vector<std::pair<int, int>> sizes;
-  std::vector<calib::WallNodes> nodes;
-  for (std::size_t p = 0; p < plans.size(); ++p) {
-    const CalibrationPlan& plan = *plans[p];
-    if (!plan.wallViews() || plan.cameras.size() != first.cameras.size() ||
-        outcomes[p].wall_nodes.size() != plan.cameras.size()) {
-      return tl::unexpected(
-          CalibrationFailure{code::kFailed, "internal: the run's projectors differ in cameras"});
-    }
-    sizes.emplace_back(plan.set.options.width, plan.set.options.height);
-    for (std::size_t c = 0; c < plan.cameras.size(); ++c) {
-      if (outcomes[p].wall_nodes[c]) nodes.push_back({p, c, *outcomes[p].wall_nodes[c]});
-    }
-  }
-  calib::WallViewsOptions options{.nodes = {.step = first.grid}, .reference_camera = 0};
-  for (const auto& c : first.cameras)
-    options.camera_names.push_back("camera '" + c.device.name + "'");
-  for (const CalibrationPlan* p : plans) {
-    options.projector_names.push_back("output '" + p->output.name + "'");
-  }
-  auto solved = calib::solveWallViews(sizes, first.cameras.size(), nodes, first.cameras[0].model,
-                                      first.cameras[0].device.name, *first.plane, options);
-  if (!solved) return tl::unexpected(CalibrationFailure{code::kFailed, solved.error().message});
-  for (std::size_t p = 0; p < plans.size(); ++p) {
-    calib::PlaneHomographyResult planar;
-    planar.projector_to_plane = solved->projector_to_plane[p];
-    const auto& stats = solved->projectors[p];
-    planar.rms_camera_px = stats.rms_px;
-    planar.coverage = stats.coverage;
-    planar.samples = stats.samples;
-    planar.inliers = stats.nodes;
-    planar.rms_projector_px = stats.rms_projector_px;
-    outcomes[p].planar = std::move(planar);
-  }
-  return std::move(*solved);
-}
-
-nlohmann::json wallViewsJson(const calib::WallViewsResult& result,
-                             std::span<const CalibrationPlan* const> plans) {
-  nlohmann::json cameras = nlohmann::json::array();
-  for (const auto& c : plans.front()->cameras) cameras.push_back(c.device.name);
-  nlohmann::json links = nlohmann::json::array();
-  for (std::size_t p = 0; p < result.projectors.size() && p < plans.size(); ++p) {
-    links.push_back(
-        {{"output", plans[p]->output.name},
-         {"cameras", result.projectors[p].cameras},
-         {"nodes", result.projectors[p].nodes},
-         {"rms_camera_px", result.projectors[p].rms_px},
-         {"coverage", result.projectors[p].coverage},
-         {"chain_cameras", p < result.tree.chain_views.size() ? result.tree.chain_views[p] : 0}});
-  }
-  return {{"reference_camera", plans.front()->cameras.front().device.name},
-          {"cameras", cameras},
-          {"links", result.tree.links},
-          {"nodes", result.tree.matches},
-          {"rms_camera_px", result.tree.rms_px},
-          {"chain_rms_camera_px", result.tree.chain_rms_px},
-          {"iterations", result.tree.iterations},
-          {"converged", result.tree.converged},
-          {"projectors", links}};
 }
 
 }  // namespace procam::daemon

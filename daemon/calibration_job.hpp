@@ -19,7 +19,6 @@
 #include "calibration/board_plane.hpp"
 #include "calibration/plane_homography_route.hpp"
 #include "calibration/stereo_route.hpp"
-#include "calibration/wall_views_route.hpp"
 #include "config.hpp"
 #include "driver.hpp"
 #include "geometry/camera_model.hpp"
@@ -148,14 +147,6 @@ struct CalibrationOutcome {
   int settle_frames = 0;     // waited after every pattern
   nlohmann::json latency;    // the measured latency (auto_settle; latencyJson), else null
 };
-
-// Route (b′) from cameras at several positions: the projectors of a run, scanned (their
-// outcomes' wall_nodes), solved together through the homography tree; each outcome gets
-// its `planar` result. The reply part of the tree: `wall` (wallViewsJson).
-tl::expected<calib::WallViewsResult, CalibrationFailure> solveWallViewsRun(
-    std::span<const CalibrationPlan* const> plans, std::span<CalibrationOutcome> outcomes);
-nlohmann::json wallViewsJson(const calib::WallViewsResult& result,
-                             std::span<const CalibrationPlan* const> plans);
 
 // Shared with the latency probe (latency_probe.hpp).
 CalibrationFailure deviceFailure(const char* family, const std::string& name, int rc,

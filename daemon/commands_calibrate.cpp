@@ -10,6 +10,7 @@
 #include "log.hpp"
 #include "rig_store.hpp"
 #include "surface/surface_model.hpp"
+#include "wall_views_run.hpp"
 
 namespace procam::daemon {
 
@@ -21,11 +22,13 @@ namespace {
 using Failure = CalibrationFailure;
 
 // A camera's K, distortion and pose: the camera of that name in the rig model, as
-// procam-calibrate camera/stereo, `procamd --rig` or an earlier calibrate put it.
-tl::expected<geom::CameraModel, Failure> cameraModel(const DeviceEntry& e,
-                                                     const rig::RigModel& rig) {
+// procam-calibrate camera/stereo, `procamd --rig` or an earlier calibrate put it. Without
+// `pose_needed` (a camera of route (b′) at several positions other than the reference,
+// registered through the projectors it shares) K and distortion are enough.
+tl::expected<geom::CameraModel, Failure> cameraModel(const DeviceEntry& e, const rig::RigModel& rig,
+                                                     bool pose_needed = true) {
   if (const rig::RigCamera* c = rig.camera(e.name)) {
-    if (c->pose_known) return c->model;
+    if (c->pose_known || !pose_needed) return c->model;
     return tl::unexpected(
         Failure{code::kUnavailable,
                 "camera '" + e.name +
@@ -38,18 +41,6 @@ tl::expected<geom::CameraModel, Failure> cameraModel(const DeviceEntry& e,
                               "' is not calibrated: the rig model has no camera of that name "
                               "(calibrate the cameras with procam-calibrate stereo and install "
                               "the result with procamd --rig)"});
-}
-
-// A camera of route (b′) from several positions other than the reference: its K and
-// distortion are enough (it is registered through the projectors it shares).
-tl::expected<geom::CameraModel, Failure> cameraIntrinsics(const DeviceEntry& e,
-                                                          const rig::RigModel& rig) {
-  if (const rig::RigCamera* c = rig.camera(e.name)) return c->model;
-  return tl::unexpected(Failure{
-      code::kUnavailable, "camera '" + e.name +
-                              "' is not calibrated: the rig model has no camera of that name "
-                              "(calibrate it with procam-calibrate camera or calibrate-camera "
-                              "and install the result with procamd --rig)"});
 }
 
 // The devices and camera models of a run; everything but the capture itself.
@@ -151,7 +142,7 @@ tl::expected<CalibrationPlan, Failure> makePlan(DeviceSet& devices, const Calibr
   plan.latency = latency;
   plan.output = {out->name, out->device.share()};
   for (const DeviceEntry* c : cams) {
-    auto model = c == cams.front() ? cameraModel(*c, rig) : cameraIntrinsics(*c, rig);
+    auto model = cameraModel(*c, rig, !several || c == cams.front());
     if (!model) return tl::unexpected(model.error());
     plan.cameras.push_back({{c->name, c->device.share()}, *model});
   }
@@ -507,19 +498,6 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
             scan = std::move(*planned);
           } else {
             result = tl::unexpected(planned.error());
-          }
-          // Cameras at several positions: a projector no camera sees ends the run now,
-          // not after every other projector's scan.
-          for (std::size_t i = 0; result && plans.front()->wallViews() && i < plans.size(); ++i) {
-            bool lit = false;
-            for (const cv::Mat& m : scan.footprints[i])
-              lit = lit || (!m.empty() && cv::countNonZero(m) > 0);
-            if (!lit) {
-              result = tl::unexpected(Failure{
-                  code::kFailed, "output '" + plans[i]->output.name +
-                                     "': none of the cameras sees its light (the coarse pass "
-                                     "showed it white alone)"});
-            }
           }
         } else {
           for (std::size_t i = 0; i < plans.size(); ++i) scan.batches.push_back({i});

@@ -90,36 +90,4 @@ Result<WallViewsResult> solveWallViews(std::span<const std::pair<int, int>> proj
   return out;
 }
 
-Result<WallViewsResult> solveWallViewsRoute(std::span<const sl::PatternSet> sets,
-                                            std::size_t cameras,
-                                            std::span<const WallSighting> sightings,
-                                            const geom::Plane& plane,
-                                            const WallViewsOptions& options) {
-  std::vector<WallNodes> nodes;
-  std::vector<WallViewsResult::Link> links;
-  const WallSighting* reference = nullptr;
-  for (const WallSighting& s : sightings) {
-    if (s.projector >= sets.size() || s.camera >= cameras)
-      return fail(ErrorCode::kInvalidInput, "a sighting's projector or camera is out of range");
-    WallViewsResult::Link link{s.projector, s.camera, 0, 0};
-    auto found = collineationNodes(sets[s.projector], s.view, options.nodes);
-    if (!found && found.error().code == ErrorCode::kInvalidInput)
-      return tl::unexpected(found.error());
-    if (found) {
-      link.samples = found->samples;
-      link.inliers = found->projector.size();
-      nodes.push_back({s.projector, s.camera, std::move(*found)});
-    }
-    if (s.camera == options.reference_camera) reference = &s;
-    links.push_back(link);
-  }
-  if (!reference) return fail(ErrorCode::kInvalidInput, "the reference camera saw no projector");
-  std::vector<std::pair<int, int>> sizes;
-  for (const auto& set : sets) sizes.emplace_back(set.options.width, set.options.height);
-  auto out = solveWallViews(sizes, cameras, nodes, reference->view.camera, reference->view.name,
-                            plane, options);
-  if (out) out->links = std::move(links);
-  return out;
-}
-
 }  // namespace procam::calib

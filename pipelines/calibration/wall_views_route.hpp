@@ -12,23 +12,15 @@
 #include <vector>
 
 #include "calibration/plane_homography_route.hpp"
-#include "calibration/stereo_route.hpp"
 #include "core/error.hpp"
 #include "geometry/homography_tree.hpp"
 #include "geometry/plane_fit.hpp"
 #include "geometry/plane_homography.hpp"
-#include "structured_light/pattern_set.hpp"
 
 namespace procam::calib {
 
-// What camera `camera` decoded of projector `projector`'s scan.
-struct WallSighting {
-  std::size_t projector = 0, camera = 0;
-  DecodedView view;
-};
-
-// The nodes of one sighting (collineationNodes): what the solve itself needs, so a
-// caller that scans projector by projector keeps these and not the decoded maps.
+// What camera `camera` saw of projector `projector`'s scan (collineationNodes): a caller
+// that scans projector by projector keeps these, not the decoded maps.
 struct WallNodes {
   std::size_t projector = 0, camera = 0;
   CollineationNodes nodes;
@@ -53,11 +45,6 @@ struct WallViewsResult {
     std::size_t cameras = 0;      // cameras that saw it (with at least min_points nodes)
   };
   std::vector<Projector> projectors;
-  struct Link {
-    std::size_t projector = 0, camera = 0;
-    std::size_t samples = 0, inliers = 0;  // 0 inliers: too few nodes, left out
-  };
-  std::vector<Link> links;  // one per sighting, in order
   geom::HomographyTree tree;
 };
 
@@ -72,15 +59,5 @@ Result<WallViewsResult> solveWallViews(std::span<const std::pair<int, int>> proj
                                        const geom::CameraModel& reference,
                                        const std::string& reference_name, const geom::Plane& plane,
                                        const WallViewsOptions& options = {});
-
-// From decoded maps: `sets[p]`: projector p's pattern set. A sighting with too few
-// nodes is left out (the camera barely saw that projector); kInvalidInput as above and
-// for a decoded map whose size is not its camera's, or no sighting by the reference
-// camera.
-Result<WallViewsResult> solveWallViewsRoute(std::span<const sl::PatternSet> sets,
-                                            std::size_t cameras,
-                                            std::span<const WallSighting> sightings,
-                                            const geom::Plane& plane,
-                                            const WallViewsOptions& options = {});
 
 }  // namespace procam::calib

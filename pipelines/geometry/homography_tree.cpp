@@ -277,11 +277,8 @@ Result<HomographyTree> solveHomographyTree(std::span<const ViewProjectorMatches>
     }
     out.chain_views.push_back(depth[views + p]);
   }
-  for (const Link& l : links) {
-    // A link between parts the tree did not reach cannot exist: both ends are reached.
-    ++out.links;
-    out.matches += l.projector_px.size();
-  }
+  out.links = links.size();
+  for (const Link& l : links) out.matches += l.projector_px.size();
   residuals(links, P, G, out.chain_rms_px, out.chain_max_px);
   out.rms_px = out.chain_rms_px;
   out.max_px = out.chain_max_px;

@@ -65,8 +65,8 @@ TEST(WallViewsRoute, TwoCamerasThatEachSeeHalfCalibrateTheWholeWall) {
   ASSERT_EQ(state.projectors.size(), 4u);
   ASSERT_EQ(state.cameras.size(), 2u);
 
-  std::vector<sl::PatternSet> sets;
-  std::vector<calib::WallSighting> sightings;
+  std::vector<std::pair<int, int>> sizes;
+  std::vector<calib::WallNodes> nodes;
   for (std::size_t p = 0; p < state.projectors.size(); ++p) {
     const auto& proj = state.projectors[p];
     sl::PatternOptions o;
@@ -94,39 +94,42 @@ TEST(WallViewsRoute, TwoCamerasThatEachSeeHalfCalibrateTheWholeWall) {
       // Only the reference camera is calibrated: the other keeps its intrinsics (for its
       // lens) and no pose.
       if (c != 0) model.pose = geom::Pose{};
-      sightings.push_back({p, c, {state.cameras[c].spec.name, model, std::move(*d)}});
+      const calib::DecodedView view{state.cameras[c].spec.name, model, std::move(*d)};
+      auto seen = calib::collineationNodes(*set, view);
+      const std::string what =
+          seen ? std::to_string(seen->projector.size()) + " nodes" : seen.error().message;
+      std::printf("[ figures  ] %s sees %s: %s\n", state.cameras[c].spec.name.c_str(),
+                  proj.spec.name.c_str(), what.c_str());
+      if (seen) nodes.push_back({p, c, std::move(*seen)});
     }
-    sets.push_back(std::move(*set));
+    sizes.emplace_back(set->options.width, set->options.height);
   }
   const geom::Plane wall{Vec3(0, -1, 0), 3.0};  // y = 3, what an installer measures
-  auto r = calib::solveWallViewsRoute(sets, state.cameras.size(), sightings, wall);
-  ASSERT_TRUE(r) << r.error().message;
-  for (const auto& l : r->links) {
-    std::printf("[ figures  ] %s sees %s: %zu nodes, %zu inliers\n",
-                state.cameras[l.camera].spec.name.c_str(),
-                state.projectors[l.projector].spec.name.c_str(), l.samples, l.inliers);
-  }
+  auto solved = calib::solveWallViews(sizes, state.cameras.size(), nodes, state.cameras[0].model,
+                                      state.cameras[0].spec.name, wall);
+  ASSERT_TRUE(solved) << solved.error().message;
+  const calib::WallViewsResult& r = *solved;
   // Corners of each projector's image through the estimate onto the wall, seen by the
   // true projector: the keystone bound (0.5 px) holds for every projector, also those
   // the calibrated camera sees only a fifth of.
   double worst_corner = 0;
   for (std::size_t p = 0; p < state.projectors.size(); ++p) {
     worst_corner = std::max(worst_corner, procam::testing::planeCornerErrorPx(
-                                              r->projector_to_plane[p], state.projectors[p].model));
+                                              r.projector_to_plane[p], state.projectors[p].model));
   }
   // Seams: plane points (every 2 mm) two projectors show by the estimate; where the
   // true projectors put the two pixels, apart, in the first one's pixels.
   Seams s;
   double sq = 0;
-  const geom::PlaneBasis& basis = r->projector_to_plane[0].basis;
+  const geom::PlaneBasis& basis = r.projector_to_plane[0].basis;
   std::vector<Mat3> to_pixel;
-  for (const auto& e : r->projector_to_plane) to_pixel.push_back(e.H.inverse());
+  for (const auto& e : r.projector_to_plane) to_pixel.push_back(e.H.inverse());
   for (double b = -2.0; b < 2.0; b += 0.002) {
     for (double a = -2.5; a < 2.5; a += 0.002) {
       const Vec3 world = basis.toWorld(Vec2(a, b));
       std::vector<std::pair<std::size_t, Vec3>> shown;  // projector, true wall point
       for (std::size_t p = 0; p < to_pixel.size(); ++p) {
-        const Vec3 q = to_pixel[p] * r->projector_to_plane[p].basis.toPlane(world).homogeneous();
+        const Vec3 q = to_pixel[p] * r.projector_to_plane[p].basis.toPlane(world).homogeneous();
         if (!(q.z() > 0)) continue;
         const Vec2 px = q.hnormalized();
         const auto& truth = state.projectors[p].model;
@@ -150,13 +153,13 @@ TEST(WallViewsRoute, TwoCamerasThatEachSeeHalfCalibrateTheWholeWall) {
   }
   s.rms = s.points ? std::sqrt(sq / double(s.points)) : 0;
   int deepest = 0;
-  for (int d : r->tree.chain_views) deepest = std::max(deepest, d);
+  for (int d : r.tree.chain_views) deepest = std::max(deepest, d);
   std::printf(
       "[ figures  ] 4 projectors from 2 cameras (chains up to %d): corners within %.3f px of "
       "the truth, seams over %ld points RMS %.3f px max %.3f px; residual %.3f px RMS (chain "
       "%.3f), %d iterations\n",
-      deepest, worst_corner, s.points, s.rms, s.max, r->tree.rms_px, r->tree.chain_rms_px,
-      r->tree.iterations);
+      deepest, worst_corner, s.points, s.rms, s.max, r.tree.rms_px, r.tree.chain_rms_px,
+      r.tree.iterations);
   EXPECT_LE(worst_corner, 0.5);
   EXPECT_GT(s.points, 10000);
   EXPECT_LE(s.rms, 0.3);
