@@ -116,10 +116,11 @@ tl::expected<bool, CalibrationFailure> showAndSettle(const CalibrationPlan& plan
 }
 
 // The camera's mean at each ramp level over the pixels that decoded this projector
-// (flags 0), eroded by 3 pixels so that its blurred edge does not count.
+// (flags 0), eroded by 3 pixels so that its blurred edge does not count; and, from the
+// same pixels' white minus black, the projector's brightness across its frame.
 Result<blend::ProjectorResponse> rampResponse(const std::vector<cv::Mat>& ramp,
-                                              const cv::Mat& flags) {
-  cv::Mat mask = flags == 0;
+                                              const sl::Decoded& decoded, cv::Size framebuffer) {
+  cv::Mat mask = decoded.flags == 0;
   cv::erode(mask, mask, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(7, 7)));
   if (cv::countNonZero(mask) < 100) {
     return fail(ErrorCode::kTooFewPoints, "fewer than 100 camera pixels see the projector");
@@ -131,7 +132,13 @@ Result<blend::ProjectorResponse> rampResponse(const std::vector<cv::Mat>& ramp,
     }
     samples.push_back({CalibrationPlan::kRampLevels[i], cv::mean(ramp[i], mask)[0]});
   }
-  return blend::fitResponse(samples);
+  auto response = blend::fitResponse(samples);
+  if (!response) return response;
+  auto brightness =
+      blend::measureBrightness(ramp.back(), ramp.front(), decoded.u, decoded.v, mask, framebuffer);
+  if (!brightness) return tl::unexpected(brightness.error());
+  response->brightness = std::move(*brightness);
+  return response;
 }
 
 }  // namespace
@@ -314,7 +321,8 @@ tl::expected<std::vector<CalibrationOutcome>, CalibrationFailure> runBatchCalibr
       }
       out.decoded.push_back(d.decoded);
       if (c == 0 && !ramp.empty()) {
-        auto response = rampResponse(ramp, d.flags);
+        auto response =
+            rampResponse(ramp, d, cv::Size(member.set.options.width, member.set.options.height));
         // Responses are compared within one camera's exposure: with several cameras
         // only the reference camera measures them, and a projector it sees too little
         // of is left unmeasured (the reply has no response for it).

@@ -275,9 +275,11 @@ Learnt learntByPlaneRoute(const CalibrationPlan& plan, const CalibrationOutcome&
 
 // rig.json's photometric record of a projector: its response as the camera saw it.
 json responseJson(const blend::ProjectorResponse& r, const CalibrationCamera& camera) {
-  return {{"response_gamma", r.gamma}, {"black", r.black},   {"white", r.white},
-          {"fit_rms", r.rms},          {"levels", r.levels}, {"camera", camera.device.name},
-          {"measured", utcNow()}};
+  json out = {{"response_gamma", r.gamma}, {"black", r.black},   {"white", r.white},
+              {"fit_rms", r.rms},          {"levels", r.levels}, {"camera", camera.device.name},
+              {"measured", utcNow()}};
+  if (r.brightness) out["brightness"] = blend::brightnessToJson(*r.brightness);
+  return out;
 }
 
 }  // namespace
@@ -585,6 +587,15 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
               const json photometric = responseJson(*outcome.response, plans[i]->cameras[0]);
               for (auto& p : learnt.update.projectors) p.photometric = photometric;
               learnt.reply["response"] = photometric;
+              // The reply names the brightness map's extent, not its nodes.
+              if (const auto& map = outcome.response->brightness) {
+                double lo = 0, hi = 0;
+                cv::minMaxLoc(map->white, &lo, &hi);
+                learnt.reply["response"]["brightness"] = {
+                    {"nodes", {map->white.cols, map->white.rows}},
+                    {"step_px", map->step},
+                    {"min_over_max", hi > 0 ? lo / hi : 0.0}};
+              }
             } else if (!outcome.response_note.empty()) {
               learnt.reply["response"] = {{"measured", false}, {"why", outcome.response_note}};
             }

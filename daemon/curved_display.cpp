@@ -60,7 +60,7 @@ const KeystoneRuntime::Curved* Daemon::curvedDisplay(cv::Size content, const Vie
     auto surface = rigSurfaceFor(p->name);
     if (!surface) continue;
     inputs.push_back({e.name, p->model().projectionMatrix(), *mode, surface, &surface->intersector,
-                      blend::responseFromPhotometric(p->photometric)});
+                      blend::projectorResponse(*p)});
   }
   if (inputs.size() < 2 || content.width < 1 || content.height < 1) {
     k.curved.reset();
@@ -159,7 +159,8 @@ json Daemon::curvedDisplayJson() const {
           {"tiles", tiles},
           {"blend",
            {{"weights", "feathered"},
-            {"response", k.curved->measured ? "measured" : "assumed gamma 2.2"}}}};
+            {"response", k.curved->measured ? "measured" : "assumed gamma 2.2"},
+            {"photometric", blend::matchingJson(*k.curved)}}}};
 }
 
 }  // namespace procam::daemon

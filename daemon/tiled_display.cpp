@@ -34,7 +34,7 @@ std::vector<Daemon::RigTile> Daemon::rigTiles() const {
     const rig::RigProjector* p = rig_.projectorForOutput(e.name);
     if (!p) continue;
     if (auto tile = blend::displayTile(*p, rig_.surface)) {
-      tiles.push_back({e.name, *tile, blend::responseFromPhotometric(p->photometric)});
+      tiles.push_back({e.name, *tile, blend::projectorResponse(*p)});
     }
   }
   return tiles;
@@ -182,7 +182,8 @@ json Daemon::tiledDisplayJson() const {
           {"tiles", tiles},
           {"blend",
            {{"weights", "feathered"},
-            {"response", k.tiled->measured ? "measured" : "assumed gamma 2.2"}}}};
+            {"response", k.tiled->measured ? "measured" : "assumed gamma 2.2"},
+            {"photometric", blend::matchingJson(*k.tiled)}}}};
 }
 
 }  // namespace procam::daemon

@@ -71,7 +71,7 @@ Result<json> renderCurved(const CurvedRenderInput& in) {
   for (std::size_t t = 0; t < chosen.size(); ++t) {
     projectors.push_back({&surfaces[t], chosen[t]->model().projectionMatrix(),
                           cv::Size(chosen[t]->width, chosen[t]->height)});
-    responses.push_back(blend::responseFromPhotometric(chosen[t]->photometric));
+    responses.push_back(blend::projectorResponse(*chosen[t]));
   }
   auto made = blend::makeCurvedBlend(projectors, responses, *eye, in.content.size());
   if (!made) return tl::unexpected(made.error());
@@ -117,7 +117,9 @@ Result<json> renderCurved(const CurvedRenderInput& in) {
                {{"weights", in.geometry_only ? "none" : "feathered"},
                 {"response", in.geometry_only ? "none"
                              : made->measured ? "measured"
-                                              : "assumed gamma 2.2"}}},
+                                              : "assumed gamma 2.2"},
+                {"photometric",
+                 in.geometry_only ? json{{"matching", "none"}} : blend::matchingJson(*made)}}},
               {"projectors", shares}};
   if (!skipped.empty()) doc["skipped"] = skipped;
   return doc;

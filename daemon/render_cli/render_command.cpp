@@ -217,7 +217,7 @@ Result<json> runRender(const RenderArgs& args) {
     }
     chosen.push_back(&p);
     tiles.push_back(*tile);
-    responses.push_back(blend::responseFromPhotometric(p.photometric));
+    responses.push_back(blend::projectorResponse(p));
   }
   if (tiles.empty()) {
     std::string why;
@@ -287,7 +287,9 @@ Result<json> runRender(const RenderArgs& args) {
        {{"weights", args.geometry_only ? "none" : "feathered"},
         {"response", args.geometry_only ? "none"
                      : made->measured   ? "measured"
-                                        : "assumed gamma 2.2"}}},
+                                        : "assumed gamma 2.2"},
+        {"photometric",
+         args.geometry_only ? json{{"matching", "none"}} : blend::matchingJson(*made)}}},
       {"projectors", projectors}};
   if (!skipped.empty()) doc["skipped"] = skipped;
   if (!args.mpcdi.empty()) {

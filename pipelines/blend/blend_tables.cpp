@@ -7,9 +7,12 @@
 namespace procam::blend {
 
 Result<BlendTables> blendTables(std::vector<cv::Mat> weights,
-                                std::span<const std::optional<ProjectorResponse>> responses) {
+                                std::span<const std::optional<ProjectorResponse>> responses,
+                                std::span<const ContentOf> to_content, cv::Size content) {
   if (!responses.empty() && responses.size() != weights.size())
     return fail(ErrorCode::kInvalidInput, "one response per projector, or none");
+  if (!to_content.empty() && to_content.size() != weights.size())
+    return fail(ErrorCode::kInvalidInput, "one content map per projector, or none");
   for (const cv::Mat& w : weights) {
     if (w.type() != CV_32FC1 || w.empty())
       return fail(ErrorCode::kInvalidInput, "blend weights must be non-empty CV_32FC1 images");
@@ -21,8 +24,21 @@ Result<BlendTables> blendTables(std::vector<cv::Mat> weights,
   if (out.measured) {
     for (const auto& r : responses) measured.push_back(*r);
   }
-  const std::vector<double> gains =
-      out.measured ? matchedGains(measured) : std::vector<double>(weights.size(), 1.0);
+  const bool per_pixel =
+      out.measured && !to_content.empty() &&
+      std::all_of(measured.begin(), measured.end(), [](const auto& r) { return r.brightness; });
+  if (per_pixel) {
+    std::vector<MatchProjector> match;
+    for (std::size_t t = 0; t < weights.size(); ++t)
+      match.push_back({&weights[t], &*measured[t].brightness, to_content[t]});
+    auto matched = matchLuminance(match, content);
+    if (!matched) return tl::unexpected(matched.error());
+    weights = std::move(matched->weights);
+    out.matched = matched->figures;
+  }
+  const std::vector<double> gains = out.measured && !per_pixel
+                                        ? matchedGains(measured)
+                                        : std::vector<double>(weights.size(), 1.0);
   for (std::size_t t = 0; t < weights.size(); ++t) {
     const double gamma = out.measured ? measured[t].gamma : kAssumedGamma;
     auto lut = weightLut(gamma, gains[t]);
@@ -34,6 +50,18 @@ Result<BlendTables> blendTables(std::vector<cv::Mat> weights,
   }
   out.weights = std::move(weights);
   return out;
+}
+
+nlohmann::json matchingJson(const BlendTables& tables) {
+  if (!tables.measured) return {{"matching", "none"}};
+  if (!tables.matched) return {{"matching", "per-projector gain"}};
+  const LuminanceFigures& f = *tables.matched;
+  const auto ratio = [](double lo, double hi) { return hi > 0 ? lo / hi : 0.0; };
+  return {{"matching", "per-pixel"},
+          {"uniformity_before", ratio(f.before_min, f.before_max)},
+          {"uniformity_after", ratio(f.after_min, f.after_max)},
+          {"light_kept", f.kept},
+          {"largest_step_per_px", f.largest_step}};
 }
 
 }  // namespace procam::blend

@@ -3,10 +3,12 @@
 // as an 8-bit alpha mask and the table that turns a weight into a code value through the
 // projector's response and its brightness gain (response.hpp). Shared by the planar
 // tiled display and the curved one.
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <span>
 #include <vector>
 
+#include "blend/luminance_match.hpp"
 #include "blend/response.hpp"
 #include "core/error.hpp"
 #include "render/final_stage.hpp"
@@ -23,13 +25,26 @@ struct BlendTables {
   std::vector<render::Lut> weight_lut;  // per projector: weight code -> code
   std::vector<double> gamma, gain;      // per projector, what the tables were made with
   bool measured = false;                // every projector's response was measured
+  // Matched per pixel ([Majumder05], luminance_match.hpp): the weights carry each
+  // point's attenuation to the display's smooth target and every gain is 1.
+  std::optional<LuminanceFigures> matched;
 };
 
 // `responses` has one entry per weight image (or none): when every projector's response
-// is known the projectors are matched to the dimmest one's white in linear light;
-// otherwise every one gets the assumed gamma and no gain. kInvalidInput for a responses
-// count other than 0 or one per weight image, or weights that are not CV_32FC1.
+// and its brightness across the frame are known and `to_content` gives each projector's
+// content map, the projectors are matched per pixel (luminance_match.hpp) into `content`;
+// when every response is known, to the dimmest one's white in linear light; otherwise
+// every one gets the assumed gamma and no gain. kInvalidInput for a responses or
+// to_content count other than 0 or one per weight image, or weights that are not
+// CV_32FC1; errors of matchLuminance.
 Result<BlendTables> blendTables(std::vector<cv::Mat> weights,
-                                std::span<const std::optional<ProjectorResponse>> responses);
+                                std::span<const std::optional<ProjectorResponse>> responses,
+                                std::span<const ContentOf> to_content = {}, cv::Size content = {});
+
+// How the tables match the projectors, for status and display.json: {"matching":
+// "per-pixel", "uniformity_before", "uniformity_after" (min / max of the display's
+// white), "light_kept", "largest_step_per_px"}, {"matching": "per-projector gain"} or
+// {"matching": "none"} (responses assumed).
+nlohmann::json matchingJson(const BlendTables& tables);
 
 }  // namespace procam::blend

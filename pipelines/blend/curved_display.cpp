@@ -142,7 +142,11 @@ Result<CurvedBlend> makeCurvedBlend(std::span<const SurfaceProjector> projectors
   if (!display) return tl::unexpected(display.error());
   auto weights = curvedFeatherWeights(projectors, options.feather, display->lookup);
   if (!weights) return tl::unexpected(weights.error());
-  auto tables = blendTables(std::move(*weights), responses);
+  std::vector<ContentOf> to_content;
+  for (const render::WarpGrid& grid : display->lookup) {
+    to_content.push_back([&grid](const Vec2& pixel) { return render::gridSource(grid, pixel); });
+  }
+  auto tables = blendTables(std::move(*weights), responses, to_content, content);
   if (!tables) return tl::unexpected(tables.error());
   CurvedBlend out;
   static_cast<BlendTables&>(out) = std::move(*tables);

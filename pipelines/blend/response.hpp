@@ -8,9 +8,11 @@
 // log(g / 255) over the levels well above black. Brightness matching scales every
 // projector to the dimmest one's white, in linear light, so that no projector's region
 // is brighter than its neighbours' (a global form of Majumder's per-pixel attenuation).
+#include <optional>
 #include <span>
 #include <vector>
 
+#include "blend/brightness_map.hpp"
 #include "core/error.hpp"
 #include "render/final_stage.hpp"
 
@@ -26,6 +28,9 @@ struct ProjectorResponse {
   double black = 0, white = 0;  // camera units at levels 0 and 255
   double rms = 0;               // of the fit, relative to white - black
   int levels = 0;               // used by the fit
+  // Its white across the frame, in the same camera's units (per-pixel matching,
+  // luminance_match.hpp), when measured.
+  std::optional<BrightnessMap> brightness;
 };
 
 // kTooFewPoints without levels 0 and 255 and three levels between them whose

@@ -28,7 +28,8 @@ Result<DisplayTile> displayTile(const rig::RigProjector& p, const rig::RigSurfac
   return DisplayTile{geom::PlaneHomography{*basis, lu.inverse()}, p.width, p.height};
 }
 
-std::optional<ProjectorResponse> responseFromPhotometric(const nlohmann::json& ph) {
+std::optional<ProjectorResponse> projectorResponse(const rig::RigProjector& projector) {
+  const nlohmann::json& ph = projector.photometric;
   if (!ph.is_object()) return std::nullopt;
   const auto number = [&](const char* key) {
     const auto it = ph.find(key);
@@ -40,6 +41,11 @@ std::optional<ProjectorResponse> responseFromPhotometric(const nlohmann::json& p
   r.white = number("white");
   if (!(r.gamma >= 1 && r.gamma <= 4) || !std::isfinite(r.black) || !(r.white > r.black)) {
     return std::nullopt;
+  }
+  if (const auto it = ph.find("brightness"); it != ph.end()) {
+    auto map = brightnessFromJson(*it);
+    if (map && map->width == projector.width && map->height == projector.height)
+      r.brightness = std::move(*map);
   }
   return r;
 }

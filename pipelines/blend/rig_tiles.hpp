@@ -19,8 +19,9 @@ namespace procam::blend {
 // plane_homography, and no pose or no planar surface); errors of planeToImage.
 Result<DisplayTile> displayTile(const rig::RigProjector& projector, const rig::RigSurface& surface);
 
-// The response rig.json's `photometric` record describes (response_gamma in [1, 4],
-// white above black), or nullopt.
-std::optional<ProjectorResponse> responseFromPhotometric(const nlohmann::json& photometric);
+// The response the projector's rig.json `photometric` record describes (response_gamma
+// in [1, 4], white above black), or nullopt; with its brightness across the frame when
+// the record holds a valid one of the projector's framebuffer size (brightness_map.hpp).
+std::optional<ProjectorResponse> projectorResponse(const rig::RigProjector& projector);
 
 }  // namespace procam::blend

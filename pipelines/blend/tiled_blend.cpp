@@ -1,5 +1,7 @@
 #include "blend/tiled_blend.hpp"
 
+#include <Eigen/LU>
+
 #include "blend/feather.hpp"
 
 namespace procam::blend {
@@ -18,7 +20,16 @@ Result<TiledBlend> makeTiledBlend(std::span<const DisplayTile> tiles,
   }
   auto weights = featherWeights(feather);
   if (!weights) return tl::unexpected(weights.error());
-  auto tables = blendTables(std::move(*weights), responses);
+  std::vector<ContentOf> to_content;
+  for (const Mat3& h : display->content_to_framebuffer) {
+    const Mat3 inverse = h.inverse();
+    to_content.push_back([inverse](const Vec2& pixel) -> std::optional<Vec2> {
+      const Vec3 q = inverse * pixel.homogeneous();
+      if (!(std::abs(q.z()) > 1e-12)) return std::nullopt;
+      return Vec2(q.x() / q.z(), q.y() / q.z());
+    });
+  }
+  auto tables = blendTables(std::move(*weights), responses, to_content, content);
   if (!tables) return tl::unexpected(tables.error());
   TiledBlend out;
   static_cast<BlendTables&>(out) = std::move(*tables);

@@ -1,5 +1,6 @@
 // procam-render on a curved rig: cylinder3's three projectors from the scene's true rig
-// model (each with its true response as its photometric record) and the true wall as
+// model (each with its true response and brightness across its frame as its photometric
+// record) and the true wall as
 // the surface mesh beside rig.json, drawn for the scene's viewer at the sweet spot:
 //  - geometry: a 16-bit content ramp drawn geometry-only, every framebuffer pixel's code
 //    read back as a content coordinate and compared with where the viewer's pinhole
@@ -24,6 +25,7 @@
 #include "sim/renderer.hpp"
 #include "sim/scene_library.hpp"
 #include "sim/truth_rig.hpp"
+#include "true_brightness.hpp"
 
 namespace procam::itest {
 namespace {
@@ -70,11 +72,13 @@ Rig trueCylinder(const TempDir& dir) {
   auto rig = sim::truthRig(r.scene, 0.0);
   EXPECT_TRUE(rig);
   for (auto& p : rig->projectors) {
-    for (const auto& s : r.state.projectors) {
+    for (std::size_t i = 0; i < r.state.projectors.size(); ++i) {
+      const auto& s = r.state.projectors[i];
       if (s.spec.name != p.name) continue;
       p.photometric = {{"response_gamma", s.spec.gamma},
                        {"black", 0.0},
                        {"white", s.spec.brightness},
+                       {"brightness", blend::brightnessToJson(trueBrightness(r.scene, r.state, i))},
                        {"camera", "truth"}};
     }
   }
@@ -150,6 +154,8 @@ TEST(RenderCliCurved, BlendedFramesLightTheCurvedWallEvenlyForTheViewer) {
                                     dir.file("frames"), "--viewer", rig.eye}));
   ASSERT_TRUE(doc) << doc.error().message;
   EXPECT_EQ((*doc)["blend"]["response"], "measured");
+  const json& matching = (*doc)["blend"]["photometric"];
+  EXPECT_EQ(matching["matching"], "per-pixel") << matching.dump();
   const Mat34 V = rowMajor34((*doc)["display"]["viewer_matrix"]);
   sim::Framebuffers shown;
   for (const auto& p : rig.state.projectors) {
@@ -167,7 +173,7 @@ TEST(RenderCliCurved, BlendedFramesLightTheCurvedWallEvenlyForTheViewer) {
     const Vec2 q = (V * hit->hit.point.homogeneous()).hnormalized();
     return q.x() > 0.03 * kW && q.x() < 0.97 * kW && q.y() > 0.03 * kH && q.y() < 0.97 * kH;
   };
-  double step = 0;
+  double step = 0, lo = 1e9, hi = 0;
   long pixels = 0;
   for (int y = 0; y + 1 < view.rows; ++y) {
     for (int x = 0; x + 1 < view.cols; ++x) {
@@ -176,13 +182,15 @@ TEST(RenderCliCurved, BlendedFramesLightTheCurvedWallEvenlyForTheViewer) {
       ASSERT_GT(l, 0) << "an unlit point inside the display at viewer pixel " << x << "," << y;
       step = std::max({step, std::abs(view.at<cv::Vec3f>(y, x + 1)[0] - l) / l,
                        std::abs(view.at<cv::Vec3f>(y + 1, x)[0] - l) / l});
+      lo = std::min(lo, l);
+      hi = std::max(hi, l);
       ++pixels;
     }
   }
   std::printf(
       "[ figures  ] procam-render, curved: white seen by the viewer, %ld pixels, "
-      "largest step %.2f %%\n",
-      pixels, 100 * step);
+      "largest step %.2f %%, uniformity min/max %.3f (matching: %s)\n",
+      pixels, 100 * step, lo / hi, matching.dump().c_str());
   EXPECT_GT(pixels, 20000);
   EXPECT_LE(step, 0.02);
 }

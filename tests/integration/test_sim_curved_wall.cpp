@@ -109,7 +109,7 @@ void readCalibrated(const std::string& state_dir, Calibrated& out) {
     const rig::RigProjector* p = out.rig.projectorForOutput(kOutputs[t]);
     out.projectors.push_back(
         {&out.surfaces[t], p->model().projectionMatrix(), cv::Size(p->width, p->height)});
-    out.responses.push_back(blend::responseFromPhotometric(p->photometric));
+    out.responses.push_back(blend::projectorResponse(*p));
   }
 }
 
@@ -205,6 +205,10 @@ TEST(SimCurvedWall, ThreeProjectorsCalibratedIntoOneDisplayForTheSweetSpot) {
   EXPECT_EQ(display["outputs"], json({"proj_l", "proj_c", "proj_r"})) << display.dump();
   EXPECT_EQ(display["viewer"]["source"], "config");
   EXPECT_EQ(display["blend"]["response"], "measured");
+  // Matched per pixel from the brightness maps calibrate measured ([Majumder05]).
+  const json& matching = display["blend"]["photometric"];
+  EXPECT_EQ(matching["matching"], "per-pixel") << display.dump();
+  std::printf("[ figures  ] matching: %s\n", matching.dump().c_str());
   const Mat34 V = rowMajor34(display["viewer_matrix"]);
   for (const char* name : kOutputs) {
     EXPECT_EQ(rowMajor34(shown[name]["viewer_matrix"]), V) << name;
