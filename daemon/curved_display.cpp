@@ -5,8 +5,9 @@
 // rig model's) should see; every output shows its share through its own lookup warp,
 // feathered in the overlaps (eq. 4.3) in linear light through its measured response
 // (blend/curved_display.hpp). Made on the compute worker and kept until the content's
-// size, the outputs, the rig or the eye change; a tracked viewer is drawn by each output
-// alone (two-pass).
+// size, the outputs, the rig or the eye change. A tracked viewer sees the same display
+// (rectangle, weights, photometric match) from where they are: each output draws it by
+// the two-pass path for the tracked eye (rig_surfaces.cpp).
 #include <sstream>
 
 #include "blend/rig_tiles.hpp"

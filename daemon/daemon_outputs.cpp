@@ -304,8 +304,10 @@ json Daemon::outputsJson() const {
     if (!st.path.empty()) o["path"] = st.path;
     if (st.viewer) o["viewer_matrix"] = rowMajor(*st.viewer);
     if (st.homography) o["homography"] = rowMajor(*st.homography);
-    // Its share of a display across outputs: on a curved surface (lookup warp) or a wall.
-    const bool on_surface = st.path == render::toString(render::RenderPath::kLookupWarp);
+    // Its share of a display across outputs: on a curved surface (lookup warp for the
+    // sweet spot, two-pass for a tracked eye) or a wall.
+    const bool on_surface = st.path == render::toString(render::RenderPath::kLookupWarp) ||
+                            st.path == render::toString(render::RenderPath::kTwoPassMesh);
     if (st.tile >= 0 && on_surface && keystone_rt_.curved) {
       o["display"] = {{"tile", st.tile},
                       {"tiles", keystone_rt_.curved->outputs.size()},

@@ -110,10 +110,14 @@ Result<std::shared_ptr<const render::RenderSetup>> Daemon::nonPlanarSetup(
   auto& st = keystone_rt_.output_state[output];
   const std::optional<Mat34> fixed =
       fixed_viewer ? std::optional<Mat34>(*fixed_viewer) : std::nullopt;
-  // The static viewer of several projectors: this output's share of one display.
+  // Several projectors: this output's share of one display, made for the static viewer
+  // (the sweet spot). A tracked viewer sees the same display from where they are: the
+  // same content rectangle and blend, each output drawing it by the two-pass path for
+  // the tracked eye (the eq. 4.3 weights and the photometric match are properties of
+  // the surface, not of the eye).
   std::shared_ptr<const KeystoneRuntime::Curved> curved;
   int index = -1;
-  if (!tracked && !fixed) {
+  if (!fixed) {
     if (auto e = staticEye(); e && curvedDisplay(content, *e)) {
       index = keystone_rt_.curved->index(output);
       if (index >= 0) curved = keystone_rt_.curved;
@@ -141,9 +145,17 @@ Result<std::shared_ptr<const render::RenderSetup>> Daemon::nonPlanarSetup(
     render::RenderSetup setup;
     setup.output_size = mode;
     setup.content_size = content;
-    setup.path = render::RenderPath::kLookupWarp;
-    setup.lookup = curved->display.lookup[index];
-    setup.viewer = curved->display.viewer;
+    if (tracked) {
+      setup.path = render::RenderPath::kTwoPassMesh;
+      setup.surface = surface->mesh;
+      setup.projector = P;
+      setup.viewer =
+          render::contentViewMatrix(curved->display.rotation, *eye, curved->display.rect, content);
+    } else {
+      setup.path = render::RenderPath::kLookupWarp;
+      setup.lookup = curved->display.lookup[index];
+      setup.viewer = curved->display.viewer;
+    }
     // Eq. 4.3 weights in linear light, through the projector's response and its
     // brightness gain ([Raskar02] §4.1.2).
     setup.final_stage.alpha = curved->alpha[index];

@@ -82,6 +82,7 @@ Result<CurvedDisplay> solveCurvedDisplay(std::span<const SurfaceProjector> proje
   }
   CurvedDisplay out;
   out.eye = eye;
+  out.rotation = R;
   out.rect = largest->rect;
   out.cell = largest->cell;
   out.union_area = largest->region_area;

@@ -29,6 +29,9 @@ struct CurvedDisplayOptions {
 struct CurvedDisplay {
   Mat34 viewer = Mat34::Zero();  // world -> content pixels: a pinhole at the eye
   Vec3 eye = Vec3::Zero();
+  // The eye's turn (render::uprightEyeRotation, world -> eye): with `rect` it places the
+  // content for an eye elsewhere (a tracked viewer) as render::contentViewMatrix does.
+  Mat3 rotation = Mat3::Identity();
   keystone::AxisRect rect;               // the content on the eye's plane z = 1 (x right, y up)
   double cell = 0;                       // the rectangle's accuracy on that plane
   double union_area = 0;                 // of the images on that plane

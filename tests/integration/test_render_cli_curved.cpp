@@ -18,6 +18,8 @@
 #include <sstream>
 
 #include "content_ramp.hpp"
+#include "curved_display_checks.hpp"
+#include "cylinder_mesh.hpp"
 #include "daemon_harness.hpp"
 #include "mpcdi_readback.hpp"
 #include "render_command.hpp"
@@ -31,32 +33,6 @@ namespace procam::itest {
 namespace {
 
 constexpr int kW = 4800, kH = 900;  // a panorama
-
-// The cylinder wall (radius 3 m about Z, 0-3.5 m high) as a PLY mesh of 0.25 deg facets
-// over the 240 deg facing +Y: its chords lie within 7 um of the true wall.
-std::string cylinderPly() {
-  constexpr int kAround = 960, kUp = 14;
-  std::ostringstream v, f;
-  v.precision(12);
-  for (int i = 0; i <= kAround; ++i) {
-    const double a = (-120.0 + 240.0 * i / kAround) * std::numbers::pi / 180;
-    for (int j = 0; j <= kUp; ++j)
-      v << 3 * std::sin(a) << ' ' << 3 * std::cos(a) << ' ' << 3.5 * j / kUp << '\n';
-  }
-  int faces = 0;
-  for (int i = 0; i < kAround; ++i) {
-    for (int j = 0; j < kUp; ++j) {
-      const int k = i * (kUp + 1) + j;
-      f << "3 " << k << ' ' << k + kUp + 1 << ' ' << k + 1 << '\n';
-      f << "3 " << k + 1 << ' ' << k + kUp + 1 << ' ' << k + kUp + 2 << '\n';
-      faces += 2;
-    }
-  }
-  return "ply\nformat ascii 1.0\nelement vertex " + std::to_string((kAround + 1) * (kUp + 1)) +
-         "\nproperty double x\nproperty double y\nproperty double z\nelement face " +
-         std::to_string(faces) + "\nproperty list uchar int vertex_indices\nend_header\n" +
-         v.str() + f.str();
-}
 
 struct Rig {
   sim::Scene scene;
@@ -173,26 +149,15 @@ TEST(RenderCliCurved, BlendedFramesLightTheCurvedWallEvenlyForTheViewer) {
     const Vec2 q = (V * hit->hit.point.homogeneous()).hnormalized();
     return q.x() > 0.03 * kW && q.x() < 0.97 * kW && q.y() > 0.03 * kH && q.y() < 0.97 * kH;
   };
-  double step = 0, lo = 1e9, hi = 0;
-  long pixels = 0;
-  for (int y = 0; y + 1 < view.rows; ++y) {
-    for (int x = 0; x + 1 < view.cols; ++x) {
-      if (!inside(x, y) || !inside(x + 1, y + 1)) continue;
-      const double l = view.at<cv::Vec3f>(y, x)[0];
-      ASSERT_GT(l, 0) << "an unlit point inside the display at viewer pixel " << x << "," << y;
-      step = std::max({step, std::abs(view.at<cv::Vec3f>(y, x + 1)[0] - l) / l,
-                       std::abs(view.at<cv::Vec3f>(y + 1, x)[0] - l) / l});
-      lo = std::min(lo, l);
-      hi = std::max(hi, l);
-      ++pixels;
-    }
-  }
+  const ViewerLight light = viewerLight(view, inside);
+  EXPECT_FALSE(light.unlit) << "an unlit point inside the display at viewer pixel "
+                            << light.unlit->transpose();
   std::printf(
       "[ figures  ] procam-render, curved: white seen by the viewer, %ld pixels, "
       "largest step %.2f %%, uniformity min/max %.3f (matching: %s)\n",
-      pixels, 100 * step, lo / hi, matching.dump().c_str());
-  EXPECT_GT(pixels, 20000);
-  EXPECT_LE(step, 0.02);
+      light.pixels, 100 * light.step, light.uniformity(), matching.dump().c_str());
+  EXPECT_GT(light.pixels, 20000);
+  EXPECT_LE(light.step, 0.02);
 }
 
 TEST(RenderCliCurved, MpcdiPackageRebuildsTheSameFramebuffers) {

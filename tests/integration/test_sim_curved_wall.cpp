@@ -20,6 +20,7 @@
 #include "blend/curved_display.hpp"
 #include "blend/rig_tiles.hpp"
 #include "content/mesh_content.hpp"
+#include "curved_display_checks.hpp"
 #include "daemon_harness.hpp"
 #include "render/cpu_renderer.hpp"
 #include "render/viewer_view.hpp"
@@ -38,79 +39,6 @@ Mat34 rowMajor34(const json& j) {
   Mat34 m;
   for (int i = 0; i < 12; ++i) m(i / 4, i % 4) = j[i].get<double>();
   return m;
-}
-
-// d lookup / d pixel at u, numerically.
-std::optional<Eigen::Matrix2d> lookupJacobian(const render::WarpGrid& g, const Vec2& u) {
-  const auto x0 = render::gridSource(g, u - Vec2(0.5, 0)),
-             x1 = render::gridSource(g, u + Vec2(0.5, 0));
-  const auto y0 = render::gridSource(g, u - Vec2(0, 0.5)),
-             y1 = render::gridSource(g, u + Vec2(0, 0.5));
-  if (!x0 || !x1 || !y0 || !y1) return std::nullopt;
-  Eigen::Matrix2d J;
-  J.col(0) = *x1 - *x0;
-  J.col(1) = *y1 - *y0;
-  return J;
-}
-
-// The pixel of a projector whose lookup shows content pixel c: Newton from the nearest node.
-std::optional<Vec2> showing(const render::WarpGrid& g, const Vec2& c) {
-  double best = 1e300;
-  Vec2 u;
-  for (int j = 0; j < g.rows; ++j) {
-    for (int i = 0; i < g.cols; ++i) {
-      const Vec2& s = g.at(i, j);
-      if (s.x() == render::kOutside) continue;
-      if (const double d = (s - c).squaredNorm(); d < best) {
-        best = d;
-        u = g.node(i, j);
-      }
-    }
-  }
-  if (best > 4 * g.step.squaredNorm() * 16) return std::nullopt;  // c is not in this image
-  for (int it = 0; it < 8; ++it) {
-    const auto at = render::gridSource(g, u);
-    const auto J = lookupJacobian(g, u);
-    if (!at || !J) return std::nullopt;
-    u += J->inverse() * (c - *at);
-  }
-  const auto at = render::gridSource(g, u);
-  if (!at || (*at - c).norm() > 1e-3) return std::nullopt;
-  return u;
-}
-
-struct Calibrated {
-  rig::RigModel rig;
-  std::vector<geom::MeshIntersector> surfaces;  // per output, kOutputs order
-  std::vector<blend::SurfaceProjector> projectors;
-  std::vector<std::optional<blend::ProjectorResponse>> responses;
-};
-
-// The rig model calibrate wrote, with each projector's mesh, in kOutputs order.
-void readCalibrated(const std::string& state_dir, Calibrated& out) {
-  std::ifstream in(state_dir + "/rig.json");
-  std::stringstream text;
-  text << in.rdbuf();
-  auto rig = rig::rigFromText(text.str(), "rig.json");
-  ASSERT_TRUE(rig) << rig.error().message;
-  out.rig = std::move(*rig);
-  out.surfaces.reserve(3);
-  for (const char* name : kOutputs) {
-    const rig::RigProjector* p = out.rig.projectorForOutput(name);
-    ASSERT_TRUE(p && p->pose_known) << name;
-    ASSERT_TRUE(out.rig.surface.meshes.count(p->name)) << name;
-    auto mesh = content::loadMeshContent(state_dir + "/" + out.rig.surface.meshes.at(p->name));
-    ASSERT_TRUE(mesh) << mesh.error().message;
-    auto intersector = geom::MeshIntersector::build(std::move(mesh->mesh));
-    ASSERT_TRUE(intersector);
-    out.surfaces.push_back(std::move(*intersector));
-  }
-  for (std::size_t t = 0; t < 3; ++t) {
-    const rig::RigProjector* p = out.rig.projectorForOutput(kOutputs[t]);
-    out.projectors.push_back(
-        {&out.surfaces[t], p->model().projectionMatrix(), cv::Size(p->width, p->height)});
-    out.responses.push_back(blend::projectorResponse(*p));
-  }
 }
 
 TEST(SimCurvedWall, ThreeProjectorsCalibratedIntoOneDisplayForTheSweetSpot) {
@@ -217,92 +145,26 @@ TEST(SimCurvedWall, ThreeProjectorsCalibratedIntoOneDisplayForTheSweetSpot) {
 
   // The same display from the rig model the daemon wrote: what every output draws.
   Calibrated cal;
-  ASSERT_NO_FATAL_FAILURE(readCalibrated(dir.file("state"), cal));
+  ASSERT_NO_FATAL_FAILURE(readCalibrated(dir.file("state"), {kOutputs, kOutputs + 3}, cal));
   auto blend = blend::makeCurvedBlend(cal.projectors, cal.responses, eye, {kW, kH});
   ASSERT_TRUE(blend) << blend.error().message;
   EXPECT_LT((blend->display.viewer - V).norm(), 1e-9 * V.norm());
   const auto& lookup = blend->display.lookup;
 
-  // TRUE surface point of a TRUE projector pixel.
-  auto onTheWall = [&](const std::string& name, const Vec2& u) -> std::optional<Vec3> {
-    auto rays = render::pixelRays(truth[name].projectionMatrix());
-    auto hit = scene->world().intersect(rays->through(u.x(), u.y()));
-    return hit ? std::optional<Vec3>(hit->hit.point) : std::nullopt;
-  };
-  auto inFrame = [](const Vec2& u, double margin) {
-    return u.x() >= -0.5 + margin && u.y() >= -0.5 + margin && u.x() <= 1279.5 - margin &&
-           u.y() <= 799.5 - margin;
-  };
+  TrueRig true_rig{&*scene, {}};
+  for (const char* name : kOutputs) true_rig.projectors.push_back(truth[name]);
 
   // Seams: where one projector puts a content point on the TRUE wall, the other shows
   // the same content point within 0.3 px RMS, 1 px at most (its pixels).
-  double sq = 0, worst = 0;
-  int pairs = 0;
-  for (std::size_t m = 0; m < 3; ++m) {
-    const auto& g = lookup[m];
-    for (int j = 0; j < g.rows; ++j) {
-      for (int i = 0; i < g.cols; ++i) {
-        const Vec2 content = g.at(i, j);
-        if (content.x() < 0 || content.y() < 0 || content.x() > kW - 1 || content.y() > kH - 1)
-          continue;
-        const auto X = onTheWall(kOutputs[m], g.node(i, j));
-        if (!X) continue;
-        for (std::size_t n = 0; n < 3; ++n) {
-          if (n == m) continue;
-          const Vec2 q = *truth[kOutputs[n]].project(*X);
-          if (!inFrame(q, 1)) continue;
-          const auto other = render::gridSource(lookup[n], q);
-          const auto J = lookupJacobian(lookup[n], q);
-          if (!other || !J) continue;
-          const double e = (J->inverse() * (content - *other)).norm();
-          sq += e * e;
-          worst = std::max(worst, e);
-          ++pairs;
-        }
-      }
-    }
-  }
-  ASSERT_GT(pairs, 1000);
-  const double rms = std::sqrt(sq / pairs);
-  std::printf("[ figures  ] seams: %d content points lit twice, RMS %.3f px, max %.3f px\n", pairs,
-              rms, worst);
-  EXPECT_LE(rms, 0.3);
-  EXPECT_LE(worst, 1.0);
+  const SeamFigures seams = seamsOnTheTrueSurface(lookup, true_rig, {kW, kH});
+  ASSERT_GT(seams.pairs, 1000);
+  std::printf("[ figures  ] seams: %d content points lit twice, RMS %.3f px, max %.3f px\n",
+              seams.pairs, seams.rms, seams.worst);
+  EXPECT_LE(seams.rms, 0.3);
+  EXPECT_LE(seams.worst, 1.0);
 
-  // Straight lines of the content stay straight for the viewer: where the TRUE wall point
-  // that shows content pixel c appears in the viewer's pinhole (V, a camera at the eye),
-  // along every 10th row and column: within 0.5 content px of a straight line.
-  double bent = 0;
-  auto straightness = [&](bool rows, double at) {
-    std::vector<Vec2> seen;  // (along, across) in content px
-    const int n = rows ? kW : kH;
-    for (int k = 10; k < n - 10; k += 20) {
-      const Vec2 content = rows ? Vec2(k, at) : Vec2(at, k);
-      for (std::size_t m = 0; m < 3; ++m) {
-        const auto u = showing(lookup[m], content);
-        if (!u || !inFrame(*u, 1)) continue;
-        const auto X = onTheWall(kOutputs[m], *u);
-        if (!X) continue;
-        const Vec2 s = (V * X->homogeneous()).hnormalized();
-        seen.push_back(rows ? Vec2(k, s.y()) : Vec2(k, s.x()));
-      }
-    }
-    EXPECT_GT(seen.size(), size_t(n / 25));
-    // Least-squares line across = a + b along; the largest residual.
-    Eigen::MatrixXd A(seen.size(), 2);
-    Eigen::VectorXd b(seen.size());
-    for (std::size_t i = 0; i < seen.size(); ++i) {
-      A(i, 0) = 1;
-      A(i, 1) = seen[i].x();
-      b(i) = seen[i].y();
-    }
-    const Eigen::VectorXd line = A.colPivHouseholderQr().solve(b);
-    bent = std::max(bent, (A * line - b).cwiseAbs().maxCoeff());
-  };
-  for (int k = 1; k < 10; ++k) {
-    straightness(true, kH * k / 10.0);
-    straightness(false, kW * k / 10.0);
-  }
+  // Straight lines of the content stay straight for the viewer: within 0.5 content px.
+  const double bent = bentOnTheTrueSurface(lookup, true_rig, V, {kW, kH});
   std::printf(
       "[ figures  ] content lines seen from the sweet spot: %.3f content px from straight\n", bent);
   EXPECT_LE(bent, 0.5);
@@ -348,28 +210,15 @@ TEST(SimCurvedWall, ThreeProjectorsCalibratedIntoOneDisplayForTheSweetSpot) {
     const Vec2 q = (V * hit->hit.point.homogeneous()).hnormalized();
     return q.x() > 0.03 * kW && q.x() < 0.97 * kW && q.y() > 0.03 * kH && q.y() < 0.97 * kH;
   };
-  double step = 0, lo = 1e9, hi = 0;
-  Vec2 step_at = Vec2::Zero();
-  for (int y = 0; y + 1 < view.rows; ++y) {
-    for (int x = 0; x + 1 < view.cols; ++x) {
-      if (!inside(x, y) || !inside(x + 1, y + 1)) continue;
-      const double l = view.at<cv::Vec3f>(y, x)[0];
-      const double right = view.at<cv::Vec3f>(y, x + 1)[0], down = view.at<cv::Vec3f>(y + 1, x)[0];
-      const double st = std::max(std::abs(right - l) / l, std::abs(down - l) / l);
-      if (st > step) {
-        step = st;
-        step_at = Vec2(x, y);
-      }
-      lo = std::min(lo, l);
-      hi = std::max(hi, l);
-    }
-  }
+  const ViewerLight light = viewerLight(view, inside);
+  EXPECT_FALSE(light.unlit) << "an unlit point inside the display at viewer pixel "
+                            << light.unlit->transpose();
   std::printf(
       "[ figures  ] white seen from the sweet spot: largest step %.2f %% at viewer pixel (%.0f, "
       "%.0f), uniformity min/max %.3f\n",
-      100 * step, step_at.x(), step_at.y(), lo / hi);
-  EXPECT_GT(hi, 0);
-  EXPECT_LE(step, 0.02);
+      100 * light.step, light.at.x(), light.at.y(), light.uniformity());
+  EXPECT_GT(light.pixels, 10000);
+  EXPECT_LE(light.step, 0.02);
 }
 
 }  // namespace
