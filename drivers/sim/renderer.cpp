@@ -135,12 +135,12 @@ PixelTruth::Light Renderer::light(const Lamp& lamp, const Vec3& point, const Vec
   geom::Ray shadow;
   shadow.origin = lamp.center;
   shadow.dir = -to_lamp / out.distance;
-  out.lit = !scene_->world().occluded(shadow, out.distance * (1.0 - 1e-7), surface);
+  out.lit = !world().occluded(shadow, out.distance * (1.0 - 1e-7), surface);
   return out;
 }
 
 cv::Vec3f Renderer::radianceAlong(const geom::Ray& ray) const {
-  const auto hit = scene_->world().intersect(ray);
+  const auto hit = world().intersect(ray);
   if (!hit) return {0.f, 0.f, 0.f};
   cv::Vec3f irradiance = ambient_bgr_;
   for (const Lamp& lamp : lamps_) {
@@ -154,8 +154,9 @@ cv::Vec3f Renderer::radianceAlong(const geom::Ray& ray) const {
   }
   const auto surface = static_cast<std::size_t>(hit->surface);
   const cv::Vec3f albedo = albedo_bgr_[surface];
-  const auto& print = scene_->world().surfaces()[surface].print;
-  return irradiance.mul(print ? albedo * print->at(hit->hit.point) : albedo);
+  const Surface& moved = world().surfaces()[surface];
+  return irradiance.mul(moved.print ? albedo * moved.print->at(hit->hit.point - moved.offset)
+                                    : albedo);
 }
 
 cv::Mat Renderer::radianceImage(const geom::CameraModel& view, int supersamples,
@@ -218,7 +219,7 @@ PixelTruth Renderer::truthAt(const geom::CameraModel& view, const Vec2& pixel) c
   PixelTruth truth;
   const auto ray = pixelRay(view, pixel.x(), pixel.y());
   if (!ray) return truth;
-  const auto hit = scene_->world().intersect(*ray);
+  const auto hit = world().intersect(*ray);
   if (!hit) return truth;
   truth.hit = true;
   truth.surface = hit->surface;

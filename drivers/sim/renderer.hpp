@@ -92,6 +92,8 @@ class Renderer {
                           int surface) const;
   cv::Mat radianceImage(const geom::CameraModel& view, int supersamples, int threads) const;
 
+  // The surfaces as they stand at the state's time.
+  const World& world() const { return state_.world ? *state_.world : scene_->world(); }
   const Scene* scene_;
   SceneState state_;
   std::vector<Lamp> lamps_;

@@ -1,8 +1,12 @@
 #include "sim/scene.hpp"
 
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <iterator>
 
+#include "core/units.hpp"
 #include "sim/orientation.hpp"
 
 namespace procam::sim {
@@ -41,13 +45,34 @@ geom::Pose Scene::placementPose(const Placement& p, double time) const {
     case Placement::Kind::kTrajectory:
       return trajectory(p.trajectory)->poseAt(time);
     case Placement::Kind::kAttached:
-      // The parser guarantees the parent exists and is itself not attached.
+      // The parser guarantees the parent exists and is itself not attached; a device
+      // on it follows its events.
       for (const auto& proj : projectors_) {
-        if (proj.name == p.parent) return compose(p.offset, placementPose(proj.placement, time));
+        if (proj.name != p.parent) continue;
+        return compose(p.offset, withEvents(placementPose(proj.placement, time),
+                                            SceneEvent::Target::kProjector, proj.name, time));
       }
       break;
   }
   return p.fixed;
+}
+
+geom::Pose Scene::withEvents(geom::Pose pose, SceneEvent::Target target, std::string_view name,
+                             double time) const {
+  for (const SceneEvent& e : events_) {
+    if (e.time > time) break;
+    if (e.target != target || e.name != name) continue;
+    // The device's axes turn by B in its own frame about its centre: R' = B^T R.
+    const Vec3 r = e.rotate_deg.unaryExpr([](double a) { return degToRad(a); });
+    const Mat3 B =
+        (Eigen::AngleAxisd(r.x(), Vec3::UnitY()) * Eigen::AngleAxisd(r.y(), Vec3::UnitX()) *
+         Eigen::AngleAxisd(r.z(), Vec3::UnitZ()))
+            .toRotationMatrix();
+    const Vec3 centre = pose.center() + e.move_m;
+    pose.R = B.transpose() * pose.R;
+    pose.t = -pose.R * centre;
+  }
+  return pose;
 }
 
 Vec3 Scene::viewerPosition(double time) const {
@@ -60,7 +85,8 @@ SceneState Scene::at(double time) const {
   for (const auto& spec : projectors_) {
     geom::CameraModel m;
     m.K = spec.K;
-    m.pose = placementPose(spec.placement, time);
+    m.pose = withEvents(placementPose(spec.placement, time), SceneEvent::Target::kProjector,
+                        spec.name, time);
     m.width = spec.width;
     m.height = spec.height;
     state.projectors.push_back({spec, m});
@@ -69,7 +95,8 @@ SceneState Scene::at(double time) const {
     geom::CameraModel m;
     m.K = spec.K;
     m.dist = spec.dist;
-    m.pose = placementPose(spec.placement, time);
+    m.pose = withEvents(placementPose(spec.placement, time), SceneEvent::Target::kCamera, spec.name,
+                        time);
     m.width = spec.width;
     m.height = spec.height;
     state.cameras.push_back({spec, m});
@@ -82,6 +109,12 @@ SceneState Scene::at(double time) const {
   state.viewer.pose = placementPose(viewer_.placement, time);
   state.viewer.width = viewer_.width;
   state.viewer.height = viewer_.height;
+  std::size_t moved = 0;
+  for (const SceneEvent& e : events_) {
+    if (e.time > time) break;
+    moved += e.target == SceneEvent::Target::kSurface;
+  }
+  state.world = worlds_[std::min(moved, worlds_.size() - 1)];
   return state;
 }
 

@@ -4,6 +4,7 @@
 // every trajectory and rigid attachment and gives the true state of the rig.
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -81,6 +82,19 @@ struct ViewerSpec {
   geom::Intrinsics K;  // for renderings of what the viewer perceives
 };
 
+// A step change of the rig at `time` (a scene's [[events]]): a projector or camera
+// turned about its own centre (yaw, pitch, roll in its own frame: positive yaw turns the
+// optical axis right, pitch up, roll clockwise seen from behind) and moved; a surface
+// moved. Devices attached to a turned projector turn with it.
+struct SceneEvent {
+  enum class Target { kProjector, kCamera, kSurface };
+  double time = 0;
+  Target target = Target::kProjector;
+  std::string name;
+  Vec3 rotate_deg = Vec3::Zero();  // yaw, pitch, roll
+  Vec3 move_m = Vec3::Zero();      // world metres
+};
+
 // True state of every device at one time.
 struct ProjectorState {
   ProjectorSpec spec;
@@ -101,6 +115,9 @@ struct SceneState {
   std::vector<CameraState> cameras;
   std::vector<TiltSensorState> tilt_sensors;
   geom::CameraModel viewer;  // viewer eye as a pinhole (pose, K, resolution)
+  // The surfaces as they stand at this time (moved by events); the scene's own world
+  // before any surface event.
+  std::shared_ptr<const World> world;
 
   const ProjectorState* projector(std::string_view name) const;
   const CameraState* camera(std::string_view name) const;
@@ -125,7 +142,8 @@ class Scene {
   const std::vector<TrackerSpec>& trackers() const { return trackers_; }
   const std::vector<Trajectory>& trajectories() const { return trajectories_; }
   const ViewerSpec& viewer() const { return viewer_; }
-  const World& world() const { return world_; }
+  const std::vector<SceneEvent>& events() const { return events_; }  // in time order
+  const World& world() const { return *worlds_.front(); }            // as the scene began
   Vec3 ambientRgb() const { return ambient_rgb_; }  // irradiance-like, added to every point
 
   const Trajectory* trajectory(std::string_view name) const;
@@ -134,6 +152,9 @@ class Scene {
  private:
   friend class SceneBuilder;
   geom::Pose placementPose(const Placement& p, double time) const;
+  // A device's pose with the events on it up to `time` applied.
+  geom::Pose withEvents(geom::Pose pose, SceneEvent::Target target, std::string_view name,
+                        double time) const;
 
   std::string name_, description_;
   std::vector<ProjectorSpec> projectors_;
@@ -142,7 +163,9 @@ class Scene {
   std::vector<TrackerSpec> trackers_;
   std::vector<Trajectory> trajectories_;
   ViewerSpec viewer_;
-  World world_;
+  // worlds_[k]: the surfaces after the first k surface events (worlds_[0] as read).
+  std::vector<std::shared_ptr<const World>> worlds_{std::make_shared<const World>()};
+  std::vector<SceneEvent> events_;
   Vec3 ambient_rgb_ = Vec3::Zero();
 };
 

@@ -1,4 +1,5 @@
 // Scene::parse: the TOML schema of SCENE-FORMAT.md -> Scene.
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -262,6 +263,36 @@ class Reader {
     return s;
   }
 
+  // [[events]]: `t`, `target` (a projector, camera or surface), `rotate_deg` (devices)
+  // and/or `move_m`.
+  SceneEvent event(const Fields& f) {
+    SceneEvent e;
+    e.time = f.requiredIn("t", 0, 1e6);
+    e.name = f.string("target");
+    if (projector_names_.contains(e.name)) {
+      e.target = SceneEvent::Target::kProjector;
+    } else if (camera_names_.contains(e.name)) {
+      e.target = SceneEvent::Target::kCamera;
+    } else if (surface_names_.contains(e.name)) {
+      e.target = SceneEvent::Target::kSurface;
+    } else {
+      f.error("target", "no projector, camera or surface named '" + e.name + "'");
+    }
+    const auto rotate = f.optionalVec3("rotate_deg");
+    const auto move = f.optionalVec3("move_m");
+    if (!rotate && !move) f.errorHere("an event turns or moves its target: rotate_deg or move_m");
+    if (rotate && rotate->cwiseAbs().maxCoeff() > 180)
+      f.error("rotate_deg", "each angle must lie in [-180, 180]");
+    if (move && move->cwiseAbs().maxCoeff() > 100)
+      f.error("move_m", "each component must lie in [-100, 100] m");
+    if (rotate && e.target == SceneEvent::Target::kSurface)
+      f.error("rotate_deg", "a surface can only be moved (move_m)");
+    e.rotate_deg = rotate.value_or(Vec3::Zero());
+    e.move_m = move.value_or(Vec3::Zero());
+    f.finish();
+    return e;
+  }
+
   TrackerSpec tracker(const Fields& f) {
     TrackerSpec s;
     s.name = uniqueName(f, tracker_names_);
@@ -399,7 +430,7 @@ class SceneBuilder {
     for (const Fields& f : root.tableArray("cameras")) scene.cameras_.push_back(reader.camera(f));
     std::vector<Surface> surfaces;
     for (const Fields& f : root.tableArray("surfaces")) surfaces.push_back(reader.surface(f));
-    scene.world_ = World(std::move(surfaces));
+    scene.worlds_ = {std::make_shared<const World>(std::move(surfaces))};
     for (const Fields& f : root.tableArray("tilt_sensors"))
       scene.tilt_sensors_.push_back(reader.tiltSensor(f));
     for (const Fields& f : root.tableArray("trackers"))
@@ -411,6 +442,18 @@ class SceneBuilder {
       scene.viewer_.K.fx = scene.viewer_.K.fy = 0.5 * 640 / std::tan(degToRad(30));
       scene.viewer_.K.cx = 319.5;
       scene.viewer_.K.cy = 239.5;
+    }
+    for (const Fields& f : root.tableArray("events")) scene.events_.push_back(reader.event(f));
+    std::stable_sort(scene.events_.begin(), scene.events_.end(),
+                     [](const SceneEvent& a, const SceneEvent& b) { return a.time < b.time; });
+    for (const SceneEvent& e : scene.events_) {
+      if (e.target != SceneEvent::Target::kSurface) continue;
+      const auto& surfaces = scene.worlds_.back()->surfaces();
+      for (std::size_t i = 0; i < surfaces.size(); ++i) {
+        if (surfaces[i].name != e.name) continue;
+        scene.worlds_.push_back(
+            std::make_shared<const World>(scene.worlds_.back()->moved(i, e.move_m)));
+      }
     }
     if (scene.projectors_.empty() && scene.cameras_.empty())
       root.errorHere("a scene needs at least one projector or camera");

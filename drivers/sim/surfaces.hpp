@@ -29,6 +29,9 @@ struct Surface {
   Vec3 albedo_rgb = Vec3::Constant(0.8);  // diffuse reflectance per channel, [0, 1]
   Shape shape;
   std::shared_ptr<const SurfacePrint> print;  // a board on a plane or rectangle, if any
+  // Moved by scene events since the scene began (world metres): the shape and its print
+  // stand where they were read, and rays meet them shifted back by this much.
+  Vec3 offset = Vec3::Zero();
 };
 
 struct SurfaceHit {
@@ -49,6 +52,8 @@ class World {
   bool occluded(const geom::Ray& ray, double t_max, int on_surface = -1) const;
 
   const std::vector<Surface>& surfaces() const { return surfaces_; }
+  // The same world with surface `index` moved by `by` (world metres).
+  World moved(std::size_t index, const Vec3& by) const;
 
  private:
   std::vector<Surface> surfaces_;

@@ -145,9 +145,10 @@ json truthJson(const Scene& scene, const SceneState& state) {
   out["viewer"] = modelJson("viewer", state.viewer);
   out["ambient_rgb"] = vecJson(scene.ambientRgb());
   out["surfaces"] = json::array();
-  for (const auto& s : scene.world().surfaces()) {
+  for (const auto& s : (state.world ? *state.world : scene.world()).surfaces()) {
     json j = shapeJson(s.shape);
     j["name"] = s.name;
+    if (!s.offset.isZero()) j["moved_m"] = vecJson(s.offset);  // by events, from the shape
     j["type"] = s.type;
     j["albedo_rgb"] = vecJson(s.albedo_rgb);
     if (s.print) {

@@ -105,9 +105,10 @@ Result<rig::RigModel> truthRig(const Scene& scene, double time) {
     // The surface the central ray lights, when it is a plane.
     const geom::CameraModel& model = s->model;
     auto ray = model.backproject(Vec2((model.width - 1) / 2.0, (model.height - 1) / 2.0));
-    const auto hit = ray ? scene.world().intersect(*ray) : std::nullopt;
+    const World& world = state.world ? *state.world : scene.world();  // as it stands then
+    const auto hit = ray ? world.intersect(*ray) : std::nullopt;
     if (!hit) continue;
-    const Surface& surface = scene.world().surfaces()[static_cast<size_t>(hit->surface)];
+    const Surface& surface = world.surfaces()[static_cast<size_t>(hit->surface)];
     if (!std::holds_alternative<geom::Plane>(surface.shape) &&
         !std::holds_alternative<geom::Rectangle>(surface.shape)) {
       planar = false;
