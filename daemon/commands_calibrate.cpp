@@ -10,6 +10,7 @@
 #include "log.hpp"
 #include "rig_store.hpp"
 #include "surface/surface_model.hpp"
+#include "unify_run.hpp"
 #include "wall_views_run.hpp"
 
 namespace procam::daemon {
@@ -554,6 +555,18 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
             result = tl::unexpected(solved.error());
           }
         }
+        // Route (a) over several projectors: their meshes agree where they overlap.
+        json unified;
+        if (result && !cancelled->load() && plans.size() > 1) {
+          std::vector<const CalibrationPlan*> all;
+          for (const auto& p : plans) all.push_back(p.get());
+          auto made = unifyRunMeshes(all, *result);
+          if (made) {
+            unified = std::move(*made);
+          } else {
+            result = tl::unexpected(made.error());
+          }
+        }
         json batches = json::array();
         for (const auto& batch : scan.batches) {
           json names = json::array();
@@ -562,7 +575,7 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
         }
         const json scanned = {{"batches", std::move(batches)}, {"captures", done}};
         return [this, client, req, op_id, cancelled, plans, result, progress, captures, scanned,
-                wall] {
+                wall, unified] {
           auto finish = [this, client, req, op_id](const json& reply, const Failure* failure) {
             endDeviceOp(client, req, op_id, "calibrate", "CALIBRATE", reply, failure);
             refreshOutputs();  // what the outputs showed before the pattern frames
@@ -613,6 +626,7 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
             reply["scan"] = scanned;
           }
           if (!wall.is_null()) reply["wall"] = wall;
+          if (!unified.is_null()) reply["unified"] = unified;
           reply["operation"] = op_id;
           reply["state"] = "done";
           writeRig(std::move(update), std::move(meshes),

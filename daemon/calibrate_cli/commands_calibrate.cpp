@@ -8,6 +8,7 @@
 #include "calibration/stereo_route.hpp"
 #include "cli_files.hpp"
 #include "commands.hpp"
+#include "surface/mesh_unification.hpp"
 #include "surface/projector_samples.hpp"
 #include "surface/surface_model.hpp"
 
@@ -155,7 +156,8 @@ Result<void> runSolveProjectors(const Arguments& a) {
     return fail(ErrorCode::kInvalidInput, *cameras_file + " holds one camera; solve needs two");
   nlohmann::json doc;
   nlohmann::json meshes = nlohmann::json::object();
-  std::vector<std::pair<std::string, std::string>> plies;  // file, text
+  std::vector<std::string> plies;             // file per projector
+  std::vector<surface::UnifyProjector> made;  // mesh per projector
   for (const Arguments& g : a.groups()) {
     if (auto ok = g.only({"projector", "patterns", "captures"}); !ok) return ok;
     auto name = g.one("projector");
@@ -195,13 +197,30 @@ Result<void> runSolveProjectors(const Arguments& a) {
     }
     const std::string file = "surface-" + *name + ".ply";
     meshes[*name] = file;
-    plies.emplace_back((fs::path(*out).parent_path() / file).string(),
-                       surface::toPly(route->surface.mesh));
+    plies.push_back((fs::path(*out).parent_path() / file).string());
+    geom::CameraModel fitted;
+    fitted.K = route->projector.K;
+    fitted.pose = route->projector.pose;
+    made.push_back({std::move(route->surface.mesh), fitted.projectionMatrix(),
+                    cv::Size(set->options.width, set->options.height)});
+  }
+  // Where the projectors' meshes overlap they are unified ([Raskar02] eq. 4.4), as the
+  // daemon's calibrate does.
+  if (made.size() > 1) {
+    auto unified = surface::unifyMeshes(made);
+    if (!unified) return asVoid(unified);
+    char line[200];
+    std::snprintf(line, sizeof line,
+                  "meshes unified: %d of %d vertices shared, %.3f mm apart RMS before, %.3f mm "
+                  "after",
+                  unified->shared, unified->vertices, 1000 * unified->gap_rms_m,
+                  1000 * unified->gap_after_rms_m);
+    progress(line);
   }
   // Meshes first, rig.json last: a rig.json never names a mesh that is not written.
-  for (const auto& [file, text] : plies) {
-    progress("mesh -> " + file);
-    if (auto w = writeText(file, text); !w) return w;
+  for (std::size_t k = 0; k < plies.size(); ++k) {
+    progress("mesh -> " + plies[k]);
+    if (auto w = writeText(plies[k], surface::toPly(made[k].mesh)); !w) return w;
   }
   doc["surface"] = {{"meshes", meshes}};
   return writeText(*out, doc.dump(2) + "\n");
