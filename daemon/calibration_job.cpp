@@ -119,7 +119,8 @@ tl::expected<bool, CalibrationFailure> showAndSettle(const CalibrationPlan& plan
 // (flags 0), eroded by 3 pixels so that its blurred edge does not count; and, from the
 // same pixels' white minus black, the projector's brightness across its frame.
 Result<blend::ProjectorResponse> rampResponse(const std::vector<cv::Mat>& ramp,
-                                              const sl::Decoded& decoded, cv::Size framebuffer) {
+                                              const sl::Decoded& decoded, cv::Size framebuffer,
+                                              std::string& brightness_note) {
   cv::Mat mask = decoded.flags == 0;
   cv::erode(mask, mask, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(7, 7)));
   if (cv::countNonZero(mask) < 100) {
@@ -134,10 +135,15 @@ Result<blend::ProjectorResponse> rampResponse(const std::vector<cv::Mat>& ramp,
   }
   auto response = blend::fitResponse(samples);
   if (!response) return response;
+  // Without its brightness across the frame the response still serves (a gain per
+  // projector instead of matching per pixel); the reply says why.
   auto brightness =
       blend::measureBrightness(ramp.back(), ramp.front(), decoded.u, decoded.v, mask, framebuffer);
-  if (!brightness) return tl::unexpected(brightness.error());
-  response->brightness = std::move(*brightness);
+  if (brightness) {
+    response->brightness = std::move(*brightness);
+  } else {
+    brightness_note = brightness.error().message;
+  }
   return response;
 }
 
@@ -322,7 +328,8 @@ tl::expected<std::vector<CalibrationOutcome>, CalibrationFailure> runBatchCalibr
       out.decoded.push_back(d.decoded);
       if (c == 0 && !ramp.empty()) {
         auto response =
-            rampResponse(ramp, d, cv::Size(member.set.options.width, member.set.options.height));
+            rampResponse(ramp, d, cv::Size(member.set.options.width, member.set.options.height),
+                         out.brightness_note);
         // Responses are compared within one camera's exposure: with several cameras
         // only the reference camera measures them, and a projector it sees too little
         // of is left unmeasured (the reply has no response for it).

@@ -140,6 +140,7 @@ struct CalibrationOutcome {
   std::optional<geom::PlaneFit> triangulated_plane;
   std::optional<blend::ProjectorResponse> response;  // from the grey ramp
   std::string response_note;                         // why a ramp gave no response
+  std::string brightness_note;  // why a response has no brightness across the frame
   // Route (b′) from cameras at several positions: per camera, the projector nodes it
   // saw (none: too few); the planar result comes from solveWallViewsRun.
   std::vector<std::optional<calib::CollineationNodes>> wall_nodes;

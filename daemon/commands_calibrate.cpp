@@ -560,12 +560,9 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
         if (result && !cancelled->load() && plans.size() > 1) {
           std::vector<const CalibrationPlan*> all;
           for (const auto& p : plans) all.push_back(p.get());
+          // A failure keeps the meshes as triangulated: the run is not lost for it.
           auto made = unifyRunMeshes(all, *result);
-          if (made) {
-            unified = std::move(*made);
-          } else {
-            result = tl::unexpected(made.error());
-          }
+          unified = made ? std::move(*made) : json{{"skipped", made.error().message}};
         }
         json batches = json::array();
         for (const auto& batch : scan.batches) {
@@ -608,6 +605,9 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
                     {"nodes", {map->white.cols, map->white.rows}},
                     {"step_px", map->step},
                     {"min_over_max", hi > 0 ? lo / hi : 0.0}};
+              } else {
+                learnt.reply["response"]["brightness"] = {{"measured", false},
+                                                          {"why", outcome.brightness_note}};
               }
             } else if (!outcome.response_note.empty()) {
               learnt.reply["response"] = {{"measured", false}, {"why", outcome.response_note}};

@@ -80,8 +80,8 @@ std::optional<OutputDraw> Daemon::planOutput(DeviceEntry& e, const OutputDrawPol
     return std::nullopt;
   }
   if (tile >= 0 && tiled->alpha[tile].size() == *mode) {
-    // Eq. 4.3 weights in linear light, through the projector's response and its
-    // brightness gain ([Raskar02] §4.1.2).
+    // Eq. 4.3 weights in linear light, through the projector's response, matched per
+    // pixel or by a brightness gain ([Raskar02] §4.1.2, [Majumder05]).
     plan->setup.final_stage.alpha = tiled->alpha[tile];
     plan->setup.final_stage.weight_lut = tiled->weight_lut[tile];
   }

@@ -156,8 +156,8 @@ Result<std::shared_ptr<const render::RenderSetup>> Daemon::nonPlanarSetup(
       setup.lookup = curved->display.lookup[index];
       setup.viewer = curved->display.viewer;
     }
-    // Eq. 4.3 weights in linear light, through the projector's response and its
-    // brightness gain ([Raskar02] §4.1.2).
+    // Eq. 4.3 weights in linear light, through the projector's response, matched per
+    // pixel or by a brightness gain ([Raskar02] §4.1.2, [Majumder05]).
     setup.final_stage.alpha = curved->alpha[index];
     setup.final_stage.weight_lut = curved->weight_lut[index];
     return remember(std::move(setup));

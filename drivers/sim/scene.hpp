@@ -58,6 +58,16 @@ struct CameraSpec {
   double electronsPerDn() const { return full_well_e / maxDn(); }  // at gain 1
 };
 
+// A rate gyroscope in the same package as a tilt sensor (an MPU-6050's gyro, an IIO
+// `anglvel` channel): angular velocity in the sensor frame plus a constant bias, a bias
+// that wanders (a random walk) and white noise.
+struct GyroSpec {
+  double noise_density_dps = 0.0;  // white noise, degrees/s per sqrt(Hz)
+  Vec3 bias_dps = Vec3::Zero();    // constant bias per sensor axis, degrees/s
+  double bias_walk_dps = 0.0;      // bias random walk, degrees/s per sqrt(s)
+  double full_scale_dps = 0.0;     // clamp of each axis, degrees/s; 0 = unlimited
+};
+
 struct TiltSensorSpec {
   std::string name;
   std::string projector;                          // the projector it is mounted on
@@ -67,6 +77,7 @@ struct TiltSensorSpec {
   double rate_hz = 100.0;                         // output data rate
   double full_scale_g = 0.0;                      // clamp of each axis, g; 0 = unlimited
   bool report_in_g = false;                       // units of samples: g, or m/s^2 (default)
+  std::optional<GyroSpec> gyro;                   // the package's gyroscope, if it has one
 };
 
 struct TrackerSpec {

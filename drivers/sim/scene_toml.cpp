@@ -259,6 +259,16 @@ class Reader {
     const std::string units = f.optionalString("units").value_or("m/s2");
     if (units != "m/s2" && units != "g") f.error("units", "must be \"m/s2\" or \"g\"");
     s.report_in_g = units == "g";
+    if (f.has("gyro")) {
+      const Fields g = f.table("gyro");
+      GyroSpec gyro;
+      gyro.noise_density_dps = g.numberIn("noise_density_dps", 0, 0, 100);
+      gyro.bias_dps = g.scalarOrVec3("bias_dps", Vec3::Zero(), -1e3, 1e3);
+      gyro.bias_walk_dps = g.numberIn("bias_walk_dps", 0, 0, 100);
+      gyro.full_scale_dps = g.numberIn("full_scale_dps", 0, 0, 1e5);
+      g.finish();
+      s.gyro = gyro;
+    }
     f.finish();
     return s;
   }
@@ -269,6 +279,10 @@ class Reader {
     SceneEvent e;
     e.time = f.requiredIn("t", 0, 1e6);
     e.name = f.string("target");
+    const int kinds = projector_names_.contains(e.name) + camera_names_.contains(e.name) +
+                      surface_names_.contains(e.name);
+    if (kinds > 1)
+      f.error("target", "'" + e.name + "' names more than one projector, camera or surface");
     if (projector_names_.contains(e.name)) {
       e.target = SceneEvent::Target::kProjector;
     } else if (camera_names_.contains(e.name)) {

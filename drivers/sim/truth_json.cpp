@@ -153,7 +153,7 @@ json truthJson(const Scene& scene, const SceneState& state) {
     j["albedo_rgb"] = vecJson(s.albedo_rgb);
     if (s.print) {
       j["board"] = {{"spec", s.print->board},
-                    {"center", vecJson(s.print->center)},
+                    {"center", vecJson(s.print->center + s.offset)},
                     {"right", vecJson(s.print->right)},
                     {"down", vecJson(s.print->down)},
                     {"metres_per_px", s.print->metres_per_px}};

@@ -24,8 +24,13 @@ Result<BlendTables> blendTables(std::vector<cv::Mat> weights,
   if (out.measured) {
     for (const auto& r : responses) measured.push_back(*r);
   }
+  out.different_cameras =
+      out.measured && std::any_of(measured.begin(), measured.end(), [&](const auto& r) {
+        return r.camera != measured.front().camera;
+      });
+  const bool comparable = out.measured && !out.different_cameras;
   const bool per_pixel =
-      out.measured && !to_content.empty() &&
+      comparable && !to_content.empty() &&
       std::all_of(measured.begin(), measured.end(), [](const auto& r) { return r.brightness; });
   if (per_pixel) {
     std::vector<MatchProjector> match;
@@ -36,9 +41,8 @@ Result<BlendTables> blendTables(std::vector<cv::Mat> weights,
     weights = std::move(matched->weights);
     out.matched = matched->figures;
   }
-  const std::vector<double> gains = out.measured && !per_pixel
-                                        ? matchedGains(measured)
-                                        : std::vector<double>(weights.size(), 1.0);
+  const std::vector<double> gains =
+      comparable && !per_pixel ? matchedGains(measured) : std::vector<double>(weights.size(), 1.0);
   for (std::size_t t = 0; t < weights.size(); ++t) {
     const double gamma = out.measured ? measured[t].gamma : kAssumedGamma;
     auto lut = weightLut(gamma, gains[t]);
@@ -54,6 +58,8 @@ Result<BlendTables> blendTables(std::vector<cv::Mat> weights,
 
 nlohmann::json matchingJson(const BlendTables& tables) {
   if (!tables.measured) return {{"matching", "none"}};
+  if (tables.different_cameras)
+    return {{"matching", "none"}, {"why", "the responses were measured by different cameras"}};
   if (!tables.matched) return {{"matching", "per-projector gain"}};
   const LuminanceFigures& f = *tables.matched;
   const auto ratio = [](double lo, double hi) { return hi > 0 ? lo / hi : 0.0; };

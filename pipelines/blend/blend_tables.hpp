@@ -28,12 +28,16 @@ struct BlendTables {
   // Matched per pixel ([Majumder05], luminance_match.hpp): the weights carry each
   // point's attenuation to the display's smooth target and every gain is 1.
   std::optional<LuminanceFigures> matched;
+  // Responses measured by different cameras: their brightness does not compare, so the
+  // projectors are not matched (each keeps its response, no gain).
+  bool different_cameras = false;
 };
 
 // `responses` has one entry per weight image (or none): when every projector's response
 // and its brightness across the frame are known and `to_content` gives each projector's
 // content map, the projectors are matched per pixel (luminance_match.hpp) into `content`;
-// when every response is known, to the dimmest one's white in linear light; otherwise
+// when every response is known, to the dimmest one's white in linear light (neither
+// when different cameras measured them: each keeps its response, no gain); otherwise
 // every one gets the assumed gamma and no gain. kInvalidInput for a responses or
 // to_content count other than 0 or one per weight image, or weights that are not
 // CV_32FC1; errors of matchLuminance.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
@@ -147,9 +148,16 @@ Result<BrightnessMap> brightnessFromJson(const nlohmann::json& j) {
   for (int k = 0; k < cols * rows; ++k) {
     const auto& e = (*values)[static_cast<std::size_t>(k)];
     const double value = e.is_number() ? e.get<double>() : std::nan("");
-    if (!(std::isfinite(value) && value > 0)) return bad("a node that is not finite and > 0");
-    out.white.at<float>(k / cols, k % cols) = static_cast<float>(value);
+    const auto node = static_cast<float>(value);
+    if (!(std::isfinite(node) && node >= std::numeric_limits<float>::min()))
+      return bad("a node that is not a finite number > 0 (as a float)");
+    out.white.at<float>(k / cols, k % cols) = node;
   }
+  // As measured maps are: no node below a thousandth of the brightest (matching divides
+  // by them).
+  double brightest = 0;
+  cv::minMaxLoc(out.white, nullptr, &brightest);
+  cv::max(out.white, 1e-3 * brightest, out.white);
   return out;
 }
 

@@ -142,7 +142,7 @@ Result<LuminanceMatch> matchLuminance(std::span<const MatchProjector> projectors
   std::vector<char> known(n, 0);
   double sum_before = 0;
   for (std::size_t k = 0; k < n; ++k) {
-    if (!(den[k] > 1e-9) || !(num[k] > 0) || !std::isfinite(bound[k])) continue;
+    if (!(den[k] > 1e-9) || !(num[k] > 0) || !std::isfinite(bound[k]) || !(bound[k] > 0)) continue;
     const double white = num[k] / den[k];
     out.figures.before_min = std::min(out.figures.before_min, white);
     out.figures.before_max = std::max(out.figures.before_max, white);
@@ -187,10 +187,11 @@ Result<LuminanceMatch> matchLuminance(std::span<const MatchProjector> projectors
         float* row = scaled.ptr<float>(y);
         for (int x = 0; x < scaled.cols; ++x) {
           if (row[x] <= 0) continue;
+          // A pixel that shows no content point has no share of the target either.
           const auto q = p.to_content(Vec2(x, y));
-          if (!q) continue;
-          const double share = row[x] * r.at(target, *q) / brightnessAt(*p.brightness, Vec2(x, y));
-          row[x] = static_cast<float>(std::clamp(share, 0.0, 1.0));
+          const double share =
+              q ? row[x] * r.at(target, *q) / brightnessAt(*p.brightness, Vec2(x, y)) : 0.0;
+          row[x] = std::isfinite(share) ? static_cast<float>(std::clamp(share, 0.0, 1.0)) : 0.0f;
         }
       }
     });

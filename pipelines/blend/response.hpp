@@ -10,6 +10,7 @@
 // is brighter than its neighbours' (a global form of Majumder's per-pixel attenuation).
 #include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "blend/brightness_map.hpp"
@@ -31,6 +32,8 @@ struct ProjectorResponse {
   // Its white across the frame, in the same camera's units (per-pixel matching,
   // luminance_match.hpp), when measured.
   std::optional<BrightnessMap> brightness;
+  // The camera that measured it: brightness compares only within one camera's exposure.
+  std::string camera;
 };
 
 // kTooFewPoints without levels 0 and 255 and three levels between them whose

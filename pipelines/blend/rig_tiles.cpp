@@ -42,6 +42,8 @@ std::optional<ProjectorResponse> projectorResponse(const rig::RigProjector& proj
   if (!(r.gamma >= 1 && r.gamma <= 4) || !std::isfinite(r.black) || !(r.white > r.black)) {
     return std::nullopt;
   }
+  if (const auto it = ph.find("camera"); it != ph.end() && it->is_string())
+    r.camera = it->get<std::string>();
   if (const auto it = ph.find("brightness"); it != ph.end()) {
     auto map = brightnessFromJson(*it);
     if (map && map->width == projector.width && map->height == projector.height)

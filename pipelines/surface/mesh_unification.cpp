@@ -108,6 +108,13 @@ Result<UnifyReport> unifyMeshes(std::vector<UnifyProjector>& projectors,
     if (!lu.isInvertible()) return fail(ErrorCode::kInvalidInput, "mesh unification: singular P");
     if (p.mesh.projector.size() != p.mesh.vertices.size())
       return fail(ErrorCode::kInvalidInput, "mesh unification: a pixel for every vertex needed");
+    for (const Vec2& u : p.mesh.projector) {
+      // Pixels are rasterised: they must lie near the frame (a frame's size off at most).
+      if (!u.allFinite() || u.x() < -p.size.width || u.y() < -p.size.height ||
+          u.x() > 2.0 * p.size.width || u.y() > 2.0 * p.size.height)
+        return fail(ErrorCode::kInvalidInput,
+                    "mesh unification: a vertex's pixel is off its frame");
+    }
     auto surface = intersectorOf(p.mesh);
     if (!surface) return tl::unexpected(surface.error());
     centres.push_back(-lu.solve(p.P.col(3)));

@@ -3,7 +3,8 @@
 // meshes (each triangulated on its own) cover the same part of the surface, they do not
 // quite agree, and the projectors then disagree about where content lands. Each vertex
 // of a projector's mesh, the surface point its pixel u lights, becomes the weighted mean
-// of the points every mesh that covers it gives along that pixel's ray,
+// of the points every mesh that covers it gives along the ray from the projector's
+// centre through it (the pixel's ray, to the calibration's reprojection error),
 //   M'(u) = sum_j d_j M_j(u) / sum_k d_k,
 // d_j the distance of the point's pixel in projector j to the nearest pixel j's mesh
 // does not cover (its image edge or a hole). The mean lies on the pixel's own ray, so the
@@ -39,8 +40,9 @@ struct UnifyReport {
 };
 
 // Unifies every mesh in place. kInvalidInput for a framebuffer outside [2, 16384], a
-// singular or non-finite P, a mesh whose vertex and pixel counts differ, out-of-range
-// face indices or options out of range.
+// singular or non-finite P, a mesh whose vertex and pixel counts differ, a pixel that is
+// not finite or lies more than a frame's size off the frame, out-of-range face indices or
+// options out of range.
 Result<UnifyReport> unifyMeshes(std::vector<UnifyProjector>& projectors,
                                 const UnifyOptions& options = {});
 

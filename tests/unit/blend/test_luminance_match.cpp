@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "blend/blend_tables.hpp"
 #include "blend/brightness_map.hpp"
 #include "blend/luminance_match.hpp"
 
@@ -206,6 +207,38 @@ TEST(LuminanceMatch, ProjectorsOfDifferentBrightnessLightASmoothTarget) {
     EXPECT_LE(m->figures.kept, 1.2);
     EXPECT_NEAR(lo / hi, m->figures.after_min / m->figures.after_max, 0.02);
   }
+}
+
+// Brightness compares only within one camera's exposure: responses two cameras measured
+// keep their gammas but are not matched, and the tables say why.
+TEST(LuminanceMatch, ResponsesFromDifferentCamerasAreNotMatched) {
+  const TwoProjectors rig(false);
+  std::vector<std::optional<ProjectorResponse>> responses(2);
+  for (std::size_t t = 0; t < 2; ++t) {
+    ProjectorResponse r;
+    r.gamma = 2.0 + 0.4 * t;
+    r.white = 100.0 + 40.0 * t;
+    r.brightness = t == 0 ? rig.left : rig.right;
+    r.camera = t == 0 ? "cam_a" : "cam_b";
+    responses[t] = r;
+  }
+  std::vector<ContentOf> to_content;
+  for (const auto& p : rig.match) to_content.push_back(p.to_content);
+  auto apart =
+      blendTables({rig.w_left.clone(), rig.w_right.clone()}, responses, to_content, rig.content);
+  ASSERT_TRUE(apart) << apart.error().message;
+  EXPECT_TRUE(apart->different_cameras);
+  EXPECT_FALSE(apart->matched);
+  EXPECT_EQ(apart->gain, std::vector<double>({1.0, 1.0}));
+  EXPECT_EQ(apart->gamma, std::vector<double>({2.0, 2.4}));
+  EXPECT_EQ(matchingJson(*apart)["matching"], "none");
+  // One camera: matched per pixel.
+  responses[1]->camera = "cam_a";
+  auto together =
+      blendTables({rig.w_left.clone(), rig.w_right.clone()}, responses, to_content, rig.content);
+  ASSERT_TRUE(together) << together.error().message;
+  EXPECT_TRUE(together->matched);
+  EXPECT_EQ(matchingJson(*together)["matching"], "per-pixel");
 }
 
 TEST(LuminanceMatch, BadInputIsRefused) {

@@ -4,6 +4,7 @@
 // moves.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "geometry/camera_model.hpp"
@@ -98,6 +99,12 @@ TEST(MeshUnification, BadInputIsRefused) {
   EXPECT_EQ(unifyMeshes(broken).error().code, ErrorCode::kInvalidInput);
   broken = rig;
   broken[0].mesh.projector.pop_back();
+  EXPECT_EQ(unifyMeshes(broken).error().code, ErrorCode::kInvalidInput);
+  broken = rig;
+  broken[0].mesh.projector[3] = Vec2(std::nan(""), 0);
+  EXPECT_EQ(unifyMeshes(broken).error().code, ErrorCode::kInvalidInput);
+  broken = rig;
+  broken[0].mesh.projector[3] = Vec2(1e12, 0);
   EXPECT_EQ(unifyMeshes(broken).error().code, ErrorCode::kInvalidInput);
   broken = rig;
   broken[0].mesh.faces.push_back({0, 1, 1 << 20});

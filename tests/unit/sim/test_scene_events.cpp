@@ -119,8 +119,13 @@ TEST(SceneEvents, EventsThatNameNothingOrDoNothingAreRefused) {
             "rotate_deg"},
            {"[[events]]\nt = -1.0\ntarget = \"proj\"\nmove_m = [0.0, 0.0, 0.1]\n", "t"},
            {"[[events]]\ntarget = \"proj\"\nmove_m = [0.0, 0.0, 0.1]\n", "t"},
-           {"[[events]]\nt = 1.0\ntarget = \"proj\"\nmove_m = [0.0, 0.0, 0.1]\nspin = 3\n",
-            "spin"}}) {
+           {"[[events]]\nt = 1.0\ntarget = \"proj\"\nmove_m = [0.0, 0.0, 0.1]\nspin = 3\n", "spin"},
+           // A camera that shares the wall's name: the event's target is ambiguous.
+           {"[[cameras]]\nname = \"wall\"\nresolution = [64, 48]\n"
+            "intrinsics = { fx = 60.0, fy = 60.0, cx = 31.5, cy = 23.5 }\n"
+            "pose = { position = [0.0, 0.0, 1.0], look_at = [0.0, 3.0, 1.0] }\n"
+            "[[events]]\nt = 1.0\ntarget = \"wall\"\nmove_m = [0.0, 0.01, 0.0]\n",
+            "more than one"}}) {
     auto scene = Scene::parse(eventScene(events), "bad.toml", {});
     ASSERT_FALSE(scene) << events;
     EXPECT_EQ(scene.error().code, ErrorCode::kParse);
