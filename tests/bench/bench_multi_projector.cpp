@@ -7,13 +7,14 @@
 //    refinement, geom::solveHomographyTree; the chain alone is reported beside it). The
 //    projector nodes (every 8 px) the decoder would give, seen with 0.1 px of noise (a
 //    node's scatter under the reference capture conditions). Then the display,
-//    feathering weights and weight tables (blend::makeTiledBlend). Compute time of the
-//    fits and of the display; capture frames of the scans (Gray + phase pattern set and
-//    the 9-level response ramp), one projector at a time and batched (a coarse pass,
-//    then projectors whose footprints do not meet together); the seam error: content
-//    points shown by two projectors, where the TRUE projectors put them on the wall,
-//    apart in projector pixels (RMS, max). Decoding is not included
-//    (bench_structured_light times it per capture set).
+//    feathering weights and weight tables (blend::makeTiledBlend), and the same display
+//    matched per pixel ([Majumder05]) for projectors of known brightness across their
+//    frames (a bowl, peaks 9-13). Compute time of the fits and of the display (both); capture
+//    frames of the scans (Gray + phase pattern set and the 9-level response ramp), one projector at
+//    a time and batched (a coarse pass, then projectors whose footprints do not meet together); the
+//    seam error: content points shown by two projectors, where the TRUE projectors put them on the
+//    wall, apart in projector pixels (RMS, max). Decoding is not included (bench_structured_light
+//    times it per capture set).
 //  - frame time per output at 1920x1080 with blending (alpha mask + weight table in the
 //    final stage) for the homography, lookup and two-pass paths, CPU reference renderer
 //    (and GLES 3 on the surfaceless EGL platform when built), and per frame of N outputs
@@ -39,6 +40,7 @@
 #include "../unit/render/render_test_rig.hpp"   // test camera rigs and surfaces
 #include "bench_timing.hpp"
 #include "bench_warps.hpp"
+#include "blend/brightness_map.hpp"
 #include "blend/rig_tiles.hpp"
 #include "blend/tiled_blend.hpp"
 #include "geometry/homography.hpp"
@@ -132,6 +134,8 @@ int scanBatches(const testing::SyntheticWall& w) {
 struct Calibrated {
   std::vector<blend::DisplayTile> truth, estimated;
   double fit_s = 0, display_s = 0;
+  double matched_display_s = 0;  // the same display matched per pixel ([Majumder05])
+  double uniformity_before = 0, uniformity_after = 0;
   double seam_rms = 0, seam_max = 0;
   long seam_points = 0;
   // Several camera positions: the tree's chain (before the refinement) and its depth.
@@ -255,6 +259,35 @@ Calibrated calibrate(const testing::SyntheticWall& w, bool several_views, std::m
     std::printf("  display: %s\n", made.error().message.c_str());
     return out;
   }
+  // The same display with every projector's response and brightness across its frame
+  // known (a cos^3-like bowl, peaks 9-13 as on tiled_wall): matched per pixel.
+  std::vector<std::optional<blend::ProjectorResponse>> responses;
+  for (std::size_t t = 0; t < out.estimated.size(); ++t) {
+    blend::ProjectorResponse r;
+    r.gamma = 2.2;
+    r.white = 9.0 + 4.0 * double(t % 5) / 4;
+    blend::BrightnessMap map;
+    map.width = out.estimated[t].width;
+    map.height = out.estimated[t].height;
+    map.white = cv::Mat(blend::brightnessNodes(map.height, map.step),
+                        blend::brightnessNodes(map.width, map.step), CV_32FC1);
+    for (int j = 0; j < map.white.rows; ++j) {
+      for (int i = 0; i < map.white.cols; ++i) {
+        const double dx = (i * map.step - 0.5 * map.width) / map.width;
+        const double dy = (j * map.step - 0.5 * map.height) / map.width;
+        map.white.at<float>(j, i) = static_cast<float>(r.white * (1 - 0.4 * (dx * dx + dy * dy)));
+      }
+    }
+    r.brightness = std::move(map);
+    responses.push_back(std::move(r));
+  }
+  const auto t_matched = std::chrono::steady_clock::now();
+  auto matched = blend::makeTiledBlend(out.estimated, responses, cv::Size(1920, 1080));
+  out.matched_display_s = seconds(t_matched);
+  if (matched && matched->matched) {
+    out.uniformity_before = matched->matched->before_min / matched->matched->before_max;
+    out.uniformity_after = matched->matched->after_min / matched->matched->after_max;
+  }
   const Seams s = seams(*made, out.truth, w.pixel_m);
   out.seam_rms = s.rms;
   out.seam_max = s.max;
@@ -360,7 +393,8 @@ int main(int argc, char** argv) {
 
   std::ofstream csv(out / "multi_projector_calibration.csv");
   csv << "projectors,layout,cameras,capture_frames,capture_frames_batched,fit_s,display_s,"
-         "seam_points,seam_rms_px,seam_max_px,chain_views,chain_seam_rms_px,chain_seam_max_px\n";
+         "seam_points,seam_rms_px,seam_max_px,chain_views,chain_seam_rms_px,chain_seam_max_px,"
+         "matched_display_s,uniformity_before,uniformity_after\n";
   std::printf(
       "Calibration on synthetic planar walls (%d capture frames per projector scan; batched: "
       "a coarse pass of N + 1 frames, then projectors whose footprints do not meet scanned "
@@ -377,7 +411,7 @@ int main(int argc, char** argv) {
       const char* cameras = several ? "views_2x2" : "one";
       if (!c.ok) {
         std::printf("  %2d projectors, %s: failed\n", n, cameras);
-        csv << n << ',' << cols << 'x' << rows << ',' << cameras << ",,,,,,,,,,\n";
+        csv << n << ',' << cols << 'x' << rows << ',' << cameras << ",,,,,,,,,,,,,\n";
         continue;
       }
       std::printf(
@@ -389,12 +423,14 @@ int main(int argc, char** argv) {
         std::printf("; %d views, chains of up to %d, chained alone RMS %.4f max %.4f", c.views,
                     c.deepest_chain, c.chain_seam_rms, c.chain_seam_max);
       }
-      std::printf("\n");
+      std::printf("; matched per pixel %.3f s (uniformity %.3f -> %.3f)\n", c.matched_display_s,
+                  c.uniformity_before, c.uniformity_after);
       csv << n << ',' << cols << 'x' << rows << ',' << cameras << ',' << n * frames_per_projector
           << ',' << batched << ',' << c.fit_s << ',' << c.display_s << ',' << c.seam_points << ','
           << c.seam_rms << ',' << c.seam_max << ',' << c.deepest_chain << ','
           << (several ? c.chain_seam_rms : c.seam_rms) << ','
-          << (several ? c.chain_seam_max : c.seam_max) << '\n';
+          << (several ? c.chain_seam_max : c.seam_max) << ',' << c.matched_display_s << ','
+          << c.uniformity_before << ',' << c.uniformity_after << '\n';
     }
   }
   csv.close();
