@@ -27,7 +27,7 @@ struct CurvedInput {
   cv::Size size;
   std::shared_ptr<const void> surface;  // holds `intersector`
   const geom::MeshIntersector* intersector = nullptr;
-  std::optional<blend::ProjectorResponse> response;
+  Daemon::RigResponse response;
 };
 
 // What a display is made for: the content's size, the eye, every output's projector,
@@ -40,9 +40,7 @@ std::string curvedKey(cv::Size content, const Vec3& eye, const std::vector<Curve
     key << ' ' << in.output << ' ' << in.size.width << 'x' << in.size.height << ' '
         << in.surface.get();
     for (int i = 0; i < 12; ++i) key << ' ' << in.projector(i / 4, i % 4);
-    if (in.response) {
-      key << " r " << in.response->gamma << ' ' << in.response->black << ' ' << in.response->white;
-    }
+    key << in.response.key;
   }
   return key.str();
 }
@@ -61,7 +59,7 @@ const KeystoneRuntime::Curved* Daemon::curvedDisplay(cv::Size content, const Vie
     auto surface = rigSurfaceFor(p->name);
     if (!surface) continue;
     inputs.push_back({e.name, p->model().projectionMatrix(), *mode, surface, &surface->intersector,
-                      blend::projectorResponse(*p)});
+                      rigResponse(*p)});
   }
   if (inputs.size() < 2 || content.width < 1 || content.height < 1) {
     k.curved.reset();
@@ -84,7 +82,7 @@ const KeystoneRuntime::Curved* Daemon::curvedDisplay(cv::Size content, const Vie
         std::vector<std::optional<blend::ProjectorResponse>> responses;
         for (const auto& in : inputs) {
           projectors.push_back({in.intersector, in.projector, in.size});
-          responses.push_back(in.response);
+          responses.push_back(in.response.response);
           made->outputs.push_back(in.output);
           made->surfaces.push_back(in.surface);
         }

@@ -59,10 +59,16 @@ class Daemon {
   int run();
 
   // An output whose projector the rig model maps onto a display plane.
+  // A projector's response as rig.json's photometric record gives it (if measured), read
+  // once per rig model, and the part of a display's key it makes.
+  struct RigResponse {
+    std::optional<blend::ProjectorResponse> response;
+    std::string key;
+  };
   struct RigTile {
     std::string output;
     blend::DisplayTile tile;
-    std::optional<blend::ProjectorResponse> response;  // rig.json photometric, if measured
+    RigResponse response;
   };
 
  private:
@@ -146,6 +152,9 @@ class Daemon {
   // tiled_display.cpp: several projectors of the rig on one wall as one display.
   // Usable outputs whose projectors the rig maps onto a display plane, in device order.
   std::vector<RigTile> rigTiles() const;
+  // The projector's RigResponse: parsed when first asked for after the rig changed (its
+  // brightness map has a thousand nodes: not parsed again on every output refresh).
+  const RigResponse& rigResponse(const rig::RigProjector& projector) const;
   // [keystone] display_centre / display_size: the display rectangle the configuration gives.
   std::optional<blend::WorldRect> displayRect() const;
   const KeystoneRuntime::Tiled* tiledDisplay(cv::Size content);
@@ -258,6 +267,9 @@ class Daemon {
   // rig_'s surface meshes by projector name ("" for the unified mesh).
   std::map<std::string, std::shared_ptr<const RigSurfaceMesh>> rig_surfaces_;
   uint64_t rig_generation_ = 0;
+  // rigResponse's, by projector name, for rig_generation_ rig_responses_generation_.
+  mutable std::map<std::string, RigResponse> rig_responses_;
+  mutable uint64_t rig_responses_generation_ = 0;
   std::vector<std::string> warnings_;
   plugins::DriverRegistry registry_;
   std::chrono::steady_clock::time_point started_;

@@ -9,7 +9,9 @@
 // takes about half a second for four 1280x800 outputs) and kept until the content's
 // size, the outputs or the rig change.
 #include <cmath>
+#include <functional>
 #include <sstream>
+#include <string_view>
 
 #include "blend/rig_tiles.hpp"
 #include "blend/tiled_blend.hpp"
@@ -34,10 +36,36 @@ std::vector<Daemon::RigTile> Daemon::rigTiles() const {
     const rig::RigProjector* p = rig_.projectorForOutput(e.name);
     if (!p) continue;
     if (auto tile = blend::displayTile(*p, rig_.surface)) {
-      tiles.push_back({e.name, *tile, blend::projectorResponse(*p)});
+      tiles.push_back({e.name, *tile, rigResponse(*p)});
     }
   }
   return tiles;
+}
+
+const Daemon::RigResponse& Daemon::rigResponse(const rig::RigProjector& projector) const {
+  if (rig_responses_generation_ != rig_generation_) {
+    rig_responses_.clear();
+    rig_responses_generation_ = rig_generation_;
+  }
+  auto it = rig_responses_.find(projector.name);
+  if (it != rig_responses_.end()) return it->second;
+  RigResponse r{blend::projectorResponse(projector), {}};
+  if (r.response) {
+    // What a display is made with: the fitted response, the camera, and the brightness
+    // map (by a digest of its nodes).
+    std::ostringstream key;
+    key.precision(17);
+    key << " r " << r.response->gamma << ' ' << r.response->black << ' ' << r.response->white << ' '
+        << r.response->camera;
+    if (const auto& map = r.response->brightness) {
+      const auto* bytes = map->white.ptr<char>();
+      key << " b " << map->step << ' '
+          << std::hash<std::string_view>{}(
+                 std::string_view(bytes, map->white.total() * map->white.elemSize()));
+    }
+    r.key = key.str();
+  }
+  return rig_responses_.emplace(projector.name, std::move(r)).first->second;
 }
 
 std::optional<blend::WorldRect> Daemon::displayRect() const {
@@ -62,9 +90,7 @@ std::string tiledKey(cv::Size content, const std::vector<Daemon::RigTile>& tiles
     for (int i = 0; i < 9; ++i) key << ' ' << ph.H(i / 3, i % 3);
     key << ' ' << ph.basis.origin.transpose() << ' ' << ph.basis.u.transpose() << ' '
         << ph.basis.v.transpose();
-    if (t.response) {
-      key << " r " << t.response->gamma << ' ' << t.response->black << ' ' << t.response->white;
-    }
+    key << t.response.key;
   }
   if (rect)
     key << " rect " << rect->centre.transpose() << ' ' << rect->width << ' ' << rect->height;
@@ -95,7 +121,7 @@ const KeystoneRuntime::Tiled* Daemon::tiledDisplay(cv::Size content) {
   for (const auto& t : tiles) {
     names.push_back(t.output);
     input.push_back(t.tile);
-    responses.push_back(t.response);
+    responses.push_back(t.response.response);
   }
   blend::TiledDisplayOptions options;
   options.world_rect = displayRect();

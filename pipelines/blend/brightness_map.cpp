@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "blend/grid_fill.hpp"
+#include "blend/node_grid.hpp"
 
 namespace procam::blend {
 namespace {
@@ -16,13 +16,6 @@ constexpr int kMaxFramebuffer = 16384;
 
 int nearestNode(double x, int step, int nodes) {
   return std::clamp(static_cast<int>(std::lround(x / step)), 0, nodes - 1);
-}
-
-// Lower node and weight of the upper one at x along a side.
-std::pair<int, double> between(double x, int pixels, int step, int nodes) {
-  x = std::clamp(x, 0.0, pixels - 1.0);
-  const int i = std::clamp(static_cast<int>(std::floor(x / step)), 0, nodes - 2);
-  return {i, std::clamp((x - i * step) / step, 0.0, 1.0)};
 }
 
 }  // namespace
@@ -99,12 +92,9 @@ Result<BrightnessMap> measureBrightness(const cv::Mat& white, const cv::Mat& bla
 }
 
 double brightnessAt(const BrightnessMap& map, const Vec2& pixel) {
-  const int cols = map.white.cols, rows = map.white.rows;
-  const auto [i, tx] = between(pixel.x(), map.width, map.step, cols);
-  const auto [j, ty] = between(pixel.y(), map.height, map.step, rows);
-  const auto at = [&](int x, int y) { return static_cast<double>(map.white.at<float>(y, x)); };
-  return (1 - ty) * ((1 - tx) * at(i, j) + tx * at(i + 1, j)) +
-         ty * ((1 - tx) * at(i, j + 1) + tx * at(i + 1, j + 1));
+  return sampleNodes(cv::Mat_<float>(map.white),
+                     std::clamp(pixel.x(), 0.0, map.width - 1.0) / map.step,
+                     std::clamp(pixel.y(), 0.0, map.height - 1.0) / map.step);
 }
 
 nlohmann::json brightnessToJson(const BrightnessMap& map) {

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "blend/grid_fill.hpp"
+#include "blend/node_grid.hpp"
 
 namespace procam::blend {
 namespace {
@@ -21,15 +21,8 @@ struct Raster {
   }
   // Bilinear between cell centres, clamped at the raster's edge.
   double at(const std::vector<double>& v, const Vec2& q) const {
-    const double fx = std::clamp((q.x() + 0.5) / cell - 0.5, 0.0, nx - 1.0);
-    const double fy = std::clamp((q.y() + 0.5) / cell - 0.5, 0.0, ny - 1.0);
-    const int i = std::min(static_cast<int>(fx), std::max(nx - 2, 0));
-    const int j = std::min(static_cast<int>(fy), std::max(ny - 2, 0));
-    const int i1 = std::min(i + 1, nx - 1), j1 = std::min(j + 1, ny - 1);
-    const double tx = fx - i, ty = fy - j;
-    const auto c = [&](int x, int y) { return v[static_cast<std::size_t>(y) * nx + x]; };
-    return (1 - ty) * ((1 - tx) * c(i, j) + tx * c(i1, j)) +
-           ty * ((1 - tx) * c(i, j1) + tx * c(i1, j1));
+    const cv::Mat_<double> grid(ny, nx, const_cast<double*>(v.data()));
+    return sampleNodes(grid, (q.x() + 0.5) / cell - 0.5, (q.y() + 0.5) / cell - 0.5);
   }
 };
 
@@ -134,8 +127,6 @@ Result<LuminanceMatch> matchLuminance(std::span<const MatchProjector> projectors
   }
 
   LuminanceMatch out;
-  out.figures.cells_x = r.nx;
-  out.figures.cells_y = r.ny;
   out.figures.before_min = none;
   out.figures.after_min = none;
   std::vector<double> target(n, 0);

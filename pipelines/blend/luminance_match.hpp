@@ -48,7 +48,6 @@ struct LuminanceFigures {
   double before_min = 0, before_max = 0, after_min = 0, after_max = 0;
   double kept = 0;
   double largest_step = 0;  // of T between neighbouring raster cells, per content pixel
-  int cells_x = 0, cells_y = 0;
 };
 
 struct LuminanceMatch {
