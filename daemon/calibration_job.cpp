@@ -7,6 +7,7 @@
 #include <span>
 #include <thread>
 
+#include "calibration/wall_views_route.hpp"
 #include "device_set.hpp"
 #include "latency_probe.hpp"
 #include "output_frames.hpp"
@@ -349,11 +350,9 @@ tl::expected<std::vector<CalibrationOutcome>, CalibrationFailure> runBatchCalibr
     }
     if (wall_views) {
       for (const calib::DecodedView& view : views) {
-        auto nodes = calib::collineationNodes(member.set, view, {.step = member.grid});
-        if (!nodes && nodes.error().code == ErrorCode::kInvalidInput) {
-          return tl::unexpected(CalibrationFailure{code::kFailed, nodes.error().message});
-        }
-        out.wall_nodes.push_back(nodes ? std::optional(std::move(*nodes)) : std::nullopt);
+        auto seen = calib::wallSighting(member.set, view, {.step = member.grid});
+        if (!seen) return tl::unexpected(CalibrationFailure{code::kFailed, seen.error().message});
+        out.wall_nodes.push_back(std::move(seen->nodes));
       }
       continue;
     }
@@ -402,7 +401,10 @@ tl::expected<std::vector<CalibrationOutcome>, CalibrationFailure> runBatchCalibr
 
 namespace {
 
-float percentile(const cv::Mat& m, double q) {
+// Of every other pixel of every other row, in any single-channel depth.
+float percentile(const cv::Mat& image, double q) {
+  cv::Mat m;
+  image.convertTo(m, CV_32F);
   std::vector<float> v;
   for (int y = 0; y < m.rows; y += 2) {
     const float* r = m.ptr<float>(y);
@@ -414,11 +416,12 @@ float percentile(const cv::Mat& m, double q) {
   return v[k];
 }
 
+// White minus black in the captures' own depth, saturated at 0 (light is only ever
+// compared with a threshold above 0): a run of cameras at several positions keeps one per
+// projector and camera until the coarse pass ends.
 cv::Mat lightOf(const cv::Mat& white, const cv::Mat& black) {
-  cv::Mat w, b, diff;
-  white.convertTo(w, CV_32F);
-  black.convertTo(b, CV_32F);
-  cv::subtract(w, b, diff);
+  cv::Mat diff;
+  cv::subtract(white, black, diff);
   return diff;
 }
 
@@ -438,9 +441,7 @@ cv::Mat litMask(const cv::Mat& light, float threshold) {
 // sees too little of it: a 99.5th percentile under 5 % of the white view's.
 cv::Mat litPixels(const cv::Mat& white, const cv::Mat& light) {
   const float top = percentile(light, 0.995);
-  cv::Mat w;
-  white.convertTo(w, CV_32F);
-  if (!(top > 0.05f * percentile(w, 0.995)) || !(top > 0))
+  if (!(top > 0.05f * percentile(white, 0.995)) || !(top > 0))
     return cv::Mat(light.size(), CV_8UC1, cv::Scalar(0));
   return litMask(light, 0.05f * top);
 }
@@ -492,7 +493,8 @@ tl::expected<ScanBatches, CalibrationFailure> planScanBatches(
   // (litPixels' rule would drop a projector's sliver at the edge of a camera's view,
   // under 0.5 % of its pixels, and with it an overlap in that camera).
   const bool shared_level = first.wallViews();
-  std::vector<std::vector<cv::Mat>> lights(plans.size(), std::vector<cv::Mat>(cams));
+  std::vector<std::vector<cv::Mat>> lights(shared_level ? plans.size() : 0,
+                                           std::vector<cv::Mat>(cams));
   std::vector<float> level(cams, 0.0f);
   for (std::size_t i = 0; i < plans.size(); ++i) {
     const CalibrationPlan& p = *plans[i];

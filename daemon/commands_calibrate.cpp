@@ -428,7 +428,7 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
   std::vector<std::string> used;
   json output_names = json::array();
   int captures = 0;
-  std::vector<const CalibrationPlan*> all;
+  std::vector<const CalibrationPlan*> all;  // the plans, kept alive by `plans`
   for (const auto& p : plans) {
     used.push_back(p->output.name);
     output_names.push_back(p->output.name);
@@ -470,7 +470,7 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
   const CalibrationHooks hooks = operationHooks(client, op_id, cancelled, progress);
   using Outcomes = tl::expected<std::vector<CalibrationOutcome>, Failure>;
   compute_worker_->submit(
-      [this, client, req, op_id, cancelled, plans, idle, progress, hooks, fence, captures,
+      [this, client, req, op_id, cancelled, plans, all, idle, progress, hooks, fence, captures,
        batching] {
         fence.wait();
         // The projectors one after the other; progress over the whole run.
@@ -489,8 +489,6 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
         // together (calibration_job.hpp planScanBatches); one at a time otherwise.
         ScanBatches scan;
         if (batching && result) {
-          std::vector<const CalibrationPlan*> all;
-          for (const auto& p : plans) all.push_back(p.get());
           // Its progress: a share of the run's captures.
           const CalibrationHooks coarse{
               hooks.cancelled, [&](const CalibrationProgress& p) {
@@ -546,8 +544,6 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
         json wall;
         if (result && !cancelled->load() && plans.front()->wallViews()) {
           hooks.progress({0.97, "solving", done});
-          std::vector<const CalibrationPlan*> all;
-          for (const auto& p : plans) all.push_back(p.get());
           auto solved = solveWallViewsRun(all, *result);
           if (solved) {
             wall = wallViewsJson(*solved, all);
@@ -558,8 +554,6 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
         // Route (a) over several projectors: their meshes agree where they overlap.
         json unified;
         if (result && !cancelled->load() && plans.size() > 1) {
-          std::vector<const CalibrationPlan*> all;
-          for (const auto& p : plans) all.push_back(p.get());
           // A failure keeps the meshes as triangulated: the run is not lost for it.
           auto made = unifyRunMeshes(all, *result);
           unified = made ? std::move(*made) : json{{"skipped", made.error().message}};

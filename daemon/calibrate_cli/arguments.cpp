@@ -128,4 +128,14 @@ bool isFileSafeName(const std::string& name) {
              std::string::npos;
 }
 
+Result<int> stepOption(const Arguments& a) {
+  const auto s = a.optional("step");
+  if (!s) return 8;
+  auto v = toInt(*s, "--step");
+  if (!v) return v;
+  if (*v < 1 || *v > 1024)
+    return fail(ErrorCode::kInvalidInput, kCommandLine + "--step takes 1 to 1024");
+  return *v;
+}
+
 }  // namespace procam::cli

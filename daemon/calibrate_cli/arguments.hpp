@@ -39,6 +39,8 @@ inline const std::string kCommandLine = "command line: ";
 bool isCommandLineError(const Error& e);
 
 Result<int> toInt(const std::string& text, const std::string& what);
+// --step: projector pixels between grid nodes, 1 to 1024 (default 8).
+Result<int> stepOption(const Arguments& a);
 Result<double> toDouble(const std::string& text, const std::string& what);
 // "WxH"
 Result<std::pair<int, int>> toSize(const std::string& text, const std::string& what);

@@ -57,11 +57,6 @@ Result<calib::StereoRouteResult> stereoRoute(const sl::PatternSet& set,
   return calib::solveStereoRoute(set, views[0], views[1], step);
 }
 
-Result<int> stepOption(const Arguments& a) {
-  if (auto s = a.optional("step")) return toInt(*s, "--step");
-  return 8;
-}
-
 Result<void> writeRig(const fs::path& out, const std::vector<NamedCamera>& cameras,
                       const NamedProjector& projector, const nlohmann::json& surface) {
   const nlohmann::json j = rig::rigJson(cameras, projector, surface);

@@ -41,14 +41,8 @@ Result<void> runSolveWall(const Arguments& a) {
     if (!*r) return tl::unexpected(r->error());
   auto plane = planeOption(*plane_text);
   if (!plane) return tl::unexpected(plane.error());
-  int step = 8;
-  if (auto s = a.optional("step")) {
-    auto v = toInt(*s, "--step");
-    if (!v) return tl::unexpected(v.error());
-    if (*v < 1 || *v > 1024)
-      return fail(ErrorCode::kInvalidInput, kCommandLine + "--step takes 1 to 1024");
-    step = *v;
-  }
+  auto step = stepOption(a);
+  if (!step) return tl::unexpected(step.error());
   if (a.groups().empty() || a.groups().size() > 64)
     return fail(
         ErrorCode::kInvalidInput,
@@ -68,7 +62,7 @@ Result<void> runSolveWall(const Arguments& a) {
   std::vector<std::string> names;
   std::vector<std::pair<int, int>> sizes;
   std::vector<calib::WallNodes> nodes;
-  const calib::WallViewsOptions options{.nodes = {.step = step}, .reference_camera = reference};
+  const calib::WallViewsOptions options{.nodes = {.step = *step}, .reference_camera = reference};
   for (const Arguments& g : a.groups()) {
     if (auto ok = g.only({"projector", "patterns", "captures"}); !ok) return ok;
     auto name = g.one("projector");
@@ -106,17 +100,15 @@ Result<void> runSolveWall(const Arguments& a) {
       }
       if (!decoded) return tl::unexpected(decoded.error());
       const calib::DecodedView view{camera.name, camera.model, std::move(*decoded)};
-      auto found = calib::collineationNodes(*set, view, options.nodes);
-      if (!found && found.error().code == ErrorCode::kInvalidInput)
-        return tl::unexpected(found.error());
-      if (!found) {
-        progress("  camera " + camera.name + " left out for " + *name + ": " +
-                 found.error().message);
+      auto seen = calib::wallSighting(*set, view, options.nodes);
+      if (!seen) return tl::unexpected(seen.error());
+      if (!seen->nodes) {
+        progress("  camera " + camera.name + " left out for " + *name + ": " + seen->why);
         continue;
       }
-      progress("  camera " + camera.name + " sees " + std::to_string(found->projector.size()) +
-               " nodes of " + *name);
-      nodes.push_back({p, c, std::move(*found)});
+      progress("  camera " + camera.name + " sees " +
+               std::to_string(seen->nodes->projector.size()) + " nodes of " + *name);
+      nodes.push_back({p, c, std::move(*seen->nodes)});
     }
   }
   const rig::NamedCamera& ref = (*cameras)[reference];

@@ -4,6 +4,16 @@
 #include <string>
 
 namespace procam::calib {
+
+Result<WallSighting> wallSighting(const sl::PatternSet& set, const DecodedView& view,
+                                  const PlaneHomographyOptions& options) {
+  auto nodes = collineationNodes(set, view, options);
+  if (!nodes && nodes.error().code == ErrorCode::kInvalidInput)
+    return tl::unexpected(nodes.error());
+  if (!nodes) return WallSighting{std::nullopt, nodes.error().message};
+  return WallSighting{std::move(*nodes), {}};
+}
+
 Result<WallViewsResult> solveWallViews(std::span<const std::pair<int, int>> projector_sizes,
                                        std::size_t cameras, std::span<const WallNodes> nodes,
                                        const geom::CameraModel& reference,

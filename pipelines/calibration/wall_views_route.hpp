@@ -7,6 +7,7 @@
 // least-squares refinement), so a wall larger than any one camera's view is calibrated
 // in one frame without error accumulating along the chain of cameras.
 #include <cstddef>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -25,6 +26,16 @@ struct WallNodes {
   std::size_t projector = 0, camera = 0;
   CollineationNodes nodes;
 };
+
+// What one camera at one position saw of one projector's scan: its nodes, or none (and
+// why) when it saw too little of that projector to count — no failure for a camera that
+// sees only part of the wall. kInvalidInput (bad input) passes through.
+struct WallSighting {
+  std::optional<CollineationNodes> nodes;
+  std::string why;  // when there are none
+};
+Result<WallSighting> wallSighting(const sl::PatternSet& set, const DecodedView& view,
+                                  const PlaneHomographyOptions& options = {});
 
 struct WallViewsOptions {
   PlaneHomographyOptions nodes;      // node step, RANSAC threshold, min_points per sighting

@@ -95,12 +95,13 @@ TEST(WallViewsRoute, TwoCamerasThatEachSeeHalfCalibrateTheWholeWall) {
       // lens) and no pose.
       if (c != 0) model.pose = geom::Pose{};
       const calib::DecodedView view{state.cameras[c].spec.name, model, std::move(*d)};
-      auto seen = calib::collineationNodes(*set, view);
+      auto seen = calib::wallSighting(*set, view);
+      ASSERT_TRUE(seen) << seen.error().message;
       const std::string what =
-          seen ? std::to_string(seen->projector.size()) + " nodes" : seen.error().message;
+          seen->nodes ? std::to_string(seen->nodes->projector.size()) + " nodes" : seen->why;
       std::printf("[ figures  ] %s sees %s: %s\n", state.cameras[c].spec.name.c_str(),
                   proj.spec.name.c_str(), what.c_str());
-      if (seen) nodes.push_back({p, c, std::move(*seen)});
+      if (seen->nodes) nodes.push_back({p, c, std::move(*seen->nodes)});
     }
     sizes.emplace_back(set->options.width, set->options.height);
   }
