@@ -144,18 +144,17 @@ tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const json& requ
   if (auto it = request.find("plane"); it != request.end()) {
     // a x + b y + c z + d = 0 in the world frame, as rig.json's surface.plane.
     const bool numbers =
-        it->is_array() && it->size() == 4 && std::all_of(it->begin(), it->end(), [](const json& v) {
-          return v.is_number() && std::isfinite(v.get<double>());
-        });
-    const Vec3 n =
-        numbers ? Vec3((*it)[0].get<double>(), (*it)[1].get<double>(), (*it)[2].get<double>())
-                : Vec3::Zero();
-    if (!numbers || !(n.norm() > 1e-9)) {
+        it->is_array() && it->size() == 4 &&
+        std::all_of(it->begin(), it->end(), [](const json& v) { return v.is_number(); });
+    if (numbers) {
+      a.plane = geom::planeFromCoefficients((*it)[0].get<double>(), (*it)[1].get<double>(),
+                                            (*it)[2].get<double>(), (*it)[3].get<double>());
+    }
+    if (!a.plane) {
       return tl::unexpected(std::string(
           "\"plane\" must be 4 finite numbers [a, b, c, d] (a x + b y + c z + d = 0, world "
           "metres) with a non-zero normal"));
     }
-    a.plane = geom::Plane{n / n.norm(), (*it)[3].get<double>() / n.norm()};
   }
   if (auto it = request.find("board"); it != request.end()) {
     auto spec = boardArg(*it);

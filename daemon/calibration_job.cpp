@@ -551,19 +551,20 @@ tl::expected<ScanBatches, CalibrationFailure> planScanBatches(
   // Seen: every camera sees some of its light (one that does not is scanned alone, and
   // fails or succeeds as it would have); with cameras at several positions, some camera
   // does (each sees only part of the wall).
-  auto seen = [&](std::size_t i) {
+  std::vector<char> seen(plans.size(), 0);  // once per projector, not per batch tried
+  for (std::size_t i = 0; i < plans.size(); ++i) {
     bool any = false, all = !out.footprints[i].empty();
     for (const cv::Mat& m : out.footprints[i]) {
       const bool lit = !m.empty() && cv::countNonZero(m) > 0;
       any = any || lit;
       all = all && lit;
     }
-    return plans[i]->wallViews() ? any : all;
-  };
+    seen[i] = plans[i]->wallViews() ? any : all;
+  }
   for (std::size_t i = 0; i < plans.size(); ++i) {
     // At several positions a projector no camera sees ends the run here, not after
     // every other projector's scan.
-    if (plans[i]->wallViews() && !seen(i)) {
+    if (plans[i]->wallViews() && !seen[i]) {
       return tl::unexpected(CalibrationFailure{
           code::kFailed, "output '" + plans[i]->output.name +
                              "': none of the cameras sees its light (the coarse pass showed "
@@ -571,9 +572,9 @@ tl::expected<ScanBatches, CalibrationFailure> planScanBatches(
     }
     bool placed = false;
     for (auto& batch : out.batches) {
-      bool fits = seen(i);
+      bool fits = seen[i];
       for (std::size_t j : batch) {
-        fits = fits && seen(j) && batchable(*plans[i], *plans[j]) && !overlap(i, j);
+        fits = fits && seen[j] && batchable(*plans[i], *plans[j]) && !overlap(i, j);
       }
       if (fits) {
         batch.push_back(i);

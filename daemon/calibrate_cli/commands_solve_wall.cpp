@@ -21,13 +21,13 @@ Result<geom::Plane> planeOption(const std::string& text) {
     if (!x) return tl::unexpected(x.error());
     v.push_back(*x);
   }
-  const Vec3 n = v.size() == 4 ? Vec3(v[0], v[1], v[2]) : Vec3::Zero();
-  if (!(n.norm() > 1e-9))
+  auto plane = v.size() == 4 ? geom::planeFromCoefficients(v[0], v[1], v[2], v[3]) : std::nullopt;
+  if (!plane)
     return fail(ErrorCode::kInvalidInput,
                 kCommandLine +
                     "--plane takes a,b,c,d (a x + b y + c z + d = 0, metres) with a "
                     "non-zero normal");
-  return geom::Plane{n / n.norm(), v[3] / n.norm()};
+  return *plane;
 }
 
 }  // namespace

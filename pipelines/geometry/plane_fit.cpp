@@ -108,6 +108,13 @@ Plane orientedPlane(Vec3 n, const Vec3& point_on_plane) {
   return Plane{n, -n.dot(point_on_plane)};
 }
 
+std::optional<Plane> planeFromCoefficients(double a, double b, double c, double d) {
+  const Vec3 n(a, b, c);
+  const double norm = n.norm();
+  if (!n.allFinite() || !std::isfinite(d) || !(norm > 1e-9)) return std::nullopt;
+  return Plane{n / norm, d / norm};
+}
+
 Result<PlaneFit> fitPlane(std::span<const Vec3> points) {
   if (auto ok = checkPoints(points); !ok) return tl::unexpected(ok.error());
   std::vector<std::uint32_t> all(points.size());

@@ -2,6 +2,7 @@
 // Planes: least-squares and RANSAC fits ([Raskar02] §4.1.1 coplanarity, §7.3 planar
 // display surfaces).
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -26,6 +27,10 @@ struct PlaneFit {
 // The plane through `point_on_plane` with unit normal `n`, oriented the way every
 // plane procamd writes is: the largest-magnitude component of n is positive.
 Plane orientedPlane(Vec3 n, const Vec3& point_on_plane);
+
+// The plane a x + b y + c z + d = 0 with its normal made unit length; nullopt when a
+// coefficient is not finite or (a, b, c) is (nearly) zero.
+std::optional<Plane> planeFromCoefficients(double a, double b, double c, double d);
 
 // kDegenerate for coincident or collinear points (extent ratio < 1e-9 or within the
 // rounding of the coordinates) and for isotropic sets with no unique best plane.

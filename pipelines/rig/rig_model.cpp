@@ -248,10 +248,8 @@ Result<void> surfaceFrom(const json& s, RigModel& rig, const std::string& where)
   if (s.contains("plane")) {
     auto v = numbers(s, "plane", 4, where + " surface");
     if (!v) return tl::unexpected(v.error());
-    Vec3 n((*v)[0], (*v)[1], (*v)[2]);
-    const double norm = n.norm();
-    if (!(norm > 1e-9)) return fail(ErrorCode::kParse, where + ": surface plane has no normal");
-    rig.surface.plane = geom::Plane{n / norm, (*v)[3] / norm};
+    rig.surface.plane = geom::planeFromCoefficients((*v)[0], (*v)[1], (*v)[2], (*v)[3]);
+    if (!rig.surface.plane) return fail(ErrorCode::kParse, where + ": surface plane has no normal");
     rig.surface.plane_rms_m = numberField(s, "rms_m", -1);
   }
   if (s.contains("mesh")) {  // version 1: the mesh of the one projector

@@ -70,12 +70,6 @@ sl::Decoded copyOf(const sl::Decoded& d) {
   return c;
 }
 
-// Largest distance, in projector pixels, between each framebuffer corner and where
-// the true projector sees the plane point the route maps it to.
-double cornerErrorPx(const calib::PlaneHomographyResult& r, const geom::CameraModel& projector) {
-  return procam::testing::planeCornerErrorPx(r.projector_to_plane, projector);
-}
-
 TEST(PlaneHomographyRoute, ExactMapGivesTheProjectorsCollineation) {
   const auto projector = procam::testing::squarePixelProjector();
   const auto camera = procam::testing::camera640();
@@ -88,7 +82,7 @@ TEST(PlaneHomographyRoute, ExactMapGivesTheProjectorsCollineation) {
   // Exact maps, stored as float32 (1e-4 px at 1024): the sampler's local affine
   // fits and the rounding leave hundredths of a pixel at most.
   EXPECT_LT(r->rms_projector_px, 0.01);
-  EXPECT_LT(cornerErrorPx(*r, projector), 0.01);
+  EXPECT_LT(procam::testing::planeCornerErrorPx(r->projector_to_plane, projector), 0.01);
   // The basis is upright (world +Z up), on the camera's side of the wall.
   const geom::PlaneBasis& b = r->projector_to_plane.basis;
   EXPECT_NEAR(b.u.z(), 0, 1e-12);
@@ -112,10 +106,10 @@ TEST(PlaneHomographyRoute, NoiseAndWrongCodesStayWithinTheKeystoneBound) {
   auto r = calib::solvePlaneHomographyRoute(patternSet(projector), view, kWall);
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_LT(r->inliers, r->samples);  // the patch's nodes were rejected
-  EXPECT_LT(cornerErrorPx(*r, projector), 0.5);
+  EXPECT_LT(procam::testing::planeCornerErrorPx(r->projector_to_plane, projector), 0.5);
   std::printf("[ figures  ] corner %.4f px, RMS %.4f camera px, %.4f projector px, %zu of %zu\n",
-              cornerErrorPx(*r, projector), r->rms_camera_px, r->rms_projector_px, r->inliers,
-              r->samples);
+              procam::testing::planeCornerErrorPx(r->projector_to_plane, projector),
+              r->rms_camera_px, r->rms_projector_px, r->inliers, r->samples);
 }
 
 TEST(PlaneHomographyRoute, TypedErrors) {
