@@ -222,13 +222,15 @@ void parseLimits(Checker& c, const toml::table& t, Config& cfg) {
 void parseKeystone(Checker& c, const toml::table& t, Config& cfg) {
   c.onlyKnown(t, "keystone.",
               {"cutoff_hz", "hysteresis_deg", "poll_hz", "mount", "accel_offset_g", "accel_scale",
-               "display_centre", "display_size"});
+               "display_centre", "display_size", "camera_yaw", "yaw_frames"});
   KeystoneConfig& k = cfg.keystone;
   if (auto* n = t.get("cutoff_hz")) c.number(*n, "keystone.cutoff_hz", 0.01, 1000.0, k.cutoff_hz);
   if (auto* n = t.get("hysteresis_deg")) {
     c.number(*n, "keystone.hysteresis_deg", 0.0, 10.0, k.hysteresis_deg);
   }
   if (auto* n = t.get("poll_hz")) c.number(*n, "keystone.poll_hz", 1.0, 1000.0, k.poll_hz);
+  if (auto* n = t.get("camera_yaw")) c.boolean(*n, "keystone.camera_yaw", k.camera_yaw);
+  if (auto* n = t.get("yaw_frames")) c.integer(*n, "keystone.yaw_frames", 1, 256, k.yaw_frames);
   if (auto* n = t.get("mount")) {
     std::array<double, 9> m{};
     if (numbers(c, *n, "keystone.mount", -1.0, 1.0, m)) k.mount = m;

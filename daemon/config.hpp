@@ -34,6 +34,11 @@ struct KeystoneConfig {
   double cutoff_hz = 10.0;       // tilt low-pass cut-off
   double hysteresis_deg = 0.02;  // re-solve only when gravity turns by more than this
   double poll_hz = 100.0;        // timer rate for tilt sensors without a poll fd
+  // The yaw a tilt sensor cannot see, from the camera mounted on the projector (rig.json
+  // `attached_to`): at each still hold the projector shows a dot grid for `yaw_frames`
+  // camera frames ([Raskar02] §6.2.2).
+  bool camera_yaw = true;
+  int yaw_frames = 64;
   // Sensor -> projector mounting (row i = sensor axis i in projector axes) and the
   // six-position accelerometer calibration (offset in g, per-axis gain); the
   // virtual rig takes the mount from its scene and calibrates at start.

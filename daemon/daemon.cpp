@@ -28,6 +28,7 @@ Daemon::Daemon(DaemonOptions options) : options_(std::move(options)) {}
 
 Daemon::~Daemon() {
   for (auto& [id, op] : operations_) op.cancelled->store(true);  // a running job stops early
+  stopCameraYaw();                                               // so does the yaw's
   server_.reset();
   io_worker_.reset();  // a state write in progress ends first
   compute_worker_.reset();

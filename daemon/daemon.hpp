@@ -140,10 +140,27 @@ class Daemon {
   Result<void> setAutoKeystone(bool enable);
   void watchTiltSensor();
   void stopTiltPolling();
-  void onTiltSample(const procam_tilt_sample& sample);
+  void onTiltSample(const TiltReading& reading);
+  // The gyroscope's reading with a tilt sample: the bias while still, the orientation
+  // carried while moving (daemon_camera_yaw.cpp).
+  void onGyroRate(const procam_rate_sample& rate, const Vec3& specific_force, bool was_still);
   void accelCalibrationStep(ClientId client, const proto::Request& req, const std::string& action);
   void requestSolve();
   std::optional<Mat3> currentWarp(cv::Size content_size) const;
+  // daemon_camera_yaw.cpp: the yaw from the camera mounted on the projector.
+  void probeCameraYaw();
+  // A still hold ended (the filter's or the gyroscope's word), or one may start.
+  void endTiltHold(bool was_still);
+  void forgetTiltHold();
+  void startTiltHold();
+  void measureCameraYaw();
+  void stopCameraYaw();
+  // The orientation of the keystone solve for `down`: with the camera's yaw when one was
+  // measured; nullopt: gravity alone (yaw 0).
+  std::optional<Mat3> keystoneOrientation(const Vec3& down) const;
+  nlohmann::json cameraYawJson() const;
+  nlohmann::json gyroJson() const;      // null without a gyroscope
+  std::string cameraYawSource() const;  // where keystoneOrientation's yaw comes from
   // keystone_rig.cpp: keystone from the rig model's plane mapping.
   Result<keystone::KeystoneSolution> solveRigKeystone(cv::Size content) const;
   std::optional<Mat3> rigKeystoneWarp(cv::Size content) const;  // when on and solvable

@@ -113,6 +113,7 @@ void Daemon::useKeystoneInputs(ProjectorModel projector, TiltMount mount) {
   k.tracker = std::move(*tracker);
   k.projector = std::move(projector);
   k.unavailable.clear();
+  probeCameraYaw();
   if (settings_.auto_keystone) {
     if (auto ok = setAutoKeystone(true); !ok) warn(ok.error().message);
   }
@@ -125,6 +126,11 @@ Result<void> Daemon::setAutoKeystone(bool enable) {
   settings_.auto_keystone = enable;
   if (!enable || !k.tracker) {
     stopTiltPolling();
+    stopCameraYaw();
+    k.yaw.normal.reset();
+    k.yaw.tried_this_hold = false;
+    if (k.gyro) k.gyro->stop();
+    k.gyro_anchor.reset();
     k.down.reset();
     k.estimate.reset();
     k.solve_again = false;
@@ -155,12 +161,17 @@ void Daemon::stopTiltPolling() {
   k.poll_timer = -1;
   k.listening = false;
   if (k.tracker) k.tracker->reset();
+  // The samples stop: no hold, no turn carries on into the next ones.
+  forgetTiltHold();
+  if (k.gyro) k.gyro->stop();
+  k.gyro_anchor.reset();
+  k.gyro_last_ns = 0;
 }
 
 void Daemon::watchTiltSensor() {
   device_manager_->onReading([this](const DeviceEntry& e, const Reading& r) {
     if (e.name != keystone_rt_.tilt_device || !keystone_rt_.listening) return;
-    if (const auto* s = std::get_if<procam_tilt_sample>(&r)) onTiltSample(*s);
+    if (const auto* s = std::get_if<TiltReading>(&r)) onTiltSample(*s);
   });
   device_manager_->onDeviceRemoved([this](const DeviceEntry& e) {
     KeystoneRuntime& k = keystone_rt_;
@@ -176,15 +187,24 @@ void Daemon::watchTiltSensor() {
   });
 }
 
-void Daemon::onTiltSample(const procam_tilt_sample& sample) {
+void Daemon::onTiltSample(const TiltReading& reading) {
   KeystoneRuntime& k = keystone_rt_;
   if (!k.tracker) return;
+  const procam_tilt_sample& sample = reading.sample;
   const Vec3 f(sample.specific_force[0], sample.specific_force[1], sample.specific_force[2]);
-  if (auto down = k.tracker->add(f, sample.timestamp_ns)) {
+  const bool was_still = k.tracker->still();
+  const auto down = k.tracker->add(f, sample.timestamp_ns);
+  if (down) {
     k.down = *down;
     k.down_time = static_cast<double>(sample.timestamp_ns) * 1e-9;
-    requestSolve();
   }
+  // A hold that ended takes its wall normal along; the gyroscope then gives this
+  // sample's turn, so that a solve made for this sample's time uses it; a new hold
+  // starts the camera's look after that solve.
+  endTiltHold(was_still);
+  if (reading.rate) onGyroRate(*reading.rate, f, was_still);
+  if (down) requestSolve();
+  startTiltHold();
 }
 
 void Daemon::requestSolve() {
@@ -198,15 +218,19 @@ void Daemon::requestSolve() {
   if (content.width < 1 || content.height < 1) return;
   k.solving = true;
   compute_worker_->submit(
-      [this, projector = *k.projector, down = *k.down, time = k.down_time, content] {
-        auto e = solveFromDown(projector, down, content.width, content.height);
+      [this, projector = *k.projector, down = *k.down, time = k.down_time, content,
+       R = keystoneOrientation(*k.down), yaw_source = cameraYawSource()] {
+        auto e =
+            R ? keystone::solveFromOrientation(projector, *R, down, content.width, content.height)
+              : solveFromDown(projector, down, content.width, content.height);
         if (e) e->sample_time = time;
-        return [this, e = std::move(e)] {
+        return [this, e = std::move(e), yaw_source] {
           KeystoneRuntime& k = keystone_rt_;
           k.solving = false;
           if (settings_.auto_keystone) {
             if (e) {
               k.estimate = *e;
+              k.estimate_yaw = yaw_source;
               ++k.solves;
               broadcast("keystone", keystoneJson());
               refreshOutputs();
@@ -293,6 +317,8 @@ json Daemon::keystoneJson() const {
     const auto& e = *k.estimate;
     j["estimate"] = {{"pitch_deg", radToDeg(e.angles.pitch)},
                      {"roll_deg", radToDeg(e.angles.roll)},
+                     {"yaw_deg", radToDeg(e.angles.yaw)},
+                     {"yaw_source", k.estimate_yaw},
                      {"down", {e.down.x(), e.down.y(), e.down.z()}},
                      {"scale", e.scale},
                      {"sample_time", e.sample_time},
@@ -317,6 +343,8 @@ json Daemon::keystoneJson() const {
                   {{"source", k.tracker->mount().calibration_source},
                    {"offset_g", {off.x(), off.y(), off.z()}}}}};
     if (k.calibration_rms_g >= 0) j["tilt"]["calibration"]["rms_g"] = k.calibration_rms_g;
+    j["tilt"]["yaw"] = cameraYawJson();
+    j["tilt"]["gyro"] = gyroJson();
     // The driver's sample gate counts (procam_tilt_ops::get_counts), when it has them.
     const DeviceEntry* tilt = self->devices_.find(k.tilt_device);
     if (auto c = tilt && tilt->usable() ? plugins::tiltCounts(tilt->device.raw()) : std::nullopt) {
@@ -511,6 +539,7 @@ void Daemon::onRigChanged() {
   const rig::RigProjector* p = out ? rig_.projectorForOutput(out->name) : nullptr;
   if (!p || !p->intrinsics_known) return;
   k.projector = projectorModel(*p);
+  probeCameraYaw();  // the camera's pose relative to the projector may be new
 }
 
 }  // namespace procam::daemon

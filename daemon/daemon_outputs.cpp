@@ -168,6 +168,13 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done, bool supersede
   }
   auto waiters = std::move(k.frame_waiters);
   k.frame_waiters.clear();
+  // The camera's yaw measurement shows its dot grid for a few seconds: what waits for a
+  // frame is drawn when it ends. A calibration shows its own frames for a long run.
+  if (k.yaw.measuring) {
+    k.frame_waiters.insert(k.frame_waiters.end(), std::make_move_iterator(waiters.begin()),
+                           std::make_move_iterator(waiters.end()));
+    return;
+  }
   if (calibrating()) {
     for (auto& w : waiters) w(false);
     return;

@@ -24,9 +24,10 @@ DeviceManager::ReadResult DeviceManager::readOnce(const procam_device& raw, proc
   std::array<char, 256> err{};
   switch (family) {
     case PROCAM_FAMILY_TILT: {
-      procam_tilt_sample s{};
-      r.rc = raw.ops.tilt->read(raw.self, &s, err.data(), err.size() - 1);
-      r.reading = s;
+      TiltReading t;
+      r.rc = raw.ops.tilt->read(raw.self, &t.sample, err.data(), err.size() - 1);
+      if (r.rc == PROCAM_OK) t.rate = plugins::tiltRate(raw);
+      r.reading = t;
       break;
     }
     case PROCAM_FAMILY_TRACKER: {

@@ -14,6 +14,7 @@
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 #include <string>
 #include <variant>
@@ -41,8 +42,15 @@ struct CameraFrame {
   uint64_t timestamp_ns = 0;  // CLOCK_MONOTONIC
 };
 
+// A tilt sample and, when the sensor's package has a gyroscope, its reading taken with
+// it (read on the same worker, right after the sample).
+struct TiltReading {
+  procam_tilt_sample sample{};
+  std::optional<procam_rate_sample> rate;
+};
+
 // What a device produced when read.
-using Reading = std::variant<procam_tilt_sample, procam_pose_sample, CameraFrame>;
+using Reading = std::variant<TiltReading, procam_pose_sample, CameraFrame>;
 
 struct DeviceManagerOptions {
   // Enumerate with libudev and follow hotplug (off on the virtual rig, whose

@@ -18,6 +18,8 @@
 #include "blend/tiled_blend.hpp"
 #include "content_mesh.hpp"
 #include "driver.hpp"
+#include "keystone/dot_grid.hpp"
+#include "keystone/gyro_orientation.hpp"
 #include "output_frames.hpp"
 #include "render/cpu_renderer.hpp"
 
@@ -35,10 +37,42 @@ struct KeystoneRuntime {
   bool listening = false;            // samples of tilt_device feed the tracker
   int poll_timer = -1;               // DeviceManager::pollEvery id, for sensors without a poll fd
 
+  // The yaw from the camera mounted on the projector (daemon_camera_yaw.cpp): measured
+  // once per still hold; the hold's wall normal is fused with every gravity published
+  // in that hold, and its yaw kept while the projector moves until the next hold.
+  struct CameraYaw {
+    std::string camera;              // the camera device; empty: none
+    std::string output;              // where the dot grid is shown
+    geom::CameraModel in_projector;  // K, distortion; pose: camera from projector
+    std::string unavailable;         // why the yaw is not measured (empty: it is)
+    std::shared_ptr<const keystone::DotGrid> grid;
+    bool measuring = false;
+    std::shared_ptr<std::atomic<bool>> stop;  // of the measurement running
+    bool tried_this_hold = false;
+    std::optional<Vec3> normal;  // this hold's wall normal, projector frame
+    std::optional<double> yaw;   // rad, kept after the hold ends
+    uint64_t measurements = 0, failures = 0;
+    nlohmann::json last;  // the last measurement, as reported
+  };
+  CameraYaw yaw;
+
+  // The gyroscope in the tilt sensor's package (daemon_camera_yaw.cpp): its bias from
+  // the still holds, and while the projector moves the orientation it carries from the
+  // last still one.
+  keystone::GyroBias gyro_bias;
+  std::optional<keystone::GyroOrientation> gyro;
+  std::optional<Mat3> gyro_anchor;  // the last orientation held still by both sensors
+  uint64_t gyro_anchor_ns = 0;
+  Vec3 gyro_anchor_rate = Vec3::Zero();
+  uint64_t gyro_samples = 0;
+  uint64_t gyro_last_ns = 0;
+  Vec3 gyro_rate = Vec3::Zero();  // the last reading, projector frame, rad/s
+
   // The last published gravity and the solution made from it.
   std::optional<Vec3> down;
   double down_time = 0;
   std::optional<KeystoneEstimate> estimate;
+  std::string estimate_yaw;  // where its yaw came from (cameraYawSource)
   bool solving = false;
   bool solve_again = false;
   uint64_t solves = 0;

@@ -245,6 +245,23 @@ std::optional<procam_tilt_counts> tiltCounts(const procam_device& d) {
   return c;
 }
 
+// read_rate came with version 3 of the tilt table.
+constexpr uint32_t kTiltRateVersion = 3;
+
+std::optional<procam_rate_sample> tiltRate(const procam_device& d) {
+  if (d.family != PROCAM_FAMILY_TILT || !d.ops.tilt || d.ops.tilt->version < kTiltRateVersion ||
+      !d.ops.tilt->read_rate) {
+    return std::nullopt;
+  }
+  procam_rate_sample r{};
+  char err[128] = {0};
+  if (d.ops.tilt->read_rate(d.self, &r, err, sizeof err - 1) != PROCAM_OK) return std::nullopt;
+  for (double w : r.angular_velocity) {
+    if (!std::isfinite(w)) return std::nullopt;
+  }
+  return r;
+}
+
 uint64_t rejectedSamples(const procam_tilt_counts& c) {
   return c.not_finite + c.out_of_range + c.stuck + c.bad_norm;
 }

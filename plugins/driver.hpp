@@ -98,5 +98,9 @@ std::optional<procam_camera_settings> cameraSettings(const procam_device& device
 std::optional<procam_tilt_counts> tiltCounts(const procam_device& device);
 // The samples those counts say the driver rejected, for every reason.
 uint64_t rejectedSamples(const procam_tilt_counts& counts);
+// The gyroscope's reading with the sample read() last returned (procam_tilt_ops::read_rate)
+// when the table has the member and the sensor a gyroscope; nullopt otherwise or when
+// a component is not finite. Call it on the thread that called read().
+std::optional<procam_rate_sample> tiltRate(const procam_device& device);
 
 }  // namespace procam::plugins

@@ -48,6 +48,18 @@ std::string keystoneText(const json& k) {
   if (k.contains("output_size") && !k["output_size"].is_null()) {
     out += field("output", scalar(k["output_size"][0]) + "x" + scalar(k["output_size"][1]));
   }
+  // The yaw a tilt sensor cannot see: from the camera on the projector, or why not.
+  if (k.contains("tilt") && k["tilt"].is_object() && k["tilt"].contains("yaw")) {
+    const json& y = k["tilt"]["yaw"];
+    std::string text = y.value("source", "");
+    if (y.contains("yaw_deg") && y["yaw_deg"].is_number()) {
+      char deg[32];
+      std::snprintf(deg, sizeof deg, "%.3f deg, ", y["yaw_deg"].get<double>());
+      text = deg + text;
+    }
+    if (y.contains("unavailable")) text += " (" + scalar(y["unavailable"]) + ")";
+    out += field("yaw", text);
+  }
   if (k.contains("homography") && k["homography"].is_array()) {
     for (size_t r = 0; r < k["homography"].size(); ++r) {
       out += field(r == 0 ? "homography" : "", pairList(k["homography"][r]));

@@ -203,11 +203,16 @@ Result<cv::Mat> Renderer::renderCamera(std::string_view camera,
   if (!cam) return fail(ErrorCode::kNotFound, "no camera named '" + std::string(camera) + "'");
   auto radiance = cameraRadiance(camera, options.threads);
   if (!radiance) return tl::unexpected(radiance.error());
-  const CameraResponse response(cam->spec, options.noise);
-  cv::Mat out(cam->model.height, cam->model.width, response.outputType());
-  const std::uint64_t seed = mixSeed(options.seed, cam->spec.name);
+  return cameraImage(cam->spec, *radiance, options);
+}
+
+cv::Mat Renderer::cameraImage(const CameraSpec& camera, const cv::Mat& radiance,
+                              const RenderOptions& options) {
+  const CameraResponse response(camera, options.noise);
+  cv::Mat out(radiance.rows, radiance.cols, response.outputType());
+  const std::uint64_t seed = mixSeed(options.seed, camera.name);
   forEachRow(out.rows, options.threads,
-             [&](int y) { response.convertRow(radiance->ptr<cv::Vec3f>(y), y, seed, out); });
+             [&](int y) { response.convertRow(radiance.ptr<cv::Vec3f>(y), y, seed, out); });
   return out;
 }
 

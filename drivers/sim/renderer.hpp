@@ -62,6 +62,10 @@ class Renderer {
   // Linear radiance the camera's pixels receive (mean over the supersamples, then
   // the lens blur), CV_32FC3, BGR.
   Result<cv::Mat> cameraRadiance(std::string_view camera, int threads = 0) const;
+  // The camera image of `radiance` (cameraRadiance's) through the camera's signal chain:
+  // what renderCamera gives, for a caller that keeps the radiance of a still scene.
+  static cv::Mat cameraImage(const CameraSpec& camera, const cv::Mat& radiance,
+                             const RenderOptions& options = {});
 
   // Noise-free linear radiance (CV_32FC3, BGR) seen through any pinhole, e.g. the
   // viewer's eye: the image a person there perceives.

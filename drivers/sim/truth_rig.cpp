@@ -80,7 +80,13 @@ Result<rig::RigModel> truthRig(const Scene& scene, double time) {
   for (const auto& c : scene.cameras()) {
     const CameraState* s = state.camera(c.name);
     if (!s) continue;
-    out.cameras.push_back({c.name, s->model, 0.0, truth});
+    rig::RigCamera camera;
+    camera.name = c.name;
+    camera.model = s->model;
+    camera.rms_px = 0.0;
+    camera.calibrated = truth;
+    if (c.placement.kind == Placement::Kind::kAttached) camera.attached_to = c.placement.parent;
+    out.cameras.push_back(std::move(camera));
   }
   bool planar = true;
   for (const auto& p : scene.projectors()) {

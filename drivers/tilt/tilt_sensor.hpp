@@ -4,6 +4,7 @@
 // up axis, the plugin ABI's convention (procam_tilt_sample). Devices are closed by the
 // destructor (RAII); open() after close() reopens.
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "core/error.hpp"
@@ -17,6 +18,9 @@ using procam::kStandardGravity;  // core/units.hpp
 struct TiltSample {
   Vec3 specific_force = Vec3::Zero();  // m/s^2, sensor frame
   std::uint64_t timestamp_ns = 0;      // CLOCK_MONOTONIC unless the device stamps it
+  // The package's gyroscope, read with the same sample: rad/s about each sensor axis
+  // (right-handed); absent without one (procam_tilt_ops::read_rate).
+  std::optional<Vec3> angular_velocity;
 };
 
 class TiltSensor {

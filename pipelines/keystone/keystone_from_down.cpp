@@ -8,11 +8,18 @@ Result<KeystoneEstimate> solveFromDown(const ProjectorModel& projector, const Ve
                                        int content_width, int content_height) {
   auto angles = tiltFromDown(down);
   if (!angles) return tl::unexpected(angles.error());
+  return solveFromOrientation(projector, rotationFromAngles(*angles), down, content_width,
+                              content_height);
+}
+
+Result<KeystoneEstimate> solveFromOrientation(const ProjectorModel& projector, const Mat3& R,
+                                              const Vec3& down, int content_width,
+                                              int content_height) {
   KeystoneProblem p;
   p.K = projector.K;
   p.width = projector.width;
   p.height = projector.height;
-  p.R = rotationFromAngles(*angles);
+  p.R = R;
   p.content_width = content_width;
   p.content_height = content_height;
   auto s = solveKeystone(p);
@@ -20,7 +27,7 @@ Result<KeystoneEstimate> solveFromDown(const ProjectorModel& projector, const Ve
   KeystoneEstimate e;
   e.H = s->H;
   e.down = down;
-  e.angles = *angles;
+  e.angles = anglesFromRotation(R);
   e.scale = s->scale;
   e.content_width = content_width;
   e.content_height = content_height;

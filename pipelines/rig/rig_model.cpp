@@ -143,6 +143,12 @@ Result<RigCamera> cameraFromJson(const json& c, const std::string& where, size_t
     if (!it->is_boolean()) return fail(ErrorCode::kParse, where + ": 'pose_known' must be a bool");
     out.pose_known = it->get<bool>();
   }
+  if (auto it = c.find("attached_to"); it != c.end() && !it->is_null()) {
+    if (!it->is_string() || it->get<std::string>().empty() || it->get<std::string>().size() > 256) {
+      return fail(ErrorCode::kParse, where + ": 'attached_to' must name a projector");
+    }
+    out.attached_to = it->get<std::string>();
+  }
   return out;
 }
 
@@ -299,6 +305,12 @@ const RigCamera* RigModel::camera(const std::string& name) const {
   return nullptr;
 }
 
+const RigCamera* RigModel::attachedCamera(const std::string& name) const {
+  for (const auto& c : cameras)
+    if (c.attached_to == name && c.pose_known) return &c;
+  return nullptr;
+}
+
 const RigProjector* RigModel::projector(const std::string& name) const {
   for (const auto& p : projectors)
     if (p.name == name) return &p;
@@ -388,6 +400,7 @@ json rigToJson(const RigModel& rig) {
                {"pose_known", c.pose_known},
                {"calibrated", provenanceJson(c.calibrated)}};
     if (c.rms_px >= 0) cj["reprojection_rms_px"] = c.rms_px;
+    if (!c.attached_to.empty()) cj["attached_to"] = c.attached_to;
     j["cameras"].push_back(std::move(cj));
   }
   j["projectors"] = json::array();
@@ -450,7 +463,10 @@ RigModel mergeRig(RigModel base, const RigModel& update) {
     auto it = std::find_if(base.cameras.begin(), base.cameras.end(),
                            [&](const RigCamera& b) { return b.name == c.name; });
     if (it != base.cameras.end()) {
+      // A recalibrated camera stays on the projector it is mounted on.
+      const std::string attached = it->attached_to;
       *it = c;
+      if (it->attached_to.empty()) it->attached_to = attached;
     } else {
       base.cameras.push_back(c);
     }

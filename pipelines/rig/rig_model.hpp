@@ -39,6 +39,11 @@ struct RigCamera {
   // false: only K and the distortion are known (a camera calibrated alone from board
   // views); the pose is then the identity and no route may use the camera.
   bool pose_known = true;
+  // The projector it is rigidly mounted on (a handheld projector's camera); empty: it
+  // stands on its own. Its pose and that projector's were calibrated together, so the
+  // camera-from-projector pose stays true however the pair moves. It may name a
+  // projector the rig does not hold yet (cameras calibrated first).
+  std::string attached_to;
 };
 
 // How a tilt sensor sits on a projector and how its readings are corrected.
@@ -107,6 +112,8 @@ struct RigModel {
   // only projector of a rig whose projector is unbound (version 1).
   const RigProjector* projectorForOutput(const std::string& output) const;
   const RigProjector* projector(const std::string& name) const;
+  // The posed camera rigidly mounted on projector `name` (the first), if any.
+  const RigCamera* attachedCamera(const std::string& name) const;
   bool empty() const { return cameras.empty() && projectors.empty() && surface.empty(); }
 };
 

@@ -14,6 +14,7 @@
 #include "geometry/camera_model.hpp"
 #include "keystone/display_error.hpp"
 #include "keystone/keystone_solver.hpp"
+#include "sim/scene.hpp"
 
 namespace procam::itest {
 
@@ -64,6 +65,21 @@ inline Measured measureAgainstTruth(const geom::Intrinsics& K, const Mat3& R, in
   m.aspect_rel = std::abs(err.aspect / (double(content_width) / content_height) - 1);
   m.area_rel = std::abs(err.area / truth->rect.area() - 1);
   return m;
+}
+
+// A keystone event of the daemon on a handheld scene (projector "proj" before the wall
+// y = 2.5 facing -y, which makes the world frame the wall frame of
+// keystone/orientation.hpp, so the pose's rotation, yaw included, is R) against the
+// truth at the tilt sample it was made from.
+inline Measured handheldEventAgainstTruth(const sim::Scene& scene, const nlohmann::json& event) {
+  const double t = event["estimate"]["sample_time"].get<double>();
+  const sim::SceneState state = scene.at(t);
+  const sim::ProjectorState* proj = state.projector("proj");
+  EXPECT_TRUE(proj);
+  if (!proj) return {1e9, 1e9, 1e9};
+  return measureAgainstTruth(proj->spec.K, proj->model.pose.R, proj->spec.width, proj->spec.height,
+                             matrixOf(event["homography"]), event["content_size"][0].get<int>(),
+                             event["content_size"][1].get<int>());
 }
 
 }  // namespace procam::itest

@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -38,7 +39,7 @@ namespace keystone = procam::keystone;
 namespace sim = procam::sim;
 
 struct Options {
-  std::string scene = "handheld";
+  std::string scene = "handheld_tour";
   double seconds = 0;  // 0: the trajectory's length plus 4 s of hold
   std::string procamd = PROCAMD_BIN;
   std::string procamctl = PROCAMCTL_BIN;
@@ -47,10 +48,10 @@ struct Options {
 void usage() {
   std::puts(
       "usage: procam-demo [--scene NAME|FILE] [--seconds S] [--procamd PATH] [--procamctl PATH]\n"
-      "Runs procamd on the virtual rig (default scene: handheld, auto keystone on) in a\n"
-      "temporary directory, drives it with procamctl and prints every keystone update\n"
-      "with its error against the rig's ground truth. The scene's wall must be the\n"
-      "world frame's plane facing -Y (as in handheld).");
+      "Runs procamd on the virtual rig (default scene: handheld_tour, auto keystone on)\n"
+      "in a temporary directory, drives it with procamctl and prints every keystone\n"
+      "update with its error against the rig's ground truth. The scene's wall must be the\n"
+      "world frame's plane facing -Y (as in handheld and handheld_tour).");
 }
 
 bool parseArgs(int argc, char** argv, Options& out) {
@@ -211,20 +212,21 @@ static int run(int argc, char** argv) {
 
   section("keystone updates while the projector moves (procamctl --json watch)");
   std::printf(
-      "Error columns: the shown image judged with the true orientation at the tilt sample's\n"
-      "time (corner px in the framebuffer, aspect and area against the largest upright\n"
-      "rectangle). 'tilt' uses the true pitch and roll; 'full' adds the true yaw, which a\n"
-      "tilt sensor cannot see ([Raskar02] §6.2.2: the camera gives the azimuth).\n\n");
-  std::printf("%7s %6s | %7s %7s %6s | %7s %7s | %9s %8s %7s | %9s\n", "t [s]", "still", "pitch",
-              "roll", "yaw", "est p", "est r", "tilt px", "aspect%", "area%", "full px");
+      "The shown image judged with the projector's TRUE orientation (yaw, pitch and roll) at\n"
+      "the tilt sample's time: corner px in the framebuffer, aspect and area against the\n"
+      "largest upright rectangle. Gravity gives pitch and roll; the camera on the projector\n"
+      "gives the yaw at each still hold ([Raskar02] §6.2.2), kept while the projector moves.\n\n");
+  std::printf("%7s %6s | %6s %6s %6s | %6s %6s %6s %-7s | %8s %8s %7s\n", "t [s]", "still", "pitch",
+              "roll", "yaw", "est p", "est r", "est y", "yaw by", "corner", "aspect%", "area%");
   auto watch = demo::Child::start({opt.procamctl, "--socket", socket, "--json", "watch"});
   if (!watch) return 1;
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   int updates = 0, hidden = 0;
   double last_printed = -1;
-  std::vector<double> moving_px;  // tilt corner errors while the trajectory runs
-  std::optional<Errors> final_hold;
-  double final_time = 0;
+  std::vector<double> moving_px;  // corner errors while the projector moves
+  // The last update of each still hold whose yaw the camera measured in that hold,
+  // keyed by the measurement's count.
+  std::map<long, std::pair<double, Errors>> holds;
   while (std::chrono::steady_clock::now() < end) {
     auto line = watch->readLine(std::chrono::milliseconds(200));
     if (!line) continue;
@@ -239,45 +241,54 @@ static int run(int argc, char** argv) {
     // The handheld wall is the world plane y = const facing -y: wall frame = world frame.
     const Mat3 R_true = scene.at(t).projector(pspec.name)->model.pose.R;
     const keystone::Angles truth = keystone::anglesFromRotation(R_true);
-    const Mat3 R_tilt = keystone::rotationFromAngles({truth.pitch, truth.roll, 0.0});
-    const Errors tilt = errorsAt(pspec, R_tilt, H, cw, ch);
     const Errors full = errorsAt(pspec, R_true, H, cw, ch);
     const bool still = e["tilt"].value("still", false);
-    if (t < trajectory) {
-      moving_px.push_back(tilt.corner_px);
-    } else {
-      final_hold = tilt;
-      final_time = t;
-    }
+    const json& yaw = e["tilt"]["yaw"];
+    const std::string source = e["estimate"].value("yaw_source", "");
+    const bool this_hold = source == "camera, this still hold";
+    const char* yaw_by = this_hold                         ? "camera"
+                         : source.starts_with("gyroscope") ? "gyro"
+                         : source.starts_with("kept")      ? "kept"
+                                                           : "none";
+    if (!still) moving_px.push_back(full.corner_px);
+    if (still && this_hold) holds[yaw.value("measurements", 0L)] = {t, full};
     // While moving the daemon updates on every sample: print ten a second.
-    if (!still && t < trajectory && t - last_printed < 0.1) {
+    if (!still && t - last_printed < 0.1) {
       ++hidden;
       continue;
     }
     last_printed = t;
-    std::printf("%7.2f %6s | %7.2f %7.2f %6.1f | %7.2f %7.2f | %9.3f %8.4f %7.4f | %9.2f\n", t,
+    std::printf("%7.2f %6s | %6.1f %6.1f %6.1f | %6.2f %6.2f %6.2f %-7s | %8.3f %8.4f %7.4f\n", t,
                 still ? "yes" : "no", radToDeg(truth.pitch), radToDeg(truth.roll),
                 radToDeg(truth.yaw), e["estimate"]["pitch_deg"].get<double>(),
-                e["estimate"]["roll_deg"].get<double>(), tilt.corner_px, tilt.aspect_pct,
-                tilt.area_pct, full.corner_px);
+                e["estimate"]["roll_deg"].get<double>(), e["estimate"].value("yaw_deg", 0.0),
+                yaw_by, full.corner_px, full.aspect_pct, full.area_pct);
     std::fflush(stdout);
   }
   watch->stop();
   std::printf("\n%d keystone update(s) in %.1f s (%d not printed).\n", updates, seconds, hidden);
+  if (!holds.empty()) {
+    Errors worst;
+    for (const auto& [n, hold] : holds) {
+      worst.corner_px = std::max(worst.corner_px, hold.second.corner_px);
+      worst.aspect_pct = std::max(worst.aspect_pct, hold.second.aspect_pct);
+      worst.area_pct = std::max(worst.area_pct, hold.second.area_pct);
+    }
+    std::printf(
+        "Held still (%zu holds, the last update of each, yaw from the camera): worst corner "
+        "%.3f px, aspect %.4f %%, area %.4f %%\n"
+        "  (procamd's keystone accuracy bounds: corner <= 0.5 px, aspect 0.1 %%, area 0.5 %%).\n",
+        holds.size(), worst.corner_px, worst.aspect_pct, worst.area_pct);
+  } else {
+    std::printf("No still hold had its yaw measured by a camera (see `keystone` below).\n");
+  }
   if (!moving_px.empty()) {
     std::sort(moving_px.begin(), moving_px.end());
     std::printf(
-        "While the projector moves (t < %.1f s): corner error vs true pitch/roll median %.2f px, "
-        "max %.2f px\n  (the low-pass filter lags the motion; a still projector is what the "
-        "tolerances are for).\n",
-        trajectory, moving_px[moving_px.size() / 2], moving_px.back());
-  }
-  if (final_hold) {
-    std::printf(
-        "Held still at the end: the update at t = %.2f s, which stays on the wall, is off by "
-        "corner %.3f px, aspect %.4f %%, area %.4f %%\n"
-        "  (procamd's keystone accuracy bounds: corner <= 0.5 px, aspect 0.1 %%, area 0.5 %%).\n",
-        final_time, final_hold->corner_px, final_hold->aspect_pct, final_hold->area_pct);
+        "While the projector moves (%zu updates): corner error median %.2f px, max %.2f px\n"
+        "  (orientation carried by the gyroscope where the tilt sensor has one; otherwise the\n"
+        "  tilt low-pass lags the motion and the yaw is the last hold's until the next).\n",
+        moving_px.size(), moving_px[moving_px.size() / 2], moving_px.back());
   }
 
   section("procamctl keystone");

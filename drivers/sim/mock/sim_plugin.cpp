@@ -37,11 +37,39 @@ struct OutputRender {
   plugins::MeshCache mesh;
 };
 
+// A camera's radiance of the last capture and what it was rendered for: while no
+// device moves and no output shows a new frame, the next capture only draws new noise
+// (a still scene renders the same light; the ray cast is most of a capture's time).
+struct CameraRadiance {
+  std::vector<geom::Pose> poses;  // every projector's and camera's, in scene order
+  std::shared_ptr<const World> world;
+  std::uint64_t shows = 0;
+  cv::Mat radiance;
+
+  static std::vector<geom::Pose> posesOf(const SceneState& state) {
+    std::vector<geom::Pose> out;
+    for (const auto& p : state.projectors) out.push_back(p.model.pose);
+    for (const auto& c : state.cameras) out.push_back(c.model.pose);
+    return out;
+  }
+  bool sameAs(const std::vector<geom::Pose>& p, const SceneState& state, std::uint64_t n) const {
+    if (radiance.empty() || n != shows || state.world != world || p.size() != poses.size()) {
+      return false;
+    }
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (p[i].R != poses[i].R || p[i].t != poses[i].t) return false;
+    }
+    return true;
+  }
+};
+
 struct Device {
   std::shared_ptr<SimWorld> world;
   std::string name;
   std::vector<uint8_t> buffer;  // camera frames
+  uint64_t frames = 0;          // camera frames captured: each has its own noise
   std::unique_ptr<OutputRender> output;
+  CameraRadiance cache;
 };
 
 // PROCAM_OK while the device is plugged in (sim_unplug.hpp).
@@ -242,13 +270,25 @@ int cameraCapture(void* self, int, procam_image* out, char* err, size_t len) {
     const CameraSpec* spec = cameraSpec(dev);
     if (!spec) return report(err, len, "camera gone", PROCAM_ENODEV);
     // The outputs as they were latency_s ago (SCENE-FORMAT.md, mock drivers).
+    const std::uint64_t shows = dev->world->showCount();
     const Framebuffers shown =
         spec->latency_s > 0 ? dev->world->shownAt(t - spec->latency_s) : dev->world->shown();
-    auto renderer = Renderer::create(scene, scene.at(t), shown);
-    if (!renderer) return report(err, len, renderer.error().message, PROCAM_EIO);
-    auto image = renderer->renderCamera(dev->name);
-    if (!image) return report(err, len, image.error().message, PROCAM_EIO);
-    cv::Mat m = *image;
+    SceneState state = scene.at(t);
+    const std::vector<geom::Pose> poses = CameraRadiance::posesOf(state);
+    // With a latency the frames lit are those of another time: always cast again.
+    if (spec->latency_s > 0 || !dev->cache.sameAs(poses, state, shows)) {
+      dev->cache = {};
+      const std::shared_ptr<const World> world = state.world;
+      auto renderer = Renderer::create(scene, std::move(state), shown);
+      if (!renderer) return report(err, len, renderer.error().message, PROCAM_EIO);
+      auto radiance = renderer->cameraRadiance(dev->name);
+      if (!radiance) return report(err, len, radiance.error().message, PROCAM_EIO);
+      dev->cache = {poses, world, shows, std::move(*radiance)};
+    }
+    // A real sensor's noise is new in every frame: averaging frames reduces it.
+    RenderOptions options;
+    options.seed = ++dev->frames;
+    cv::Mat m = Renderer::cameraImage(*spec, dev->cache.radiance, options);
     if (m.channels() == 3) cv::cvtColor(m, m, cv::COLOR_BGR2RGB);
     if (!m.isContinuous()) m = m.clone();
     dev->buffer.assign(m.datastart, m.dataend);
@@ -300,7 +340,7 @@ int create(const procam_device_desc* d, const procam_config*, procam_device* out
     if (int rc = presence(name, err, len); rc != PROCAM_OK) return rc;
     auto world = SimWorld::open(scene);
     if (!world) return report(err, len, world.error().message, PROCAM_EINVAL);
-    auto dev = std::make_unique<Device>(Device{*world, name, {}, nullptr});
+    auto dev = std::make_unique<Device>(Device{*world, name, {}, 0, nullptr, {}});
     bool known = false;
     const Scene& s = (*world)->scene();
     if constexpr (Family == PROCAM_FAMILY_CAMERA) {

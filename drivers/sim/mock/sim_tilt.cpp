@@ -16,12 +16,21 @@ Result<tilt::TiltSample> SimTiltSensor::read() {
   auto s = sampleTilt(world_->scene(), name_, t);
   if (!s) return fail(ErrorCode::kIo, s.error().message);
   double unit = 1.0;
+  bool gyro = false;
   for (const auto& spec : world_->scene().tiltSensors()) {
-    if (spec.name == name_ && spec.report_in_g) unit = kStandardGravity;
+    if (spec.name != name_) continue;
+    if (spec.report_in_g) unit = kStandardGravity;
+    gyro = spec.gyro.has_value();
   }
   tilt::TiltSample out;
   out.specific_force = s->value * unit;
   out.timestamp_ns = static_cast<uint64_t>(t * 1e9);
+  if (gyro) {
+    // The package's gyroscope, sampled with the same sample (SCENE-FORMAT.md).
+    auto w = sampleGyro(world_->scene(), name_, t);
+    if (!w) return fail(ErrorCode::kIo, w.error().message);
+    out.angular_velocity = w->value;
+  }
   return out;
 }
 

@@ -17,7 +17,8 @@ class SimTiltSensor : public tilt::TiltSensor {
 
   Result<void> open() override { return {}; }
   // The scene's sample at the world's time, in m/s^2 whatever unit the scene reports
-  // in (the ABI's unit); kNoDevice while unplugged (sim_unplug.hpp).
+  // in (the ABI's unit), with its gyroscope's reading when the sensor has one;
+  // kNoDevice while unplugged (sim_unplug.hpp).
   Result<tilt::TiltSample> read() override;
   void close() override {}
   std::string name() const override { return name_; }

@@ -47,6 +47,7 @@ void SimWorld::show(const std::string& projector, cv::Mat framebuffer) {
   std::lock_guard lock(mutex_);
   History& h = history_[projector];
   h.frames.push_back({t, std::move(framebuffer)});
+  ++shows_;
   // Keep the frame that was on at t - keep_s_ (the one before the first younger
   // than that), and no more than kMaxKeptFrames.
   while (h.frames.size() > 1 &&
@@ -54,6 +55,11 @@ void SimWorld::show(const std::string& projector, cv::Mat framebuffer) {
     h.frames.pop_front();
     h.trimmed = true;
   }
+}
+
+std::uint64_t SimWorld::showCount() const {
+  std::lock_guard lock(mutex_);
+  return shows_;
 }
 
 Framebuffers SimWorld::shown() const {

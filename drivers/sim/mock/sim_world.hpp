@@ -33,8 +33,11 @@ class SimWorld {
 
   // Shows `framebuffer` on `projector` from now on.
   void show(const std::string& projector, cv::Mat framebuffer);
-  // What the projectors show now.
+  // What the projectors show now, and how many frames have been shown so far (it
+  // changes with every show: a camera's view of a still scene is the same between two
+  // equal counts).
   Framebuffers shown() const;
+  std::uint64_t showCount() const;
   // What they showed at world time `t` (a projector that had shown nothing yet is
   // absent); older than the kept history: the oldest frame kept.
   Framebuffers shownAt(double t) const;
@@ -55,6 +58,7 @@ class SimWorld {
     bool trimmed = false;      // frames were dropped from its front
   };
   std::map<std::string, History, std::less<>> history_;
+  std::uint64_t shows_ = 0;
 };
 
 }  // namespace procam::sim::mock

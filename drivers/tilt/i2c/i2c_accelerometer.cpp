@@ -72,6 +72,7 @@ Result<TiltSample> I2cAccelerometer::read() {
       s.timestamp_ns = monotonicNs();
       for (int a = 0; a < 3; ++a)
         s.specific_force(a) = (*counts)[a] * g_per_count_ * kStandardGravity;
+      s.angular_velocity = lastRate();
       return s;
     }
     if (config_.poll_interval.count() > 0) std::this_thread::sleep_for(config_.poll_interval);

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "tilt/i2c/i2c_bus.hpp"
@@ -42,6 +43,9 @@ class I2cAccelerometer : public TiltSensor {
   virtual Result<Setup> configure() = 0;  // range, rate, measurement mode
   virtual Result<bool> dataReady() = 0;
   virtual Result<std::array<std::int16_t, 3>> readCounts() = 0;
+  // The package's gyroscope read by the last readCounts() (rad/s, chip axes); nullopt
+  // for a chip without one.
+  virtual std::optional<Vec3> lastRate() const { return std::nullopt; }
   virtual Result<void> standby() = 0;
 
   Result<std::uint8_t> readRegister(std::uint8_t reg);

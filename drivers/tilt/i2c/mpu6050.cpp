@@ -2,7 +2,11 @@
 // (0x01: awake, PLL on gyro X; 0x40 sleep); CONFIG 0x1A (DLPF_CFG 3 -> 1 kHz internal
 // rate); SMPLRT_DIV 0x19 (rate = 1 kHz / (1 + div)); ACCEL_CONFIG 0x1C (AFS_SEL bits
 // 4:3, 16384 LSB/g at ±2 g, halving per step); INT_ENABLE 0x38 (bit 0 DATA_RDY_EN);
-// INT_STATUS 0x3A (bit 0 DATA_RDY_INT); ACCEL_XOUT_H..ACCEL_ZOUT_L 0x3B..0x40 big-endian.
+// INT_STATUS 0x3A (bit 0 DATA_RDY_INT); ACCEL_XOUT_H..ACCEL_ZOUT_L 0x3B..0x40 big-endian;
+// the gyroscope: GYRO_CONFIG 0x1B (FS_SEL bits 4:3, 131 LSB/(deg/s) at +-250 deg/s,
+// halving per step), GYRO_XOUT_H..GYRO_ZOUT_L 0x43..0x48 big-endian on the
+// accelerometer's axes, after TEMP_OUT 0x41..0x42: one burst of 14 bytes from 0x3B
+// reads both from the same sample.
 #include <algorithm>
 #include <cmath>
 
@@ -28,6 +32,7 @@ class Mpu6050 final : public I2cAccelerometer {
                                                             {0x1A, 0x03},
                                                             {0x19, std::uint8_t(div)},
                                                             {0x1C, std::uint8_t(afs << 3)},
+                                                            {0x1B, std::uint8_t(kGyroFsSel << 3)},
                                                             {0x38, 0x01}};
     for (auto [reg, value] : writes)
       if (auto r = writeRegister(reg, value); !r) return tl::unexpected(r.error());
@@ -41,12 +46,20 @@ class Mpu6050 final : public I2cAccelerometer {
   }
 
   Result<std::array<std::int16_t, 3>> readCounts() override {
-    std::uint8_t b[6];
+    std::uint8_t b[14];
     if (auto r = readBlock(0x3B, b); !r) return tl::unexpected(r.error());
+    // +-500 deg/s (a hand turns a projector at up to a few hundred degrees a second).
+    constexpr double kRadPerCount = degToRad((1 << kGyroFsSel) / 131.0);
+    rate_ = Vec3(be16(b + 8), be16(b + 10), be16(b + 12)) * kRadPerCount;
     return std::array<std::int16_t, 3>{be16(b), be16(b + 2), be16(b + 4)};
   }
 
+  std::optional<Vec3> lastRate() const override { return rate_; }
+
   Result<void> standby() override { return writeRegister(0x6B, 0x40); }
+
+  static constexpr int kGyroFsSel = 1;
+  std::optional<Vec3> rate_;
 };
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <tuple>
 
 namespace procam::tilt {
 namespace {
@@ -48,29 +49,46 @@ bool IioAccelerometer::hasAttribute(const std::string& rel) const {
   return std::filesystem::exists(config_.device_dir + "/" + rel, ec);
 }
 
+Result<std::pair<double, double>> IioAccelerometer::scaleAndOffset(const std::string& type,
+                                                                   int axis) const {
+  const std::string channel = "in_" + type + "_" + kAxes[axis];
+  const std::string shared = "in_" + type;
+  const std::string scale =
+      hasAttribute(channel + "_scale") ? channel + "_scale" : shared + "_scale";
+  auto s = attribute(scale);
+  if (!s) return tl::unexpected(s.error());
+  auto sv = toNumber(*s, scale);
+  if (!sv) return tl::unexpected(sv.error());
+  for (const std::string& off : {channel + "_offset", shared + "_offset"}) {
+    if (!hasAttribute(off)) continue;
+    auto o = attribute(off);
+    if (!o) return tl::unexpected(o.error());
+    auto ov = toNumber(*o, off);
+    if (!ov) return tl::unexpected(ov.error());
+    return std::pair{*sv, *ov};
+  }
+  return std::pair{*sv, 0.0};
+}
+
 Result<void> IioAccelerometer::open() {
   if (open_) return {};
   for (const char* a : kAxes)
     if (!hasAttribute(std::string("in_accel_") + a + "_raw"))
       return fail(ErrorCode::kNotFound, config_.device_dir + ": no in_accel_" + a + "_raw");
   for (int a = 0; a < 3; ++a) {
-    const std::string axis = std::string("in_accel_") + kAxes[a];
-    const std::string scale = hasAttribute(axis + "_scale") ? axis + "_scale" : "in_accel_scale";
-    auto s = attribute(scale);
-    if (!s) return tl::unexpected(s.error());
-    auto sv = toNumber(*s, scale);
-    if (!sv) return tl::unexpected(sv.error());
-    scale_[a] = *sv;
-    offset_[a] = 0;
-    for (const std::string& off : {axis + "_offset", std::string("in_accel_offset")}) {
-      if (!hasAttribute(off)) continue;
-      auto o = attribute(off);
-      if (!o) return tl::unexpected(o.error());
-      auto ov = toNumber(*o, off);
-      if (!ov) return tl::unexpected(ov.error());
-      offset_[a] = *ov;
-      break;
-    }
+    auto so = scaleAndOffset("accel", a);
+    if (!so) return tl::unexpected(so.error());
+    std::tie(scale_[a], offset_[a]) = *so;
+  }
+  // A gyroscope on the same device (a combined IMU): its three anglvel channels, rad/s.
+  gyro_ = true;
+  for (const char* a : kAxes)
+    gyro_ = gyro_ && hasAttribute(std::string("in_anglvel_") + a + "_raw");
+  // The gyroscope is extra: one whose scale cannot be read leaves the accelerometer alone.
+  for (int a = 0; gyro_ && a < 3; ++a) {
+    auto so = scaleAndOffset("anglvel", a);
+    if (so) std::tie(gyro_scale_[a], gyro_offset_[a]) = *so;
+    gyro_ = so.has_value();
   }
   for (const char* freq : {"in_accel_sampling_frequency", "sampling_frequency"}) {
     if (!hasAttribute(freq)) continue;
@@ -98,9 +116,14 @@ Result<void> IioAccelerometer::openBuffer() {
     if (file.size() < 7 || file.rfind("in_", 0) != 0 || file.substr(file.size() - 3) != "_en")
       continue;
     const std::string ch = file.substr(3, file.size() - 6);
-    const bool wanted = ch == "accel_x" || ch == "accel_y" || ch == "accel_z" || ch == "timestamp";
-    if (wanted)
-      if (auto w = setAttribute("scan_elements/" + file, "1"); !w) return w;
+    const bool wanted = ch == "accel_x" || ch == "accel_y" || ch == "accel_z" ||
+                        ch == "timestamp" ||
+                        (gyro_ && (ch == "anglvel_x" || ch == "anglvel_y" || ch == "anglvel_z"));
+    const bool rate = ch.rfind("anglvel_", 0) == 0;
+    if (wanted) {
+      auto w = setAttribute("scan_elements/" + file, "1");
+      if (!w && !rate) return w;  // the gyroscope's channels are extra
+    }
     auto en = attribute("scan_elements/" + file);
     if (!en) return tl::unexpected(en.error());
     if (en->empty() || (*en)[0] != '1') continue;
@@ -119,9 +142,13 @@ Result<void> IioAccelerometer::openBuffer() {
   }
   if (ec) return fail(ErrorCode::kIo, config_.device_dir + "/scan_elements: " + ec.message());
   record_size_ = layoutIioRecord(channels_);
-  int axes = 0;
-  for (const auto& c : channels_) axes += c.name.rfind("accel_", 0) == 0;
+  int axes = 0, rates = 0;
+  for (const auto& c : channels_) {
+    axes += c.name.rfind("accel_", 0) == 0;
+    rates += c.name.rfind("anglvel_", 0) == 0;
+  }
   if (axes != 3) return fail(ErrorCode::kNotFound, "buffer does not carry the three accel axes");
+  gyro_ = gyro_ && rates == 3;  // a buffer without them: the accelerometer alone
   if (auto w = setAttribute("buffer/length", std::to_string(config_.buffer_length)); !w) return w;
   if (auto w = setAttribute("buffer/enable", "1"); !w) return w;
   std::string node = config_.device_node;
@@ -135,17 +162,31 @@ Result<void> IioAccelerometer::openBuffer() {
   return {};
 }
 
+Result<Vec3> IioAccelerometer::polledChannels(const char* type, const std::array<double, 3>& scale,
+                                              const std::array<double, 3>& offset) const {
+  Vec3 out;
+  for (int a = 0; a < 3; ++a) {
+    const std::string file = std::string("in_") + type + "_" + kAxes[a] + "_raw";
+    auto raw = attribute(file);
+    if (!raw) return tl::unexpected(raw.error());
+    auto v = toNumber(*raw, file);
+    if (!v) return tl::unexpected(v.error());
+    out(a) = (*v + offset[a]) * scale[a];
+  }
+  return out;
+}
+
 Result<TiltSample> IioAccelerometer::read() {
   if (!open_) return fail(ErrorCode::kIo, "iio: not open");
   TiltSample s;
   if (fd_ < 0) {
-    for (int a = 0; a < 3; ++a) {
-      const std::string file = std::string("in_accel_") + kAxes[a] + "_raw";
-      auto raw = attribute(file);
-      if (!raw) return tl::unexpected(raw.error());
-      auto v = toNumber(*raw, file);
-      if (!v) return tl::unexpected(v.error());
-      s.specific_force(a) = (*v + offset_[a]) * scale_[a];
+    auto force = polledChannels("accel", scale_, offset_);
+    if (!force) return tl::unexpected(force.error());
+    s.specific_force = *force;
+    if (gyro_) {
+      // A gyroscope reading that fails leaves the sample without one, not the sample.
+      auto rate = polledChannels("anglvel", gyro_scale_, gyro_offset_);
+      if (rate) s.angular_velocity = *rate;
     }
     s.timestamp_ns = monotonicNs();
     return s;
@@ -162,13 +203,18 @@ Result<TiltSample> IioAccelerometer::read() {
   if (n == 0) return fail(ErrorCode::kNotFound, "iio: no record available");
   if (std::size_t(n) != record.size()) return fail(ErrorCode::kIo, "iio: short record");
   s.timestamp_ns = monotonicNs();
+  Vec3 w = Vec3::Zero();
   for (const auto& c : channels_) {
     const std::int64_t v = c.type.decode(record.data() + c.offset);
     if (c.name == "timestamp") s.timestamp_ns = std::uint64_t(v);
-    for (int a = 0; a < 3; ++a)
+    for (int a = 0; a < 3; ++a) {
       if (c.name == std::string("accel_") + kAxes[a])
         s.specific_force(a) = (double(v) + offset_[a]) * scale_[a];
+      if (c.name == std::string("anglvel_") + kAxes[a])
+        w(a) = (double(v) + gyro_offset_[a]) * gyro_scale_[a];
+    }
   }
+  if (gyro_) s.angular_velocity = w;
   return s;
 }
 

@@ -1,12 +1,14 @@
 #pragma once
 // Linux IIO accelerometers (kernel ABI Documentation/ABI/testing/sysfs-bus-iio): polled
 // through sysfs (in_accel_{x,y,z}_raw with _scale and _offset, per axis or shared:
-// value = (raw + offset) * scale in m/s^2), or buffered through the character device
-// (scan_elements/, buffer/enable, records read from /dev/iio:deviceN). The device
-// directory is configurable, so tests run against a fake tree.
+// value = (raw + offset) * scale in m/s^2; a combined IMU's gyroscope likewise from
+// in_anglvel_{x,y,z}_raw, in rad/s, read with every sample), or buffered through the character
+// device (scan_elements/, buffer/enable, records read from /dev/iio:deviceN). The device directory
+// is configurable, so tests run against a fake tree.
 #include <array>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "tilt/iio/iio_scan_type.hpp"
@@ -36,16 +38,25 @@ class IioAccelerometer final : public TiltSensor {
 
   bool buffered() const { return fd_ >= 0; }
   std::optional<double> samplingHz() const { return sampling_hz_; }
+  bool hasGyroscope() const { return gyro_; }
 
  private:
   Result<std::string> attribute(const std::string& rel) const;
   Result<void> setAttribute(const std::string& rel, const std::string& value) const;
   bool hasAttribute(const std::string& rel) const;
   Result<void> openBuffer();
+  // in_<type>_<axis>_scale or the shared in_<type>_scale, and the offset likewise (0
+  // when there is none).
+  Result<std::pair<double, double>> scaleAndOffset(const std::string& type, int axis) const;
+  // The three in_<type>_<axis>_raw values through scale and offset (polled reading).
+  Result<Vec3> polledChannels(const char* type, const std::array<double, 3>& scale,
+                              const std::array<double, 3>& offset) const;
 
   IioConfig config_;
   bool open_ = false;
   std::array<double, 3> scale_{}, offset_{};
+  bool gyro_ = false;  // the device has anglvel channels (and the buffer carries them)
+  std::array<double, 3> gyro_scale_{}, gyro_offset_{};
   std::optional<double> sampling_hz_;
   int fd_ = -1;
   std::vector<IioScanChannel> channels_;

@@ -30,6 +30,7 @@ namespace {
 struct TiltDevice {
   std::unique_ptr<TiltSensor> sensor;
   SampleGate gate;
+  std::optional<procam_rate_sample> rate;  // with the sample read() last returned
 };
 
 int readSample(void* self, procam_tilt_sample* out, char* err, std::size_t len) {
@@ -55,6 +56,13 @@ int readSample(void* self, procam_tilt_sample* out, char* err, std::size_t len) 
       return report(err, len, "sample rejected: " + checked.error().message, PROCAM_EAGAIN);
     for (int a = 0; a < 3; ++a) out->specific_force[a] = checked->specific_force(a);
     out->timestamp_ns = checked->timestamp_ns;
+    d->rate.reset();
+    if (s->angular_velocity && s->angular_velocity->allFinite()) {
+      procam_rate_sample r{};
+      for (int a = 0; a < 3; ++a) r.angular_velocity[a] = (*s->angular_velocity)(a);
+      r.timestamp_ns = checked->timestamp_ns;
+      d->rate = r;
+    }
     return PROCAM_OK;
   } catch (const std::exception& e) {
     return report(err, len, e.what(), PROCAM_EINTERNAL);
@@ -67,6 +75,13 @@ int getCounts(void* self, procam_tilt_counts* out) {
   return PROCAM_OK;
 }
 
+int readRate(void* self, procam_rate_sample* out, char* err, std::size_t len) {
+  const auto* d = static_cast<const TiltDevice*>(self);
+  if (!d->rate) return report(err, len, "no gyroscope reading with this sample", PROCAM_ENOTSUP);
+  *out = *d->rate;
+  return PROCAM_OK;
+}
+
 int pollFd(void* self) {
   return static_cast<TiltDevice*>(self)->sensor->pollFd();
 }
@@ -75,7 +90,7 @@ void destroy(void* self) {
   delete static_cast<TiltDevice*>(self);  // the sensor's destructor closes it
 }
 
-const procam_tilt_ops kOps = {PROCAM_TILT_OPS_VERSION, &readSample, &getCounts};
+const procam_tilt_ops kOps = {PROCAM_TILT_OPS_VERSION, &readSample, &getCounts, &readRate};
 
 }  // namespace
 
@@ -85,7 +100,8 @@ int finishTiltDevice(std::unique_ptr<TiltSensor> sensor, const SampleGateOptions
     if (auto ok = sensor->open(); !ok)
       return report(err, len, sensor->name() + " tilt: " + ok.error().message,
                     statusOf(ok.error().code));
-    auto d = std::make_unique<TiltDevice>(TiltDevice{std::move(sensor), SampleGate(gate)});
+    auto d =
+        std::make_unique<TiltDevice>(TiltDevice{std::move(sensor), SampleGate(gate), std::nullopt});
     out->family = PROCAM_FAMILY_TILT;
     out->self = d.release();
     out->poll_fd = &pollFd;

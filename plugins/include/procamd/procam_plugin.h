@@ -38,7 +38,7 @@ extern "C" {
 
 /* The operations table versions this header describes. */
 #define PROCAM_CAMERA_OPS_VERSION 2u
-#define PROCAM_TILT_OPS_VERSION 2u
+#define PROCAM_TILT_OPS_VERSION 3u
 #define PROCAM_TRACKER_OPS_VERSION 1u
 #define PROCAM_OUTPUT_OPS_VERSION 3u
 
@@ -151,12 +151,25 @@ typedef struct procam_tilt_counts {
   uint64_t bad_norm;     /* rejected: |specific force| far from 1 g */
 } procam_tilt_counts;
 
+/* A gyroscope in the tilt sensor's package (an MPU-6050, an IIO device with
+ * anglvel channels, a HID sensor hub): angular velocity in the sensor frame,
+ * rad/s, right-handed about each sensor axis. */
+typedef struct procam_rate_sample {
+  double angular_velocity[3];
+  uint64_t timestamp_ns;
+} procam_rate_sample;
+
 typedef struct procam_tilt_ops {
   uint32_t version; /* PROCAM_TILT_OPS_VERSION */
   int (*read)(void* self, procam_tilt_sample* out, char* err, size_t err_len);
   /* Version 2, optional (may be NULL): fills `out` with the driver's counts.
    * The daemon reads this member only from a table of version 2 or later. */
   int (*get_counts)(void* self, procam_tilt_counts* out);
+  /* Version 3, optional (may be NULL): the gyroscope's reading taken with the
+   * sample read() last returned; PROCAM_ENOTSUP when the sensor has none. Called
+   * right after read(), on the same thread. The daemon reads this member only
+   * from a table of version 3 or later. */
+  int (*read_rate)(void* self, procam_rate_sample* out, char* err, size_t err_len);
 } procam_tilt_ops;
 
 /* Head tracker: viewer position in the world frame (metres) and orientation

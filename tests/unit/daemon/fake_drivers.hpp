@@ -63,7 +63,7 @@ inline int tiltRead(void* self, procam_tilt_sample* out, char* err, size_t len) 
   out->specific_force[2] = 9.81;
   return PROCAM_OK;
 }
-inline const procam_tilt_ops kTiltOps = {PROCAM_TILT_OPS_VERSION, tiltRead, nullptr};
+inline const procam_tilt_ops kTiltOps = {PROCAM_TILT_OPS_VERSION, tiltRead, nullptr, nullptr};
 
 inline int tiltFd(void* self) {
   return static_cast<Tilt*>(self)->pipe[0];

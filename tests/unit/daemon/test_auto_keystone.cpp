@@ -50,6 +50,18 @@ TEST(KeystoneConfigKeys, ParsedCheckedAndTheMountMustBeARotation) {
             std::string::npos);
   EXPECT_NE(bad.error().message.find("keystone.speed: unknown key"), std::string::npos);
 
+  // The camera's yaw: on with 64 frames unless told; bounded.
+  EXPECT_TRUE(ok->keystone.camera_yaw);
+  EXPECT_EQ(ok->keystone.yaw_frames, 64);
+  auto yaw = parseConfig("[keystone]\ncamera_yaw = false\nyaw_frames = 12\n", "k.toml");
+  ASSERT_TRUE(yaw) << yaw.error().message;
+  EXPECT_FALSE(yaw->keystone.camera_yaw);
+  EXPECT_EQ(yaw->keystone.yaw_frames, 12);
+  auto bad_yaw = parseConfig("[keystone]\ncamera_yaw = 1\nyaw_frames = 0\n", "k.toml");
+  ASSERT_FALSE(bad_yaw);
+  EXPECT_NE(bad_yaw.error().message.find("keystone.camera_yaw"), std::string::npos);
+  EXPECT_NE(bad_yaw.error().message.find("keystone.yaw_frames"), std::string::npos);
+
   KeystoneConfig skew;
   skew.mount = std::array<double, 9>{1, 0, 0, 0, 1, 0, 0, 0.5, 1};
   EXPECT_FALSE(mountFromConfig(skew));

@@ -261,7 +261,7 @@ TEST_F(ManagerTest, ReadableDeviceFdDeliversSamplesToTheHooks) {
   std::vector<double> got;
   manager_->onReading([&](const DeviceEntry& e, const Reading& r) {
     EXPECT_EQ(e.name, "iio:device0");
-    got.push_back(std::get<procam_tilt_sample>(r).specific_force[0]);
+    got.push_back(std::get<TiltReading>(r).sample.specific_force[0]);
   });
   // The pipe's write end lives in the fake driver's state.
   const int wfd =
@@ -277,7 +277,7 @@ TEST_F(ManagerTest, PollEveryReadsATimerPolledDevice) {
   startWithoutUdev(60000ms);  // no presence reads during the test
   int readings = 0;
   manager_->onReading([&](const DeviceEntry&, const Reading& r) {
-    EXPECT_DOUBLE_EQ(std::get<procam_tilt_sample>(r).specific_force[2], 9.81);
+    EXPECT_DOUBLE_EQ(std::get<TiltReading>(r).sample.specific_force[2], 9.81);
     ++readings;
   });
   auto id = manager_->pollEvery("iio:device0", 10ms);
@@ -294,7 +294,7 @@ TEST_F(ManagerTest, ClosedReadGateKeepsTheManagerOffADeviceUntilItOpens) {
   startWithoutUdev(20ms);
   std::vector<double> got;
   manager_->onReading([&](const DeviceEntry&, const Reading& r) {
-    got.push_back(std::get<procam_tilt_sample>(r).specific_force[0]);
+    got.push_back(std::get<TiltReading>(r).sample.specific_force[0]);
   });
   const int wfd =
       static_cast<fake::Tilt*>(devices_.find("iio:device0")->device.raw().self)->pipe[1];
@@ -414,7 +414,7 @@ TEST_F(ManagerTest, SlowTrackerReadRunsOffTheLoopOneAtATime) {
   startWithoutUdev(60000ms);
   std::vector<double> tilts, poses;
   manager_->onReading([&](const DeviceEntry& e, const Reading& r) {
-    if (const auto* t = std::get_if<procam_tilt_sample>(&r)) tilts.push_back(t->specific_force[0]);
+    if (const auto* t = std::get_if<TiltReading>(&r)) tilts.push_back(t->sample.specific_force[0]);
     if (const auto* p = std::get_if<procam_pose_sample>(&r)) {
       EXPECT_EQ(e.name, "hidraw7");
       poses.push_back(p->position[0]);

@@ -105,6 +105,27 @@ TEST(SimDrivers, TiltReportsGravityMagnitude) {
   EXPECT_NEAR(norm, 9.80665, 0.1 * 9.80665);
 }
 
+TEST(SimDrivers, TiltGivesItsGyroscopeWhenTheSceneHasOne) {
+  auto r = simRegistry();
+  // handheld_tour's sensor has a gyroscope; at t ~ 0 the projector is still: the reading
+  // is its bias, [0.8, -0.6, 0.4] deg/s (0.005 deg/s/sqrt(Hz) of noise at 100 Hz: 0.035).
+  Device with = open(r, simDevice(PROCAM_FAMILY_TILT, "accel", "handheld_tour"));
+  procam_tilt_sample s{};
+  char err[256] = {};
+  ASSERT_EQ(with.raw().ops.tilt->read(with.raw().self, &s, err, sizeof err), PROCAM_OK) << err;
+  const auto rate = tiltRate(with.raw());
+  ASSERT_TRUE(rate);
+  const Vec3 dps =
+      Vec3(rate->angular_velocity[0], rate->angular_velocity[1], rate->angular_velocity[2]) *
+      (180 / M_PI);
+  EXPECT_LT((dps - Vec3(0.8, -0.6, 0.4)).norm(), 0.2) << dps.transpose();
+  EXPECT_EQ(rate->timestamp_ns, s.timestamp_ns);
+  // handheld's has none.
+  Device without = open(r, simDevice(PROCAM_FAMILY_TILT, "accel"));
+  ASSERT_EQ(without.raw().ops.tilt->read(without.raw().self, &s, err, sizeof err), PROCAM_OK);
+  EXPECT_FALSE(tiltRate(without.raw()));
+}
+
 TEST(SimDrivers, TiltGarbageIsDroppedAndCountedByTheDriver) {
   // A broken accelerometer on a projector at a fixed pose: no noise and 2.5 g of bias on
   // the chip's z (up), clamped to its 2 g full scale. It reports the same vector, 2 g

@@ -27,6 +27,7 @@
 
 #include "keystone/accel_calibration.hpp"
 #include "keystone/display_error.hpp"
+#include "keystone/dot_grid.hpp"
 #include "keystone/keystone_solver.hpp"
 #include "keystone/orientation.hpp"
 #include "keystone/tilt_filter.hpp"
@@ -108,111 +109,20 @@ AccelCalibration calibrate() {
   return fit->calibration;
 }
 
-// The sparse pattern: 39 x 21 Gaussian dots 45 px apart, inset so that every dot stays
-// inside the attached camera's view at every pose. The dots are small on purpose: an
-// intensity centroid moves towards the brighter side by (the dot's second moment) x
-// (gradient of ln illumination), and the 1/d^2 and cosine fall-off across the image
-// turn that into a scale error that tilts the fitted wall (7 px dots: ~0.8 mrad; 3 px
-// dots: ~0.1 mrad).
-constexpr int kDotSpacing = 45, kDotColumns = 39, kDotRows = 21;
+// The sparse pattern (keystone/dot_grid.hpp): 39 x 21 Gaussian dots 45 px apart on
+// this 1920 x 1080 projector, inset so that every dot stays inside the attached
+// camera's view at every pose.
+//
 // Camera frames averaged per still pose (about 2 s at 30 fps of the 9.5 s hold). The
 // yaw a 6 cm baseline resolves is noise-limited: with 16 or 32 frames the corner error
 // at pitch +-45 degrees scatters to 0.5-0.7 px over noise seeds; with 64 the worst pose
 // stays near 0.3 px, most of it the accelerometer's share (see TiltOnlyWithZeroYaw).
 constexpr int kFrames = 64;
-struct DotPattern {
-  cv::Mat image;  // CV_8UC1, 1920 x 1080
-  std::vector<Vec2> centres;
-};
 
-DotPattern dotPattern() {
-  DotPattern d;
-  d.image = cv::Mat::zeros(1080, 1920, CV_8UC1);
-  constexpr double kSigma = 3;
-  constexpr int kReach = 12;  // 4 sigma
-  for (int gy = 0; gy < kDotRows; ++gy)
-    for (int gx = 0; gx < kDotColumns; ++gx) {
-      const int cx = 105 + kDotSpacing * gx, cy = 90 + kDotSpacing * gy;
-      d.centres.emplace_back(cx, cy);
-      for (int y = cy - kReach; y <= cy + kReach; ++y)
-        for (int x = cx - kReach; x <= cx + kReach; ++x) {
-          const double r2 = double((x - cx) * (x - cx) + (y - cy) * (y - cy));
-          d.image.at<std::uint8_t>(y, x) =
-              cv::saturate_cast<std::uint8_t>(255 * std::exp(-r2 / (2 * kSigma * kSigma)));
-        }
-    }
-  return d;
-}
-
-// Dot centres in the mean of the camera frames: blobs above the background, each
-// refined by intensity moments over a 7 x 7 window after subtracting the median of the
-// window's border (weights not clipped at zero, so that noise does not pull the
-// centroid towards the window's centre).
-std::vector<Vec2> detectDots(const cv::Mat& grey) {
-  std::vector<float> all(grey.begin<float>(), grey.end<float>());
-  std::nth_element(all.begin(), all.begin() + all.size() / 2, all.end());
-  const double background = all[all.size() / 2];  // dots cover a few % of the image
-  cv::Mat mask = grey > background + 6, labels, stats, seeds;
-  const int n = cv::connectedComponentsWithStats(mask, labels, stats, seeds, 8);
-  constexpr int kR = 3;
-  std::vector<Vec2> dots;
-  for (int i = 1; i < n; ++i) {
-    if (stats.at<int>(i, cv::CC_STAT_AREA) < 3) continue;
-    Vec2 c(seeds.at<double>(i, 0), seeds.at<double>(i, 1));
-    bool inside = true;
-    for (int iteration = 0; iteration < 3 && inside; ++iteration) {
-      const int x0 = int(std::lround(c.x())), y0 = int(std::lround(c.y()));
-      inside = x0 - kR >= 0 && y0 - kR >= 0 && x0 + kR < grey.cols && y0 + kR < grey.rows;
-      if (!inside) break;
-      std::vector<double> border;
-      for (int k = -kR; k <= kR; ++k)
-        for (const auto& [x, y] : {std::pair{x0 + k, y0 - kR}, std::pair{x0 + k, y0 + kR},
-                                   std::pair{x0 - kR, y0 + k}, std::pair{x0 + kR, y0 + k}})
-          border.push_back(grey.at<float>(y, x));
-      std::nth_element(border.begin(), border.begin() + border.size() / 2, border.end());
-      const double bg = border[border.size() / 2];
-      double sw = 0, sx = 0, sy = 0;
-      for (int y = y0 - kR; y <= y0 + kR; ++y)
-        for (int x = x0 - kR; x <= x0 + kR; ++x) {
-          const double w = grey.at<float>(y, x) - bg;
-          sw += w, sx += w * x, sy += w * y;
-        }
-      if (sw <= 0)
-        inside = false;
-      else
-        c = Vec2(sx / sw, sy / sw);
-    }
-    if (inside) dots.push_back(c);
-  }
-  return dots;
-}
-
-// Projector-camera correspondences of the dots in one camera frame: each projector dot
-// is predicted through the plane m.X = 1 (projector frame) and matched to the nearest
-// detected dot within `gate` pixels. Camera pixels are returned undistorted.
-void matchDots(const DotPattern& pattern, const std::vector<Vec2>& detected,
-               const geom::CameraModel& cam_in_projector, const Mat3& Kp_inv, const Vec3& m,
-               double gate, std::vector<Vec2>& xp, std::vector<Vec2>& xc) {
-  for (const Vec2& p : pattern.centres) {
-    const Vec3 ray = Kp_inv * p.homogeneous();
-    if (m.dot(ray) <= 0) continue;
-    const auto q = cam_in_projector.project(ray / m.dot(ray));
-    if (!q) continue;
-    const Vec2* best = nullptr;
-    for (const Vec2& d : detected)
-      if (!best || (d - *q).norm() < (*best - *q).norm()) best = &d;
-    if (!best || (*best - *q).norm() > gate) continue;
-    auto ideal = cam_in_projector.undistortPixel(*best);
-    if (!ideal) continue;
-    xp.push_back(p);
-    xc.push_back(*ideal);
-  }
-}
-
-// The wall plane seen by the attached camera in four rendered frames of one still pose.
-Result<WallPlane> wallFromImages(const sim::Scene& scene, const sim::SceneState& state,
-                                 const DotPattern& pattern, std::uint64_t seed,
-                                 std::size_t& out_matches) {
+// The wall plane seen by the attached camera in the mean of kFrames rendered frames of
+// one still pose.
+Result<WallFromDots> wallFromImages(const sim::Scene& scene, const sim::SceneState& state,
+                                    const DotGrid& pattern, std::uint64_t seed) {
   const sim::Framebuffers shown{{"proj", pattern.image}};
   auto renderer = sim::Renderer::create(scene, state, shown);
   if (!renderer) return tl::unexpected(renderer.error());
@@ -224,7 +134,6 @@ Result<WallPlane> wallFromImages(const sim::Scene& scene, const sim::SceneState&
   geom::CameraModel cam_in_projector = cam.model;
   cam_in_projector.pose.R = cam.model.pose.R * proj.pose.R.transpose();
   cam_in_projector.pose.t = cam.model.pose.t - cam_in_projector.pose.R * proj.pose.t;
-  const Mat3 Kp_inv = proj.K.matrix().inverse();
   const sim::CameraResponse response(cam.spec, true);
   cv::Mat mean = cv::Mat::zeros(cam.model.height, cam.model.width, CV_32F);
   for (int frame = 0; frame < kFrames; ++frame) {
@@ -239,16 +148,9 @@ Result<WallPlane> wallFromImages(const sim::Scene& scene, const sim::SceneState&
     image.convertTo(f, CV_32F, 1.0 / kFrames);
     mean += f;
   }
-  const std::vector<Vec2> dots = detectDots(mean);
-  // Identify at a nominal 3 m (gate: under half the 12 px camera spacing), then again
+  // Identified at a nominal 3 m (gate: under half the 12 px camera spacing), then again
   // through the first plane fit.
-  std::vector<Vec2> xp1, xc1, xp, xc;
-  matchDots(pattern, dots, cam_in_projector, Kp_inv, Vec3(0, 0, 1.0 / 3), 5, xp1, xc1);
-  auto first = wallFromCorrespondences(proj.K, cam.model.K, cam_in_projector.pose, xp1, xc1);
-  if (!first) return tl::unexpected(first.error());
-  matchDots(pattern, dots, cam_in_projector, Kp_inv, first->normal / first->distance, 2, xp, xc);
-  out_matches = xp.size();
-  return wallFromCorrespondences(proj.K, cam.model.K, cam_in_projector.pose, xp, xc);
+  return wallFromDots(pattern, mean, proj.K, cam_in_projector);
 }
 
 struct Outcome {
@@ -262,7 +164,9 @@ void run(const std::vector<Pose>& poses, bool use_camera, Outcome& out) {
   ASSERT_TRUE(sc) << sc.error().message;
   const Mat3 mount = sc->tiltSensors()[0].sensor_from_projector.transpose();  // sensor -> proj
   auto filter = TiltFilter::create({});
-  const DotPattern pattern = dotPattern();
+  auto pattern = makeDotGrid(1920, 1080);
+  ASSERT_TRUE(pattern) << pattern.error().message;
+  ASSERT_EQ(pattern->centres.size(), 39u * 21u);
   double t_next = 0;
   for (std::size_t i = 0; i < poses.size(); ++i) {
     const double t_eval = kHold * double(i) + kHold - 0.5;
@@ -279,13 +183,12 @@ void run(const std::vector<Pose>& poses, bool use_camera, Outcome& out) {
     const geom::CameraModel& proj = state.projectors[0].model;
     Mat3 R_est;
     if (use_camera) {
-      std::size_t matches = 0;
-      auto wall = wallFromImages(*sc, state, pattern, i + 1, matches);
+      auto wall = wallFromImages(*sc, state, *pattern, i + 1);
       ASSERT_TRUE(wall) << "pose " << i << ": " << wall.error().message;
       // Most of the 819 dots are found and identified (the far rows at pitch 45 degrees
       // are the dimmest).
-      EXPECT_GE(matches, 700u) << "pose " << i;
-      auto fused = fuseOrientation(down, wall->normal);
+      EXPECT_GE(wall->matched, 700u) << "pose " << i;
+      auto fused = fuseOrientation(down, wall->plane.normal);
       ASSERT_TRUE(fused) << fused.error().message;
       R_est = fused->R;
     } else {

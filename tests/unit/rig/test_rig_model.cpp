@@ -117,6 +117,43 @@ TEST(RigModel, MergeReplacesWhatWasCalibratedAndKeepsTheRest) {
   EXPECT_EQ(rigToJson(mergeRig(base, RigModel{})), rigToJson(base));  // nothing new: unchanged
 }
 
+TEST(RigModel, CameraMountedOnAProjectorStaysMountedWhenRecalibrated) {
+  RigModel base;
+  base.projectors = {projector("proj_a", 1500)};
+  base.cameras = {camera("cam")};
+  base.cameras[0].attached_to = "proj_a";
+  auto back = rigFromJson(rigToJson(base), "test");
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_EQ(back->cameras[0].attached_to, "proj_a");
+  EXPECT_EQ(back->attachedCamera("proj_a"), &back->cameras[0]);
+  EXPECT_EQ(back->attachedCamera("proj_b"), nullptr);
+  // A calibration that does not know the mount keeps it.
+  RigModel update;
+  update.cameras = {camera("cam")};
+  update.cameras[0].rms_px = 0.05;
+  const RigModel merged = mergeRig(base, update);
+  EXPECT_EQ(merged.cameras[0].attached_to, "proj_a");
+  EXPECT_EQ(merged.cameras[0].rms_px, 0.05);
+  // A camera without a pose gives no yaw.
+  base.cameras[0].pose_known = false;
+  EXPECT_EQ(base.attachedCamera("proj_a"), nullptr);
+  // Mounted on a projector not calibrated yet: kept, and no yaw from it; a mount that
+  // is not a name is refused.
+  json doc = rigToJson(base);
+  doc["cameras"][0]["attached_to"] = "proj_z";
+  auto later = rigFromJson(doc, "test");
+  ASSERT_TRUE(later) << later.error().message;
+  EXPECT_EQ(later->cameras[0].attached_to, "proj_z");
+  doc["cameras"][0]["attached_to"] = 3;
+  auto bad = rigFromJson(doc, "test");
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().code, ErrorCode::kParse);
+  EXPECT_NE(bad.error().message.find("attached_to"), std::string::npos);
+  EXPECT_FALSE(rigFromJson(doc, "test"));
+  doc["cameras"][0]["attached_to"] = "";
+  EXPECT_FALSE(rigFromJson(doc, "test"));
+}
+
 TEST(RigModel, MalformedDocumentsAreTypedErrors) {
   const std::pair<const char*, ErrorCode> cases[] = {
       {"[]", ErrorCode::kParse},

@@ -28,10 +28,15 @@ TEST(TruthRig, HandheldProjectorWithItsCalibratedAccelerometer) {
   EXPECT_EQ(p.tilt->sensor_from_projector, t.sensor_from_projector);
   // Offset: the scene's bias (mg) within 1 mg (10 s holds average the noise down).
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(p.tilt->calibration.offset[i] * 1e3, t.bias_mg[i], 1.0);
+  // The camera beside the lens is mounted on the projector.
+  ASSERT_EQ(rig->cameras.size(), 1u);
+  EXPECT_EQ(rig->cameras[0].attached_to, p.name);
+  EXPECT_EQ(rig->attachedCamera(p.name), &rig->cameras[0]);
   // Through JSON and back unchanged.
   auto back = rig::rigFromJson(rig::rigToJson(*rig), "truth");
   ASSERT_TRUE(back) << back.error().message;
   EXPECT_EQ(rig::rigToJson(*back), rig::rigToJson(*rig));
+  EXPECT_EQ(back->cameras[0].attached_to, p.name);
 }
 
 TEST(TruthRig, PlanarWallGivesItsPlaneAndTheViewer) {

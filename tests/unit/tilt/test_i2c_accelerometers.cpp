@@ -31,6 +31,7 @@ TEST(I2cAccelerometers, Adxl345SetupAndLittleEndianFullResolution) {
   rig.chip.produce(littleEndian({128, -64, -256}));  // 0.5, -0.25, -1 g at 256 LSB/g
   auto s = rig.sensor->read();
   ASSERT_TRUE(s) << s.error().message;
+  EXPECT_FALSE(s->angular_velocity);  // no gyroscope in the package
   EXPECT_NEAR((s->specific_force - Vec3(0.5, -0.25, -1) * kStandardGravity).norm(), 0, 1e-12);
   // Data-ready was cleared by the burst read: no second sample.
   EXPECT_EQ(rig.sensor->read().error().code, ErrorCode::kNotFound);
@@ -41,14 +42,21 @@ TEST(I2cAccelerometers, Adxl345SetupAndLittleEndianFullResolution) {
 TEST(I2cAccelerometers, Mpu6050SetupAndBigEndian) {
   Rig rig(I2cChip::kMpu6050, mpu6050(), {4, 100, 5, {}});
   ASSERT_TRUE(rig.sensor->open());
-  EXPECT_EQ(rig.chip.lastWrite(0x6B), 0x01);           // awake, PLL
-  EXPECT_EQ(rig.chip.lastWrite(0x1C), 0x08);           // AFS_SEL = 1: ±4 g
-  EXPECT_EQ(rig.chip.lastWrite(0x19), 9);              // 1 kHz / (1 + 9)
-  EXPECT_EQ(rig.chip.lastWrite(0x38), 0x01);           // DATA_RDY_EN
+  EXPECT_EQ(rig.chip.lastWrite(0x6B), 0x01);  // awake, PLL
+  EXPECT_EQ(rig.chip.lastWrite(0x1C), 0x08);  // AFS_SEL = 1: ±4 g
+  EXPECT_EQ(rig.chip.lastWrite(0x19), 9);     // 1 kHz / (1 + 9)
+  EXPECT_EQ(rig.chip.lastWrite(0x38), 0x01);  // DATA_RDY_EN
+  EXPECT_EQ(rig.chip.lastWrite(0x1B), 0x08);  // FS_SEL = 1: +-500 deg/s
+  // The gyroscope after the temperature, read in the same burst: 65.5 LSB/(deg/s).
+  const auto gyro = bigEndian({655, -6550, 32767});
+  for (int i = 0; i < 6; ++i) rig.chip.regs[std::size_t(0x43 + i)] = gyro[std::size_t(i)];
   rig.chip.produce(bigEndian({8192, -4096, -32768}));  // 8192 LSB/g
   auto s = rig.sensor->read();
   ASSERT_TRUE(s);
   EXPECT_NEAR((s->specific_force - Vec3(1, -0.5, -4) * kStandardGravity).norm(), 0, 1e-12);
+  ASSERT_TRUE(s->angular_velocity);
+  EXPECT_NEAR((*s->angular_velocity - Vec3(10, -100, 32767 / 65.5) * (M_PI / 180)).norm(), 0,
+              1e-12);
   rig.sensor->close();
   EXPECT_EQ(rig.chip.lastWrite(0x6B), 0x40);  // sleep
 }

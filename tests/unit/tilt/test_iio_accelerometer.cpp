@@ -108,6 +108,58 @@ TEST(IioAccelerometer, BufferedRecordsThroughTheCharacterDevice) {
   EXPECT_EQ(tree.get("buffer/enable"), "0");
 }
 
+TEST(IioAccelerometer, CombinedImuGivesItsGyroscopeWithEverySample) {
+  // Polled: an MPU-6050 under the kernel's inv_mpu6050 driver has anglvel channels
+  // beside the accel ones (rad/s per count).
+  FakeIioTree tree;
+  for (const char* a : {"x", "y", "z"}) tree.set(std::string("in_accel_") + a + "_raw", "0");
+  tree.set("in_accel_z_raw", "1000");
+  tree.set("in_accel_scale", "0.00980665");
+  tree.set("in_anglvel_x_raw", "655");
+  tree.set("in_anglvel_y_raw", "-131");
+  tree.set("in_anglvel_z_raw", "0");
+  tree.set("in_anglvel_scale", "0.000133090");  // 1 / 131 deg/s per count
+  tree.set("in_anglvel_z_offset", "10");
+  IioAccelerometer polled({tree.dir().string(), "", false, {}, 64, 10});
+  ASSERT_TRUE(polled.open());
+  EXPECT_TRUE(polled.hasGyroscope());
+  auto s = polled.read();
+  ASSERT_TRUE(s) << s.error().message;
+  ASSERT_TRUE(s->angular_velocity);
+  EXPECT_NEAR((*s->angular_velocity - Vec3(655, -131, 10) * 0.000133090).norm(), 0, 1e-12);
+  tree.set("in_anglvel_x_raw", "nan?");  // the sample stays, without its rate
+  s = polled.read();
+  ASSERT_TRUE(s) << s.error().message;
+  EXPECT_FALSE(s->angular_velocity);
+  polled.close();
+
+  // Buffered: the anglvel scan elements are enabled with the accel ones.
+  int index = 0;
+  for (const char* ch : {"accel_x", "accel_y", "accel_z", "anglvel_x", "anglvel_y", "anglvel_z"}) {
+    tree.set(std::string("scan_elements/in_") + ch + "_en", "0");
+    tree.set(std::string("scan_elements/in_") + ch + "_index", std::to_string(index++));
+    tree.set(std::string("scan_elements/in_") + ch + "_type", "le:s16/16>>0");
+  }
+  tree.set("in_anglvel_x_raw", "0");
+  tree.set("buffer/length", "0");
+  tree.set("buffer/enable", "0");
+  const fs::path node = tree.dir().parent_path() / "dev-iio-device0";
+  {
+    std::ofstream out(node, std::ios::binary);
+    const std::int16_t v[6] = {0, 0, 1000, 131, -262, 0};
+    out.write(reinterpret_cast<const char*>(v), sizeof v);  // little-endian host
+  }
+  IioAccelerometer buffered({tree.dir().string(), node.string(), true, {}, 32, 10});
+  ASSERT_TRUE(buffered.open());
+  EXPECT_TRUE(buffered.buffered());
+  EXPECT_EQ(tree.get("scan_elements/in_anglvel_y_en"), "1");
+  s = buffered.read();
+  ASSERT_TRUE(s) << s.error().message;
+  ASSERT_TRUE(s->angular_velocity);
+  EXPECT_NEAR((*s->angular_velocity - Vec3(131, -262, 10) * 0.000133090).norm(), 0, 1e-12);
+  EXPECT_NEAR(s->specific_force.z(), 1000 * 0.00980665, 1e-12);
+}
+
 TEST(IioAccelerometer, MissingChannelsAndScale) {
   FakeIioTree tree;
   tree.set("in_accel_x_raw", "1");

@@ -8,7 +8,7 @@ namespace procam::tilt {
 namespace {
 
 TiltSample sample(double x, double y, double z) {
-  return TiltSample{Vec3(x, y, z) * kStandardGravity, 0};
+  return TiltSample{Vec3(x, y, z) * kStandardGravity, 0, std::nullopt};
 }
 
 TEST(SampleGate, RejectsAndCountsEachKindOfGarbage) {

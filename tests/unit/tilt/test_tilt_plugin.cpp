@@ -226,10 +226,19 @@ TEST(TiltPlugin, I2cReadsRegistersAndRejectsGarbage) {
 
   EXPECT_EQ(readOnce(dev).status, PROCAM_EAGAIN);  // data not ready: no blocking wait
   // ±4 g: 8192 counts per g, big-endian. (0.5, -0.25, 0.75) g: |f| = 0.935 g.
+  // The gyroscope's (131, 0, -655) counts at 65.5 LSB/(deg/s): 2, 0, -10 deg/s.
+  const auto gyro = bigEndian({131, 0, -655});
+  for (int i = 0; i < 6; ++i) chip.regs[std::size_t(0x43 + i)] = gyro[std::size_t(i)];
   chip.produce(bigEndian({4096, -2048, 6144}));
   Read r = readOnce(dev);
   ASSERT_EQ(r.status, PROCAM_OK) << r.reason;
   EXPECT_NEAR((force(r) - Vec3(0.5, -0.25, 0.75) * kG).norm(), 0, 1e-12);
+  // Its gyroscope's reading with that sample, through the ABI (tilt table version 3).
+  const auto rate = plugins::tiltRate(dev.raw());
+  ASSERT_TRUE(rate);
+  EXPECT_NEAR(rate->angular_velocity[0], 2 * M_PI / 180, 1e-12);
+  EXPECT_NEAR(rate->angular_velocity[2], -10 * M_PI / 180, 1e-12);
+  EXPECT_EQ(rate->timestamp_ns, r.sample.timestamp_ns);
 
   // (2, 2, 2.5) g, |f| = 3.8 g: shaken, rejected and counted.
   chip.produce(bigEndian({16384, 16384, 20480}));
