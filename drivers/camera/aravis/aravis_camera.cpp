@@ -326,10 +326,32 @@ Result<const Frame*> AravisCamera::capture(int timeout_ms) {
   if (!stream_) return fail(ErrorCode::kInvalidInput, name() + ": not streaming");
   releaseHeld();
   if (lost_) return tl::unexpected(checkAlive().error());
-  ArvBuffer* b = timeout_ms == 0
-                     ? arv_stream_try_pop_buffer(stream_)
-                     : arv_stream_timeout_pop_buffer(
-                           stream_, guint64(timeout_ms < 0 ? 3'600'000 : timeout_ms) * 1000u);
+  // A frame that lost packets on the network (GigE Vision over UDP) is dropped and
+  // counted, and the wait goes on for the next one within the same time.
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::milliseconds(timeout_ms < 0 ? 3'600'000 : timeout_ms);
+  ArvBuffer* b = nullptr;
+  int incomplete = -1;
+  for (;;) {
+    const auto left = std::chrono::duration_cast<std::chrono::microseconds>(
+        deadline - std::chrono::steady_clock::now());
+    b = timeout_ms == 0
+            ? arv_stream_try_pop_buffer(stream_)
+            : (left.count() > 0 ? arv_stream_timeout_pop_buffer(stream_, guint64(left.count()))
+                                : nullptr);
+    if (!b || arv_buffer_get_status(b) == ARV_BUFFER_STATUS_SUCCESS) break;
+    ++failed_;
+    incomplete = int(arv_buffer_get_status(b));
+    held_ = b;
+    releaseHeld();
+    b = nullptr;
+    if (timeout_ms == 0) break;
+  }
+  if (!b && incomplete >= 0) {
+    return fail(
+        timeout_ms == 0 ? ErrorCode::kAgain : ErrorCode::kIo,
+        name() + ": frame incomplete (Aravis buffer status " + std::to_string(incomplete) + ")");
+  }
   if (!b) {
     if (timeout_ms == 0) {
       if (lost_) return tl::unexpected(checkAlive().error());
@@ -341,13 +363,6 @@ Result<const Frame*> AravisCamera::capture(int timeout_ms) {
                 name() + ": no frame within " + std::to_string(timeout_ms) + " ms");
   }
   held_ = b;
-  if (arv_buffer_get_status(b) != ARV_BUFFER_STATUS_SUCCESS) {
-    ++failed_;
-    const int status = int(arv_buffer_get_status(b));
-    releaseHeld();
-    return fail(ErrorCode::kIo, name() + ": frame incomplete (Aravis buffer status " +
-                                    std::to_string(status) + ")");
-  }
   std::size_t size = 0;
   const auto* data = static_cast<const uint8_t*>(arv_buffer_get_image_data(b, &size));
   const uint32_t w = uint32_t(arv_buffer_get_image_width(b));
