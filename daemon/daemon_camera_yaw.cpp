@@ -73,8 +73,7 @@ void Daemon::probeCameraYaw() {
   }
   // Camera from projector: both poses were calibrated together, in one world frame.
   geom::CameraModel in_projector = c->model;
-  in_projector.pose.R = c->model.pose.R * p->pose.R.transpose();
-  in_projector.pose.t = c->model.pose.t - in_projector.pose.R * p->pose.t;
+  in_projector.pose = c->model.pose.relativeTo(p->pose);
   if (!(in_projector.pose.t.norm() > 1e-3)) {
     y.unavailable = "camera '" + c->name + "' sits within 1 mm of the projector's lens: no " +
                     "baseline to see the wall's direction from";

@@ -125,12 +125,7 @@ Result<void> Daemon::setAutoKeystone(bool enable) {
   if (enable && !k.tracker) return fail(ErrorCode::kNotFound, k.unavailable);
   settings_.auto_keystone = enable;
   if (!enable || !k.tracker) {
-    stopTiltPolling();
-    stopCameraYaw();
-    k.yaw.normal.reset();
-    k.yaw.tried_this_hold = false;
-    if (k.gyro) k.gyro->stop();
-    k.gyro_anchor.reset();
+    stopTiltPolling();  // the hold and the gyroscope's turn end with the samples
     k.down.reset();
     k.estimate.reset();
     k.solve_again = false;

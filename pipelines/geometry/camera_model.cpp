@@ -119,6 +119,13 @@ Pose Pose::inverse() const {
   return inv;
 }
 
+Pose Pose::relativeTo(const Pose& other) const {
+  Pose rel;
+  rel.R = R * other.R.transpose();
+  rel.t = t - rel.R * other.t;
+  return rel;
+}
+
 Pose Pose::lookAt(const Vec3& eye, const Vec3& target, const Vec3& up) {
   Vec3 z = target - eye;
   if (!(z.norm() > 0) || !z.allFinite()) z = Vec3::UnitY();

@@ -37,6 +37,9 @@ struct Pose {
   Vec3 toDevice(const Vec3& world) const { return R * world + t; }
   Vec3 toWorld(const Vec3& device) const { return R.transpose() * (device - t); }
   Pose inverse() const;
+  // This device's pose in the frame of the device posed by `other` (both world ->
+  // device): x_this = R x_other + t.
+  Pose relativeTo(const Pose& other) const;
   // Device at `eye` with its +z axis towards `target` and its -y axis as close to
   // `up` as possible (image y points down). Degenerate input never yields NaN: if
   // eye == target the device looks along world +Y; if up is parallel to the view

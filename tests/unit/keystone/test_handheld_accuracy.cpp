@@ -132,8 +132,7 @@ Result<WallFromDots> wallFromImages(const sim::Scene& scene, const sim::SceneSta
   const sim::CameraState& cam = state.cameras[0];
   // The calibrated extrinsics: camera from projector.
   geom::CameraModel cam_in_projector = cam.model;
-  cam_in_projector.pose.R = cam.model.pose.R * proj.pose.R.transpose();
-  cam_in_projector.pose.t = cam.model.pose.t - cam_in_projector.pose.R * proj.pose.t;
+  cam_in_projector.pose = cam.model.pose.relativeTo(proj.pose);
   const sim::CameraResponse response(cam.spec, true);
   cv::Mat mean = cv::Mat::zeros(cam.model.height, cam.model.width, CV_32F);
   for (int frame = 0; frame < kFrames; ++frame) {
