@@ -29,6 +29,9 @@ constexpr double kMaxWallTilt = degToRad(5.0);
 // A gyroscope turning slower than this (bias removed) is still: about 14 sigma of a
 // 0.005 deg/s/sqrt(Hz) gyroscope read at 100 Hz, under a tenth of a pixel per frame.
 constexpr double kQuietRate = degToRad(0.5);
+// A gap between readings that a sensor at 100 Hz or more never leaves on its own: five
+// sample periods at 100 Hz.
+constexpr uint64_t kGyroGapNs = 50'000'000;
 
 }  // namespace
 
@@ -212,6 +215,12 @@ void Daemon::onGyroRate(const procam_rate_sample& sample, const Vec3& specific_f
   const Vec3 w = M.transpose() * Vec3(sample.angular_velocity[0], sample.angular_velocity[1],
                                       sample.angular_velocity[2]);
   if (sample.timestamp_ns <= k.gyro_last_ns) return;  // not newer: read twice
+  if (k.gyro && k.gyro->running() && k.gyro_last_ns > 0 &&
+      sample.timestamp_ns - k.gyro_last_ns > kGyroGapNs) {
+    ++k.gyro_gaps;
+    logDebug("gyroscope: " + std::to_string((sample.timestamp_ns - k.gyro_last_ns) / 1'000'000) +
+             " ms between readings while the projector turned");
+  }
   k.gyro_last_ns = sample.timestamp_ns;
   ++k.gyro_samples;
   k.gyro_rate = w;
@@ -323,7 +332,8 @@ json Daemon::gyroJson() const {
   return {{"samples", k.gyro_samples},
           {"rate_dps", {w.x(), w.y(), w.z()}},
           {"bias_dps", k.gyro_bias.known() ? json{b.x(), b.y(), b.z()} : json(nullptr)},
-          {"carrying", k.gyro && k.gyro->running()}};
+          {"carrying", k.gyro && k.gyro->running()},
+          {"gaps", k.gyro_gaps}};
 }
 
 }  // namespace procam::daemon

@@ -66,6 +66,10 @@ struct KeystoneRuntime {
   Vec3 gyro_anchor_rate = Vec3::Zero();
   uint64_t gyro_samples = 0;
   uint64_t gyro_last_ns = 0;
+  // Readings more than 50 ms apart while the gyroscope carried a turn: what
+  // turned between them is integrated from the two ends alone (a polled sensor whose
+  // reader fell behind; a buffered one delivers every sample).
+  uint64_t gyro_gaps = 0;
   Vec3 gyro_rate = Vec3::Zero();  // the last reading, projector frame, rad/s
 
   // The last published gravity and the solution made from it.

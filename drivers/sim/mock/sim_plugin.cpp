@@ -56,8 +56,12 @@ struct CameraRadiance {
     if (radiance.empty() || n != shows || state.world != world || p.size() != poses.size()) {
       return false;
     }
+    // A held pose evaluated at another time differs by rounding (a few 1e-16 from the
+    // interpolation between equal keyframes); 1e-12 rad or m moves no pixel.
+    constexpr double kSame = 1e-12;
     for (std::size_t i = 0; i < p.size(); ++i) {
-      if (p[i].R != poses[i].R || p[i].t != poses[i].t) return false;
+      if ((p[i].R - poses[i].R).norm() > kSame) return false;
+      if ((p[i].t - poses[i].t).norm() > kSame) return false;
     }
     return true;
   }

@@ -1,9 +1,43 @@
 #include "sim_tilt.hpp"
 
+#include <sys/timerfd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+
 #include "sim/sensors.hpp"
 #include "sim_unplug.hpp"
 
 namespace procam::sim::mock {
+
+SimTiltSensor::SimTiltSensor(std::shared_ptr<SimWorld> world, std::string name)
+    : world_(std::move(world)), name_(std::move(name)) {
+  for (const auto& spec : world_->scene().tiltSensors()) {
+    if (spec.name == name_) rate_hz_ = spec.rate_hz;
+  }
+}
+
+Result<void> SimTiltSensor::open() {
+  const int fd = ::timerfd_create(CLOCK_MONOTONIC, TFD_NONBLOCK | TFD_CLOEXEC);
+  if (fd < 0) return fail(ErrorCode::kIo, std::string("timerfd: ") + std::strerror(errno));
+  timer_.reset(fd);
+  next_ = -1;
+  armFor(static_cast<long long>(std::floor(world_->now() * rate_hz_)));
+  return {};
+}
+
+void SimTiltSensor::armFor(long long k) {
+  if (!timer_.valid()) return;
+  // The world's clock is CLOCK_MONOTONIC from its epoch (sim_world.hpp); a time already
+  // past fires at once. Zero would disarm: the earliest is 1 ns.
+  const uint64_t ns = std::max<uint64_t>(1, world_->monotonicNs(static_cast<double>(k) / rate_hz_));
+  itimerspec spec{};
+  spec.it_value.tv_sec = static_cast<time_t>(ns / 1'000'000'000);
+  spec.it_value.tv_nsec = static_cast<long>(ns % 1'000'000'000);
+  (void)::timerfd_settime(timer_.get(), TFD_TIMER_ABSTIME, &spec, nullptr);
+}
 
 Result<tilt::TiltSample> SimTiltSensor::read() {
   auto gone = unpluggedNow(name_);
@@ -12,7 +46,23 @@ Result<tilt::TiltSample> SimTiltSensor::read() {
   if (*gone)
     return fail(ErrorCode::kNoDevice,
                 "'" + name_ + "' is unplugged (" + std::string(kUnplugVariable) + ")");
-  const double t = world_->now();
+  if (timer_.valid()) {
+    uint64_t expirations = 0;  // the descriptor's readiness is re-armed below
+    (void)!::read(timer_.get(), &expirations, sizeof expirations);
+  }
+  // Sample k is taken at k / rate. The oldest unread one is returned; one the FIFO
+  // could not hold any more is lost, as on a chip whose reader fell behind.
+  const long long newest =
+      std::max(0LL, static_cast<long long>(std::floor(world_->now() * rate_hz_)));
+  if (next_ < 0) {
+    next_ = newest;  // the first read: the newest
+  } else if (next_ < newest - kFifoDepth + 1) {
+    next_ = newest - kFifoDepth + 1;
+  }
+  const long long k = std::min(next_, newest);  // none waits: the newest again
+  next_ = k + 1;
+  armFor(next_);
+  const double t = static_cast<double>(k) / rate_hz_;
   auto s = sampleTilt(world_->scene(), name_, t);
   if (!s) return fail(ErrorCode::kIo, s.error().message);
   double unit = 1.0;
@@ -24,7 +74,7 @@ Result<tilt::TiltSample> SimTiltSensor::read() {
   }
   tilt::TiltSample out;
   out.specific_force = s->value * unit;
-  out.timestamp_ns = static_cast<uint64_t>(t * 1e9);
+  out.timestamp_ns = static_cast<uint64_t>(std::llround(t * 1e9));
   if (gyro) {
     // The package's gyroscope, sampled with the same sample (SCENE-FORMAT.md).
     auto w = sampleGyro(world_->scene(), name_, t);
