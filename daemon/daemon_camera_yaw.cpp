@@ -191,7 +191,11 @@ void Daemon::measureCameraYaw() {
         requestSolve();
       }
     }
-    refreshOutputs();  // the content again
+    // The content again. A solution of a reading that came before the dot grid ended is
+    // not counted in the reading-to-shown latency: it waited for the measurement.
+    k.unshown_arrival.reset();
+    k.grid_ended = std::chrono::steady_clock::now();
+    refreshOutputs();
   };
   compute_worker_->submit(
       [plan, finished] {

@@ -1,6 +1,7 @@
 // Auto keystone (PROTOCOL.md: keystone). Everything here runs on the loop thread; the
 // keystone solve and the six-position calibration of the virtual rig run on
 // compute_worker_ and post their results back. What the outputs show: daemon_outputs.cpp.
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <sstream>
@@ -18,6 +19,10 @@ using nlohmann::json;
 namespace code = proto::code;
 
 namespace {
+
+// The longest lead a turn is predicted over (keystone_latency.hpp): a frame shown later
+// than this is late whatever is predicted.
+constexpr double kMaxLead = 0.1;
 
 json quadJson(const std::array<Vec2, 4>& q) {
   json a = json::array();
@@ -185,6 +190,7 @@ void Daemon::watchTiltSensor() {
 void Daemon::onTiltSample(const TiltReading& reading) {
   KeystoneRuntime& k = keystone_rt_;
   if (!k.tracker) return;
+  k.reading_arrival = std::chrono::steady_clock::now();
   const procam_tilt_sample& sample = reading.sample;
   const Vec3 f(sample.specific_force[0], sample.specific_force[1], sample.specific_force[2]);
   const bool was_still = k.tracker->still();
@@ -212,20 +218,31 @@ void Daemon::requestSolve() {
   const cv::Size content = currentSourceSize();
   if (content.width < 1 || content.height < 1) return;
   k.solving = true;
+  // While the gyroscope carries a turn, the solution is for the moment its frame reaches
+  // the wall: the orientation predicted over the measured reading-to-shown latency (at
+  // most kMaxLead: a hand's turn changes within a longer one).
+  std::optional<Mat3> R = keystoneOrientation(*k.down);
+  double lead = 0;
+  if (R && k.gyro && k.gyro->running() && !k.yaw.normal) {
+    lead = std::min(k.latency.median(), kMaxLead);
+    R = k.gyro->predicted(lead);
+  }
   compute_worker_->submit(
-      [this, projector = *k.projector, down = *k.down, time = k.down_time, content,
-       R = keystoneOrientation(*k.down), yaw_source = cameraYawSource()] {
+      [this, projector = *k.projector, down = *k.down, time = k.down_time, content, R,
+       yaw_source = cameraYawSource(), arrival = k.reading_arrival, lead] {
         auto e =
             R ? keystone::solveFromOrientation(projector, *R, down, content.width, content.height)
               : solveFromDown(projector, down, content.width, content.height);
         if (e) e->sample_time = time;
-        return [this, e = std::move(e), yaw_source] {
+        return [this, e = std::move(e), yaw_source, arrival, lead] {
           KeystoneRuntime& k = keystone_rt_;
           k.solving = false;
           if (settings_.auto_keystone) {
             if (e) {
               k.estimate = *e;
               k.estimate_yaw = yaw_source;
+              if (!k.yaw.measuring && arrival >= k.grid_ended) k.unshown_arrival = arrival;
+              k.estimate_lead = lead;
               ++k.solves;
               broadcast("keystone", keystoneJson());
               refreshOutputs();
@@ -317,7 +334,10 @@ json Daemon::keystoneJson() const {
                      {"down", {e.down.x(), e.down.y(), e.down.z()}},
                      {"scale", e.scale},
                      {"sample_time", e.sample_time},
+                     {"lead_ms", 1e3 * k.estimate_lead},
+                     {"display_time", e.sample_time + k.estimate_lead},
                      {"updates", k.solves}};
+    j["latency"] = k.latency.toJson();
   }
   if (k.projector) {
     j["projector"] = {

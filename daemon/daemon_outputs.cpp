@@ -206,6 +206,12 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done, bool supersede
       requestSolve();
     }
   }
+  if (k.unshown_arrival && settings_.auto_keystone) {
+    for (auto& job : jobs) {
+      if (job.homography) job.reading_arrival = k.unshown_arrival;
+    }
+    k.unshown_arrival.reset();
+  }
   k.rendering = true;
   k.frame_stop = std::make_shared<std::atomic<bool>>(false);
   for (auto& job : jobs) job.stop = k.frame_stop;
@@ -239,6 +245,7 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done, bool supersede
             }
             shown = true;
             drawn = drawn || r.drawn;
+            if (r.latency_s) k.latency.add(*r.latency_s);
             if (r.stats) {
               k.shown[r.name] = {r.source,
                                  r.stats->lit_fraction,

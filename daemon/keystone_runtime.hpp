@@ -20,6 +20,7 @@
 #include "driver.hpp"
 #include "keystone/dot_grid.hpp"
 #include "keystone/gyro_orientation.hpp"
+#include "keystone_latency.hpp"
 #include "output_frames.hpp"
 #include "render/cpu_renderer.hpp"
 
@@ -70,6 +71,13 @@ struct KeystoneRuntime {
   // turned between them is integrated from the two ends alone (a polled sensor whose
   // reader fell behind; a buffered one delivers every sample).
   uint64_t gyro_gaps = 0;
+
+  // From a tilt reading's arrival to the frame drawn from it (keystone_latency.hpp): the
+  // latest reading's arrival, that of the published solution not yet on an output.
+  std::chrono::steady_clock::time_point reading_arrival{};
+  std::optional<std::chrono::steady_clock::time_point> unshown_arrival;
+  std::chrono::steady_clock::time_point grid_ended{};  // the camera yaw's dot grid, last
+  KeystoneLatency latency;
   Vec3 gyro_rate = Vec3::Zero();  // the last reading, projector frame, rad/s
 
   // The last published gravity and the solution made from it.
@@ -77,6 +85,7 @@ struct KeystoneRuntime {
   double down_time = 0;
   std::optional<KeystoneEstimate> estimate;
   std::string estimate_yaw;  // where its yaw came from (cameraYawSource)
+  double estimate_lead = 0;  // s: predicted ahead of its sample, to when it is shown
   bool solving = false;
   bool solve_again = false;
   uint64_t solves = 0;

@@ -59,6 +59,14 @@ void drawFallback(const OutputDraw& j, OutputDrawn& r) {
   }
 }
 
+// A new frame on the output, drawn from a tilt solution not shown before: how long
+// after its reading arrived.
+void stampLatency(const OutputDraw& j, OutputDrawn& r) {
+  if (!r.ok || !r.drawn || !j.reading_arrival) return;
+  r.latency_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - *j.reading_arrival).count();
+}
+
 }  // namespace
 
 OutputDrawn drawOutput(const OutputDraw& j) {
@@ -82,6 +90,7 @@ OutputDrawn drawOutput(const OutputDraw& j) {
     }
     if (j.fallback) {
       drawFallback(j, r);
+      stampLatency(j, r);
       return r;
     }
     const procam_device& raw = j.device->raw();
@@ -121,6 +130,7 @@ OutputDrawn drawOutput(const OutputDraw& j) {
       r.stats = render::FrameStats{stats.lit_fraction,
                                    {stats.mean_rgb[0], stats.mean_rgb[1], stats.mean_rgb[2]}};
     }
+    stampLatency(j, r);
   } catch (const std::exception& e) {
     r.ok = false;
     r.error = e.what();

@@ -6,6 +6,7 @@
 // it (its warp map built once per setup) through `show`. The daemon plans on the loop
 // (daemon_keystone.cpp) and draws on its compute worker.
 #include <atomic>
+#include <chrono>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <optional>
@@ -37,6 +38,9 @@ struct OutputDraw {
   // Set by the loop when a newer request made this frame obsolete: the draw stops before
   // the output or, where the driver can (output operations version 3), midway.
   std::shared_ptr<const std::atomic<bool>> stop;
+  // Set when the homography is a tilt solution not shown before: its reading's arrival,
+  // from which the draw measures when the frame is shown (keystone_latency.hpp).
+  std::optional<std::chrono::steady_clock::time_point> reading_arrival;
 };
 
 struct OutputDrawn {
@@ -54,6 +58,7 @@ struct OutputDrawn {
   int rc = 0;                    // the driver's status when !ok (PROCAM_ENODEV: gone)
   std::string error;
   std::optional<render::FrameStats> stats;
+  std::optional<double> latency_s;  // reading_arrival to shown, when a new frame was shown
 };
 
 // Runs on a worker; never throws.

@@ -60,6 +60,15 @@ std::string keystoneText(const json& k) {
     if (y.contains("unavailable")) text += " (" + scalar(y["unavailable"]) + ")";
     out += field("yaw", text);
   }
+  // How long a tilt reading takes to reach the wall.
+  if (k.contains("latency") && k["latency"].is_object()) {
+    const json& l = k["latency"];
+    char text[128];
+    std::snprintf(text, sizeof text, "median %.1f ms, 95%% %.1f ms, max %.1f ms (%llu frames)",
+                  l.value("median_ms", 0.0), l.value("p95_ms", 0.0), l.value("max_ms", 0.0),
+                  static_cast<unsigned long long>(l.value("frames", 0ULL)));
+    out += field("tilt to shown", text);
+  }
   if (k.contains("homography") && k["homography"].is_array()) {
     for (size_t r = 0; r < k["homography"].size(); ++r) {
       out += field(r == 0 ? "homography" : "", pairList(k["homography"][r]));

@@ -93,7 +93,10 @@ class Reader {
         k.finish();
       }
       if (keys.empty()) f.error("keyframes", "at least one keyframe is required");
-      auto traj = Trajectory::create(name, std::move(keys), f.boolean("loop", false));
+      const std::string ease = f.optionalString("ease").value_or("linear");
+      if (ease != "linear" && ease != "smooth") f.error("ease", "must be \"linear\" or \"smooth\"");
+      auto traj = Trajectory::create(name, std::move(keys), f.boolean("loop", false),
+                                     ease == "smooth" ? Easing::kSmooth : Easing::kLinear);
       if (!traj) f.errorHere(traj.error().message);
       out.push_back(std::move(*traj));
       f.finish();

@@ -7,7 +7,8 @@
 
 namespace procam::sim {
 
-Result<Trajectory> Trajectory::create(std::string name, std::vector<Keyframe> keys, bool loop) {
+Result<Trajectory> Trajectory::create(std::string name, std::vector<Keyframe> keys, bool loop,
+                                      Easing easing) {
   if (keys.empty())
     return fail(ErrorCode::kInvalidInput, "trajectory '" + name + "' has no keyframes");
   for (std::size_t i = 0; i < keys.size(); ++i) {
@@ -22,6 +23,7 @@ Result<Trajectory> Trajectory::create(std::string name, std::vector<Keyframe> ke
   traj.name_ = std::move(name);
   traj.keys_ = std::move(keys);
   traj.loop_ = loop && traj.keys_.size() > 1;
+  traj.easing_ = easing;
   return traj;
 }
 
@@ -39,7 +41,8 @@ Keyframe Trajectory::sample(double time) const {
                                      [](double t, const Keyframe& k) { return t < k.time; });
   const Keyframe& b = *next;
   const Keyframe& a = *(next - 1);
-  const double s = (time - a.time) / (b.time - a.time);
+  const double u = (time - a.time) / (b.time - a.time);
+  const double s = easing_ == Easing::kSmooth ? u * u * u * (10.0 + u * (6.0 * u - 15.0)) : u;
   Keyframe out;
   out.time = time;
   out.center = (1.0 - s) * a.center + s * b.center;

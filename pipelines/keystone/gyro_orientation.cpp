@@ -18,6 +18,7 @@ void GyroOrientation::start(const Mat3& R, std::uint64_t time_ns, const Vec3& ra
   R_ = R;
   last_ns_ = time_ns;
   last_rate_ = rate.allFinite() ? rate : Vec3::Zero();
+  acceleration_.setZero();
   running_ = true;
 }
 
@@ -32,6 +33,13 @@ void GyroOrientation::update(const Vec3& rate, const std::optional<Vec3>& down,
   }
   // dR/dt = -[w]x R: over dt, R <- exp(-[w dt]x) R (the mean rate of the step).
   const Vec3 w = last_rate_ ? 0.5 * (rate + *last_rate_) : rate;
+  if (last_rate_) {
+    // Differences of noisy rates: low-passed so that a fast, noisy gyroscope's
+    // acceleration stays usable (a lag of kAccelerationTau costs the prediction the
+    // jerk's share, far below a pixel for a hand's motion).
+    const Vec3 raw = (rate - *last_rate_) / dt;
+    acceleration_ += std::min(1.0, dt / kAccelerationTau) * (raw - acceleration_);
+  }
   last_rate_ = rate;
   const double angle = w.norm() * dt;
   if (angle > 0) R_ = Eigen::AngleAxisd(-angle, w.normalized()).toRotationMatrix() * R_;
@@ -51,6 +59,15 @@ void GyroOrientation::update(const Vec3& rate, const std::optional<Vec3>& down,
   // Keep R a rotation against rounding over many steps.
   const Eigen::Quaterniond q(R_);
   R_ = q.normalized().toRotationMatrix();
+}
+
+Mat3 GyroOrientation::predicted(double lead_s) const {
+  if (!(lead_s > 0) || !std::isfinite(lead_s) || !last_rate_) return R_;
+  // w(t) = rate + acceleration t: the rotation vector turned through over the lead.
+  const Vec3 phi = *last_rate_ * lead_s + 0.5 * acceleration_ * lead_s * lead_s;
+  const double angle = phi.norm();
+  if (!(angle > 0) || !std::isfinite(angle)) return R_;
+  return Eigen::AngleAxisd(-angle, phi / angle).toRotationMatrix() * R_;
 }
 
 void GyroBias::addStill(const Vec3& rate) {

@@ -46,6 +46,15 @@ class GyroOrientation {
   void update(const Vec3& rate, const std::optional<Vec3>& down, std::uint64_t time_ns);
 
   const Mat3& R() const { return R_; }
+  // The orientation lead_s seconds after the last reading: turning at its rate, which
+  // changes at the angular acceleration of the last readings (low-passed over
+  // kAccelerationTau), to second order in lead_s. R() itself for lead_s <= 0. What an
+  // output shows when its frame reaches the wall lead_s later.
+  Mat3 predicted(double lead_s) const;
+  const Vec3& acceleration() const { return acceleration_; }  // rad/s^2, projector frame
+
+  // s: one reading of a 100 Hz gyroscope, ten at 1 kHz.
+  static constexpr double kAccelerationTau = 0.01;
 
  private:
   explicit GyroOrientation(const GyroOrientationOptions& options) : options_(options) {}
@@ -55,6 +64,7 @@ class GyroOrientation {
   Mat3 R_ = Mat3::Identity();
   std::uint64_t last_ns_ = 0;
   std::optional<Vec3> last_rate_;
+  Vec3 acceleration_ = Vec3::Zero();
 };
 
 // The gyroscope's bias: the mean of its readings while the projector is held still (a

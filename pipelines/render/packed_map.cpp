@@ -48,18 +48,21 @@ Result<PackedMap> packMap(const WarpMap& map, cv::Size source_size, int source_s
     i0 = i;
     f = static_cast<uint8_t>(q);
   };
-  for (int y = 0; y < out.output_size.height; ++y) {
-    const auto* row = map.xy.ptr<cv::Vec2f>(y);
-    for (int x = 0; x < out.output_size.width; ++x) {
-      const double sx = row[x][0], sy = row[x][1];
-      if (!insideFootprint(sx, sy, w, h)) continue;
-      const size_t k = static_cast<size_t>(y) * out.output_size.width + x;
-      int x0 = 0, y0 = 0;
-      axis(sx, w, x0, out.fx[k]);
-      axis(sy, h, y0, out.fy[k]);
-      out.offset[k] = y0 * source_step + 4 * x0;
+  // Rows on all threads, as the map itself (warp_map.cpp).
+  cv::parallel_for_(cv::Range(0, out.output_size.height), [&](const cv::Range& rows) {
+    for (int y = rows.start; y < rows.end; ++y) {
+      const auto* row = map.xy.ptr<cv::Vec2f>(y);
+      for (int x = 0; x < out.output_size.width; ++x) {
+        const double sx = row[x][0], sy = row[x][1];
+        if (!insideFootprint(sx, sy, w, h)) continue;
+        const size_t k = static_cast<size_t>(y) * out.output_size.width + x;
+        int x0 = 0, y0 = 0;
+        axis(sx, w, x0, out.fx[k]);
+        axis(sy, h, y0, out.fy[k]);
+        out.offset[k] = y0 * source_step + 4 * x0;
+      }
     }
-  }
+  });
   return out;
 }
 

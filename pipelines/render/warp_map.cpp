@@ -41,27 +41,30 @@ Result<WarpMap> homographyMap(const Mat3& H, cv::Size output_size) {
   }
   const Mat3 Hinv = H.inverse();
   WarpMap map{cv::Mat(output_size, CV_32FC2)};
-  for (int y = 0; y < output_size.height; ++y) {
-    auto* row = map.xy.ptr<cv::Vec2f>(y);
-    // Rows of the backward map are affine in x before the division: step incrementally
-    // in double to keep the loop cheap and exact to double rounding.
-    const Vec3 base = Hinv * Vec3(0, y, 1);
-    const Vec3 dx = Hinv.col(0);
-    for (int x = 0; x < output_size.width; ++x) {
-      const Vec3 p = base + x * dx;
-      if (p.z() <= 1e-12 * p.head<2>().norm() || p.z() <= 0) {
-        row[x] = outside();
-        continue;
-      }
-      const double sx = p.x() / p.z(), sy = p.y() / p.z();
-      // Anything beyond +-1e6 px is outside every image; keep floats finite.
-      if (std::abs(sx) > 1e6 || std::abs(sy) > 1e6) {
-        row[x] = outside();
-      } else {
-        row[x] = cv::Vec2f(float(sx), float(sy));
+  // Rows on all threads: a handheld projector's keystone changes the map every frame.
+  cv::parallel_for_(cv::Range(0, output_size.height), [&](const cv::Range& rows) {
+    for (int y = rows.start; y < rows.end; ++y) {
+      auto* row = map.xy.ptr<cv::Vec2f>(y);
+      // Rows of the backward map are affine in x before the division: step incrementally
+      // in double to keep the loop cheap and exact to double rounding.
+      const Vec3 base = Hinv * Vec3(0, y, 1);
+      const Vec3 dx = Hinv.col(0);
+      for (int x = 0; x < output_size.width; ++x) {
+        const Vec3 p = base + x * dx;
+        if (p.z() <= 1e-12 * p.head<2>().norm() || p.z() <= 0) {
+          row[x] = outside();
+          continue;
+        }
+        const double sx = p.x() / p.z(), sy = p.y() / p.z();
+        // Anything beyond +-1e6 px is outside every image; keep floats finite.
+        if (std::abs(sx) > 1e6 || std::abs(sy) > 1e6) {
+          row[x] = outside();
+        } else {
+          row[x] = cv::Vec2f(float(sx), float(sy));
+        }
       }
     }
-  }
+  });
   return map;
 }
 

@@ -70,9 +70,10 @@ inline Measured measureAgainstTruth(const geom::Intrinsics& K, const Mat3& R, in
 // A keystone event of the daemon on a handheld scene (projector "proj" before the wall
 // y = 2.5 facing -y, which makes the world frame the wall frame of
 // keystone/orientation.hpp, so the pose's rotation, yaw included, is R) against the
-// truth at the tilt sample it was made from.
+// truth when its frame is on the wall: the tilt sample's time plus the lead the daemon
+// predicted the turn over (0 unless the gyroscope carries a turn).
 inline Measured handheldEventAgainstTruth(const sim::Scene& scene, const nlohmann::json& event) {
-  const double t = event["estimate"]["sample_time"].get<double>();
+  const double t = event["estimate"]["display_time"].get<double>();
   const sim::SceneState state = scene.at(t);
   const sim::ProjectorState* proj = state.projector("proj");
   EXPECT_TRUE(proj);

@@ -46,6 +46,8 @@ TEST(SimCameraYaw, TheCameraOnTheProjectorGivesTheYawOfEachHold) {
   ASSERT_TRUE(on);
   ASSERT_EQ((*on)["class"], "KEYSTONE") << on->dump();
   ASSERT_EQ((*on)["tilt"]["yaw"]["camera"], "cam") << on->dump();
+  // A white frame: every solution changes what the wall shows.
+  ASSERT_EQ((*c.call({{"cmd", "pattern"}, {"name", "white"}}))["shown"], true);
 
   // Per hold the last solution made from this hold's yaw; while the projector turns,
   // every solution the gyroscope carried.
@@ -88,9 +90,11 @@ TEST(SimCameraYaw, TheCameraOnTheProjectorGivesTheYawOfEachHold) {
     // corner bound above is the strict check, this one names the angle.
     EXPECT_NEAR((*last[h])["estimate"]["yaw_deg"].get<double>(), kHolds[h].yaw_deg, 0.1);
   }
-  // Turning at up to about 100 deg/s, the gyroscope carries the orientation: judged against the
-  // true pose at each solution's sample (procamd's bounds while moving: median 1 px,
-  // max 3 px). The turns of the four holds above and the one after them: 4 s of turning.
+  // While the projector turns (1 s between the holds' poses, minimum-jerk as a hand
+  // turns), the gyroscope carries the orientation and predicts it over the measured
+  // latency: judged against the true pose when each solution's frame is on the wall
+  // (procamd's bounds while moving: median 1 px, max 3 px). The turns into the four
+  // holds above and the one after them: 5 s of turning.
   ASSERT_GE(turning_px.size(), 100u);
   std::sort(turning_px.begin(), turning_px.end());
   const double median = turning_px[turning_px.size() / 2];
@@ -118,6 +122,15 @@ TEST(SimCameraYaw, TheCameraOnTheProjectorGivesTheYawOfEachHold) {
   // The virtual sensor buffers its samples as an IIO device does: a daemon that falls
   // behind under load still integrates every one.
   EXPECT_EQ(gyro["gaps"], 0) << gyro.dump();
+  // Every solution reaches the output, and the daemon says how long after its reading.
+  const json& latency = (*status)["latency"];
+  ASSERT_TRUE(latency.is_object()) << status->dump();
+  EXPECT_GE(latency["frames"].get<int>(), 100);
+  EXPECT_GT(latency["median_ms"].get<double>(), 0.0);
+  EXPECT_LE(latency["median_ms"].get<double>(), latency["max_ms"].get<double>());
+  std::printf("tilt reading to shown: median %.1f ms, 95 %% %.1f ms, max %.1f ms\n",
+              latency["median_ms"].get<double>(), latency["p95_ms"].get<double>(),
+              latency["max_ms"].get<double>());
 }
 
 }  // namespace

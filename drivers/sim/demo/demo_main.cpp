@@ -210,13 +210,18 @@ static int run(int argc, char** argv) {
   section("procamctl keystone auto on");
   const auto on = ctl({"keystone", "auto", "on"});
   std::fputs(on.out.c_str(), stdout);
+  // A white frame on the wall: every keystone update is drawn and shown.
+  section("procamctl pattern white");
+  std::fputs(ctl({"pattern", "white"}).out.c_str(), stdout);
 
   section("keystone updates while the projector moves (procamctl --json watch)");
   std::printf(
-      "The shown image judged with the projector's TRUE orientation (yaw, pitch and roll) at\n"
-      "the tilt sample's time: corner px in the framebuffer, aspect and area against the\n"
-      "largest upright rectangle. Gravity gives pitch and roll; the camera on the projector\n"
-      "gives the yaw at each still hold ([Raskar02] §6.2.2), kept while the projector moves.\n\n");
+      "The shown image judged with the projector's TRUE orientation (yaw, pitch and roll)\n"
+      "when it is on the wall (the tilt sample's time plus the latency the daemon predicts a\n"
+      "turn over): corner px in the framebuffer, aspect and area against the largest upright\n"
+      "rectangle. Gravity gives pitch and roll; the camera on the projector gives the yaw at\n"
+      "each still hold ([Raskar02] §6.2.2), the gyroscope carries it while the projector\n"
+      "turns.\n\n");
   std::printf("%7s %6s | %6s %6s %6s | %6s %6s %6s %-7s | %8s %8s %7s\n", "t [s]", "still", "pitch",
               "roll", "yaw", "est p", "est r", "est y", "yaw by", "corner", "aspect%", "area%");
   auto watch = demo::Child::start({opt.procamctl, "--socket", socket, "--json", "watch"});
@@ -238,7 +243,8 @@ static int run(int argc, char** argv) {
       continue;
     }
     ++updates;
-    const double t = e["estimate"]["sample_time"].get<double>();
+    // When the frame is on the wall: the daemon predicts a turn to then.
+    const double t = e["estimate"]["display_time"].get<double>();
     const int cw = e["content_size"][0].get<int>(), ch = e["content_size"][1].get<int>();
     const Mat3 H = matrixOf(e["homography"]);
     // The handheld wall is the world plane y = const facing -y: wall frame = world frame.

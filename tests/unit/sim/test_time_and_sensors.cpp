@@ -8,6 +8,7 @@
 #include "geometry/yaw_pitch_roll.hpp"
 #include "sim/scene_library.hpp"
 #include "sim/sensors.hpp"
+#include "sim/trajectory.hpp"
 
 namespace procam::sim {
 namespace {
@@ -36,6 +37,31 @@ TEST(SimTime, HandheldTrajectoryHitsItsKeyframesAndSlerpsBetween) {
   EXPECT_TRUE(
       scene->at(99).projectors[0].model.pose.R.isApprox(scene->at(8).projectors[0].model.pose.R));
   EXPECT_TRUE(scene->at(2.7).projectors[0].model.pose.center().isApprox(Vec3(0, 0, 1.2)));
+}
+
+TEST(SimTime, SmoothEasingIsTheMinimumJerkProfileOfAHand) {
+  // Level to yaw 60 degrees in 1 s: s(u) = 10u^3 - 15u^4 + 6u^5 of the segment's time
+  // fraction u (minimum jerk).
+  std::vector<Keyframe> keys(2);
+  keys[0].time = 0;
+  keys[1].time = 1;
+  keys[0].orientation = Eigen::Quaterniond::Identity();
+  keys[1].orientation = Eigen::Quaterniond(Eigen::AngleAxisd(degToRad(60), Vec3::UnitZ()));
+  auto traj = Trajectory::create("turn", keys, false, Easing::kSmooth);
+  ASSERT_TRUE(traj);
+  auto yawAt = [&](double t) { return Eigen::AngleAxisd(traj->poseAt(t).R.transpose()).angle(); };
+  EXPECT_NEAR(yawAt(0.25), degToRad(60) * 0.103515625, 1e-12);
+  EXPECT_NEAR(yawAt(0.5), degToRad(30), 1e-12);
+  // At rest at both keyframes (speed 30 u^2 (1 - u)^2 60 deg/s: 0.0006 deg/s over the
+  // first ms), 112.5 deg/s, 1.875 times the linear speed, halfway.
+  const double h = 1e-3;
+  EXPECT_LT(radToDeg(yawAt(h) - yawAt(0)) / h, 0.01);
+  EXPECT_LT(radToDeg(yawAt(1) - yawAt(1 - h)) / h, 0.01);
+  EXPECT_NEAR(radToDeg(yawAt(0.5 + h) - yawAt(0.5 - h)) / (2 * h), 112.5, 1e-3);
+  // Linear easing: 60 deg/s from the start.
+  auto linear = Trajectory::create("turn", keys, false);
+  ASSERT_TRUE(linear);
+  EXPECT_NEAR(Eigen::AngleAxisd(linear->poseAt(0.25).R.transpose()).angle(), degToRad(15), 1e-12);
 }
 
 TEST(SimTime, AttachedCameraMovesRigidlyWithItsProjector) {
