@@ -20,9 +20,10 @@ namespace code = proto::code;
 
 namespace {
 
-// The longest lead a turn is predicted over (keystone_latency.hpp): a frame shown later
-// than this is late whatever is predicted.
-constexpr double kMaxLead = 0.1;
+// The longest lead a turn is predicted over (keystone_latency.hpp): three 60 Hz frames.
+// The prediction's error grows with the cube of the lead (a hand's jerk), 0.14 degrees
+// at 50 ms for a fast turn; a frame shown later than this is late whatever is predicted.
+constexpr double kMaxLead = 0.05;
 
 json quadJson(const std::array<Vec2, 4>& q) {
   json a = json::array();
@@ -314,6 +315,7 @@ json Daemon::keystoneJson() const {
             {"output_size", nullptr},
             {"content_size", nullptr}};
   if (!k.unavailable.empty()) j["auto_unavailable"] = k.unavailable;
+  if (settings_.auto_keystone) j["latency"] = k.latency.toJson();
   if (rig.contains("unavailable")) {
     j["rig_unavailable"] = rig["unavailable"];
   } else if (rig_active) {
@@ -337,7 +339,6 @@ json Daemon::keystoneJson() const {
                      {"lead_ms", 1e3 * k.estimate_lead},
                      {"display_time", e.sample_time + k.estimate_lead},
                      {"updates", k.solves}};
-    j["latency"] = k.latency.toJson();
   }
   if (k.projector) {
     j["projector"] = {

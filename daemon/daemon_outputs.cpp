@@ -176,6 +176,7 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done, bool supersede
     return;
   }
   if (calibrating()) {
+    k.unshown_arrival.reset();  // its frame is the calibration's: no latency to count
     for (auto& w : waiters) w(false);
     return;
   }
@@ -196,6 +197,7 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done, bool supersede
     if (timer) k.stats_timer = *timer;
   }
   if (jobs.empty()) {
+    k.unshown_arrival.reset();  // nothing shows it
     for (auto& w : waiters) w(false);
     return;
   }
@@ -206,9 +208,12 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done, bool supersede
       requestSolve();
     }
   }
+  // The tilt solution not shown yet goes with this frame; a frame stopped midway hands
+  // it to the one that replaces it.
+  std::optional<std::chrono::steady_clock::time_point> arrival;
   if (k.unshown_arrival && settings_.auto_keystone) {
     for (auto& job : jobs) {
-      if (job.homography) job.reading_arrival = k.unshown_arrival;
+      if (job.homography) job.reading_arrival = arrival = k.unshown_arrival;
     }
     k.unshown_arrival.reset();
   }
@@ -218,14 +223,15 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done, bool supersede
   // Shared with the failure handler: the waiters are answered either way.
   auto waiting = std::make_shared<decltype(waiters)>(std::move(waiters));
   compute_worker_->submit(
-      [this, jobs = std::move(jobs), waiting] {
+      [this, jobs = std::move(jobs), waiting, arrival] {
         auto results = std::make_shared<std::vector<OutputDrawn>>();
         for (const auto& job : jobs) results->push_back(drawOutput(job));
-        return [this, results, waiting] {
+        return [this, results, waiting, arrival] {
           KeystoneRuntime& k = keystone_rt_;
           k.rendering = false;
           k.frame_stop.reset();
           bool shown = false, drawn = false, stopped = false;
+          std::optional<double> latency;  // the last output's to show it: one per frame
           for (const OutputDrawn& r : *results) {
             auto st = k.output_state.find(r.name);
             if (r.stopped) {
@@ -245,7 +251,7 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done, bool supersede
             }
             shown = true;
             drawn = drawn || r.drawn;
-            if (r.latency_s) k.latency.add(*r.latency_s);
+            if (r.latency_s) latency = std::max(latency.value_or(0.0), *r.latency_s);
             if (r.stats) {
               k.shown[r.name] = {r.source,
                                  r.stats->lit_fraction,
@@ -257,6 +263,11 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done, bool supersede
             }
           }
           if (drawn) ++k.frames;  // frames drawn, not statistics read again
+          if (latency) {
+            k.latency.add(*latency);
+          } else if (stopped && arrival && !k.unshown_arrival) {
+            k.unshown_arrival = arrival;
+          }
           if (stopped) {
             ++k.frames_stopped;
             // Its waiters wait for the frame that replaces it, drawn next.

@@ -25,8 +25,9 @@ nlohmann::json KeystoneLatency::toJson() const {
   if (recent_.empty()) return nullptr;
   std::vector<double> sorted(recent_.begin(), recent_.end());
   std::sort(sorted.begin(), sorted.end());
+  // Element floor(q n): at 0.5 the same median as median(), which the prediction's lead is.
   const auto at = [&](double q) {
-    const auto i = static_cast<std::size_t>(std::ceil(q * static_cast<double>(sorted.size()))) - 1;
+    const auto i = static_cast<std::size_t>(q * static_cast<double>(sorted.size()));
     return 1e3 * sorted[std::min(i, sorted.size() - 1)];
   };
   return {{"frames", frames_},

@@ -18,6 +18,14 @@ int stopRequested(void* flag) {
   return static_cast<const std::atomic<bool>*>(flag)->load(std::memory_order_relaxed) ? 1 : 0;
 }
 
+// A new frame on the output, drawn from a tilt solution not shown before: how long
+// after its reading arrived.
+void stampLatency(const OutputDraw& j, OutputDrawn& r) {
+  if (!r.ok || !r.drawn || !j.reading_arrival) return;
+  r.latency_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - *j.reading_arrival).count();
+}
+
 // Outputs with operations version 1 show RGB8 frames drawn here.
 void drawFallback(const OutputDraw& j, OutputDrawn& r) {
   render::CpuRenderer& cpu = *j.fallback;
@@ -54,17 +62,10 @@ void drawFallback(const OutputDraw& j, OutputDrawn& r) {
   }
   r.ok = true;
   r.drawn = *drawn;
+  stampLatency(j, r);  // shown: the statistics below are not the wall's wait
   if (j.want_stats) {
     if (auto st = render::frameStats(cpu.frame())) r.stats = *st;
   }
-}
-
-// A new frame on the output, drawn from a tilt solution not shown before: how long
-// after its reading arrived.
-void stampLatency(const OutputDraw& j, OutputDrawn& r) {
-  if (!r.ok || !r.drawn || !j.reading_arrival) return;
-  r.latency_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - *j.reading_arrival).count();
 }
 
 }  // namespace
@@ -90,7 +91,6 @@ OutputDrawn drawOutput(const OutputDraw& j) {
     }
     if (j.fallback) {
       drawFallback(j, r);
-      stampLatency(j, r);
       return r;
     }
     const procam_device& raw = j.device->raw();

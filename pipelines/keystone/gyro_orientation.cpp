@@ -38,7 +38,7 @@ void GyroOrientation::update(const Vec3& rate, const std::optional<Vec3>& down,
     // acceleration stays usable (a lag of kAccelerationTau costs the prediction the
     // jerk's share, far below a pixel for a hand's motion).
     const Vec3 raw = (rate - *last_rate_) / dt;
-    acceleration_ += std::min(1.0, dt / kAccelerationTau) * (raw - acceleration_);
+    acceleration_ += (1.0 - std::exp(-dt / kAccelerationTau)) * (raw - acceleration_);
   }
   last_rate_ = rate;
   const double angle = w.norm() * dt;

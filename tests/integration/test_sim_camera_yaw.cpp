@@ -54,6 +54,7 @@ TEST(SimCameraYaw, TheCameraOnTheProjectorGivesTheYawOfEachHold) {
   constexpr std::size_t kN = std::size(kHolds);
   std::array<std::optional<json>, kN> last;
   std::vector<double> turning_px;
+  std::size_t predicted = 0;  // of those, predicted ahead to when they are shown
   const double end = kHolds[kN - 1].start + kHoldLength;
   const auto deadline = std::chrono::steady_clock::now() + 90s;
   bool done = false;
@@ -65,6 +66,7 @@ TEST(SimCameraYaw, TheCameraOnTheProjectorGivesTheYawOfEachHold) {
     const std::string source = (*e)["estimate"]["yaw_source"].get<std::string>();
     if (source.starts_with("gyroscope")) {
       turning_px.push_back(handheldEventAgainstTruth(*scene, *e).corner_px);
+      predicted += (*e)["estimate"]["lead_ms"].get<double>() > 0;
     }
     for (std::size_t h = 0; h < kN; ++h) {
       if (t < kHolds[h].start || t > kHolds[h].start + kHoldLength) continue;
@@ -103,6 +105,8 @@ TEST(SimCameraYaw, TheCameraOnTheProjectorGivesTheYawOfEachHold) {
       turning_px.size(), median, turning_px.back());
   EXPECT_LE(median, 1.0);
   EXPECT_LE(turning_px.back(), 3.0);
+  // Predicted once frames have been shown (the first turn's first readings are not).
+  EXPECT_GE(predicted, turning_px.size() * 9 / 10) << predicted << " of " << turning_px.size();
   // A hold is measured once (six holds; the daemon may start inside the first), none
   // failed, and nothing is measuring any more.
   auto status = c.call({{"cmd", "keystone"}});

@@ -60,8 +60,8 @@ struct CameraRadiance {
     // interpolation between equal keyframes); 1e-12 rad or m moves no pixel.
     constexpr double kSame = 1e-12;
     for (std::size_t i = 0; i < p.size(); ++i) {
-      if ((p[i].R - poses[i].R).norm() > kSame) return false;
-      if ((p[i].t - poses[i].t).norm() > kSame) return false;
+      if (!((p[i].R - poses[i].R).norm() <= kSame)) return false;  // NaN: not the same
+      if (!((p[i].t - poses[i].t).norm() <= kSame)) return false;
     }
     return true;
   }

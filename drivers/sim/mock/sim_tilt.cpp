@@ -40,16 +40,18 @@ void SimTiltSensor::armFor(long long k) {
 }
 
 Result<tilt::TiltSample> SimTiltSensor::read() {
+  if (timer_.valid()) {
+    // Quiet until re-armed below: a read that fails leaves nothing waiting (an
+    // unplugged sensor is reopened, which arms it again).
+    uint64_t expirations = 0;
+    (void)!::read(timer_.get(), &expirations, sizeof expirations);
+  }
   auto gone = unpluggedNow(name_);
   // A malformed variable was refused when the device was created; it changed since.
   if (!gone) return fail(ErrorCode::kInternal, gone.error().message);
   if (*gone)
     return fail(ErrorCode::kNoDevice,
                 "'" + name_ + "' is unplugged (" + std::string(kUnplugVariable) + ")");
-  if (timer_.valid()) {
-    uint64_t expirations = 0;  // the descriptor's readiness is re-armed below
-    (void)!::read(timer_.get(), &expirations, sizeof expirations);
-  }
   // Sample k is taken at k / rate. The oldest unread one is returned; one the FIFO
   // could not hold any more is lost, as on a chip whose reader fell behind.
   const long long newest =
