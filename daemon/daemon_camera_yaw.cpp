@@ -191,9 +191,8 @@ void Daemon::measureCameraYaw() {
         requestSolve();
       }
     }
-    // The content again. A solution of a reading that came before the dot grid ended is
-    // not counted in the reading-to-shown latency: it waited for the measurement.
-    k.unshown_arrival.reset();
+    // The content again. A reading from before the grid ended waited for the
+    // measurement: refreshOutputs does not count its latency.
     k.grid_ended = std::chrono::steady_clock::now();
     refreshOutputs();
   };

@@ -242,7 +242,7 @@ void Daemon::requestSolve() {
             if (e) {
               k.estimate = *e;
               k.estimate_yaw = yaw_source;
-              if (!k.yaw.measuring && arrival >= k.grid_ended) k.unshown_arrival = arrival;
+              k.unshown_arrival = arrival;
               k.estimate_lead = lead;
               ++k.solves;
               broadcast("keystone", keystoneJson());

@@ -209,7 +209,9 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done, bool supersede
     }
   }
   // The tilt solution not shown yet goes with this frame; a frame stopped midway hands
-  // it to the one that replaces it.
+  // it to the one that replaces it. One whose reading came before the camera yaw's dot
+  // grid ended waited for the measurement, not for the pipeline: not counted.
+  if (k.unshown_arrival && *k.unshown_arrival < k.grid_ended) k.unshown_arrival.reset();
   std::optional<std::chrono::steady_clock::time_point> arrival;
   if (k.unshown_arrival && settings_.auto_keystone) {
     for (auto& job : jobs) {

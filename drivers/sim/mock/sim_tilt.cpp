@@ -15,7 +15,10 @@ namespace procam::sim::mock {
 SimTiltSensor::SimTiltSensor(std::shared_ptr<SimWorld> world, std::string name)
     : world_(std::move(world)), name_(std::move(name)) {
   for (const auto& spec : world_->scene().tiltSensors()) {
-    if (spec.name == name_) rate_hz_ = spec.rate_hz;
+    if (spec.name != name_) continue;
+    rate_hz_ = spec.rate_hz;
+    unit_ = spec.report_in_g ? kStandardGravity : 1.0;
+    gyro_ = spec.gyro.has_value();
   }
 }
 
@@ -67,17 +70,10 @@ Result<tilt::TiltSample> SimTiltSensor::read() {
   const double t = static_cast<double>(k) / rate_hz_;
   auto s = sampleTilt(world_->scene(), name_, t);
   if (!s) return fail(ErrorCode::kIo, s.error().message);
-  double unit = 1.0;
-  bool gyro = false;
-  for (const auto& spec : world_->scene().tiltSensors()) {
-    if (spec.name != name_) continue;
-    if (spec.report_in_g) unit = kStandardGravity;
-    gyro = spec.gyro.has_value();
-  }
   tilt::TiltSample out;
-  out.specific_force = s->value * unit;
+  out.specific_force = s->value * unit_;
   out.timestamp_ns = static_cast<uint64_t>(std::llround(t * 1e9));
-  if (gyro) {
+  if (gyro_) {
     // The package's gyroscope, sampled with the same sample (SCENE-FORMAT.md).
     auto w = sampleGyro(world_->scene(), name_, t);
     if (!w) return fail(ErrorCode::kIo, w.error().message);

@@ -37,7 +37,11 @@ class SimTiltSensor : public tilt::TiltSensor {
 
   std::shared_ptr<SimWorld> world_;
   std::string name_;
+  // The scene's sensor, read once: its output data rate, the factor from its units to
+  // m/s^2, whether its package has a gyroscope.
   double rate_hz_ = 100.0;
+  double unit_ = 1.0;
+  bool gyro_ = false;
   UniqueFd timer_;
   long long next_ = -1;  // the sample the next read returns; -1: none read yet
 };
