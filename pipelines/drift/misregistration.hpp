@@ -1,0 +1,72 @@
+#pragma once
+// How far the projected content has moved from where the rig model puts it, in
+// projector pixels, from one camera frame of the content itself: the camera frame is
+// resampled onto the projector's framebuffer grid through the rig's mapping
+// (projector_camera_map.hpp) and compared with the frame shown, tile by tile, by phase
+// correlation (translation from the normalised cross-power spectrum; gain, offset and
+// a monotone response do not move its peak). Shifts are then screened by RANSAC on
+// one homography of the framebuffer ([Johnson07] registers projectors from content
+// correspondences the same way): a moved planar projector moves its content by a
+// collineation. Pure.
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "core/error.hpp"
+#include "core/types.hpp"
+#include "projector_camera_map.hpp"
+
+namespace procam::drift {
+
+struct MisregistrationOptions {
+  int tile = 48;  // work pixels per side; a tile's shift may differ from the whole view's by a
+                  // quarter of it
+  // A tile whose shown content varies less than this (standard deviation, in code
+  // values of 255) has nothing to register: plain.
+  double min_texture = 6.0;
+  // Phase-correlation peak (0..1) below which a tile's shift is not trusted.
+  double min_response = 0.08;
+  // Fewer registered tiles than this (or under `min_textured_share` of the tiles
+  // the camera sees being textured): too plain to tell.
+  int min_tiles = 8;
+  double min_textured_share = 0.15;
+  double ransac_px = 1.5;  // framebuffer pixels
+};
+
+// One tile: the content drawn at framebuffer point `drawn` (the tile's centre) lands on
+// the surface where the rig model puts framebuffer point `seen_at`; the phase
+// correlation's peak.
+struct TileShift {
+  Vec2 drawn = Vec2::Zero();
+  Vec2 seen_at = Vec2::Zero();
+  double response = 0;
+  bool inlier = false;
+  Vec2 shift() const { return seen_at - drawn; }
+};
+
+struct Misregistration {
+  int tiles_seen = 0;      // tiles the camera sees whole
+  int tiles_textured = 0;  // of those, with content to register
+  int tiles_used = 0;      // registered and consistent with one collineation
+  bool too_plain = false;  // not enough texture: nothing below is meaningful
+  // The shift field: one collineation of the framebuffer fitted to the inlier tiles
+  // (drawn -> seen_at), and its shifts at their centres, framebuffer pixels.
+  Mat3 drawn_to_seen = Mat3::Identity();
+  double rms_px = 0;
+  double max_px = 0;
+  double median_px = 0;
+  double tile_rms_px = 0;  // the tiles' scatter about it (the measurement's noise)
+  Vec2 mean_shift = Vec2::Zero();
+  Vec2 global_shift = Vec2::Zero();  // the whole view's, before the tiles (framebuffer px)
+  // used / textured tiles times their mean peak: 0 (nothing) .. 1 (every tile sharp).
+  double confidence = 0;
+  std::vector<TileShift> tiles;  // every registered tile, inliers marked
+};
+
+// `shown`: the frame on the output at the grid's work size (CV_32F, code values
+// 0..255); `camera`: the camera's frame (CV_32F, any scale); `map`: from
+// projectorCameraMap for the same grid. kInvalidInput for mismatched sizes or types.
+Result<Misregistration> measureMisregistration(const cv::Mat& shown, const cv::Mat& camera,
+                                               const cv::Mat& map, const WorkGrid& grid,
+                                               const MisregistrationOptions& options = {});
+
+}  // namespace procam::drift

@@ -1,0 +1,35 @@
+#pragma once
+// Where a projector's framebuffer pixels land in a camera, by the rig model: the
+// projector's collineation with the display plane ([Raskar02] §4.2.1) and the camera's
+// calibration. The drift check compares what the camera sees there with the frame shown.
+#include <opencv2/core.hpp>
+
+#include "core/error.hpp"
+#include "geometry/camera_model.hpp"
+#include "geometry/plane_homography.hpp"
+
+namespace procam::drift {
+
+// The framebuffer sampled every `factor` pixels: work pixel (x, y) is framebuffer pixel
+// (factor x + (factor - 1) / 2, factor y + (factor - 1) / 2), pixel centres on integers.
+struct WorkGrid {
+  cv::Size framebuffer;
+  int factor = 2;
+
+  cv::Size size() const { return {framebuffer.width / factor, framebuffer.height / factor}; }
+  double offset() const { return (factor - 1) / 2.0; }
+  Vec2 toFramebuffer(const Vec2& work) const {
+    return {factor * work.x() + offset(), factor * work.y() + offset()};
+  }
+  Vec2 toWork(const Vec2& fb) const {
+    return {(fb.x() - offset()) / factor, (fb.y() - offset()) / factor};
+  }
+};
+
+// For every work pixel, the camera pixel that sees it (CV_32FC2), or (-1, -1) where the
+// camera does not (behind it, outside its image, the plane seen edge-on). kInvalidInput
+// for a factor outside 1..8, an empty framebuffer or a non-finite mapping.
+Result<cv::Mat> projectorCameraMap(const geom::PlaneHomography& projector_to_plane,
+                                   const geom::CameraModel& camera, const WorkGrid& grid);
+
+}  // namespace procam::drift
