@@ -121,6 +121,7 @@ json Daemon::statusJson() const {
           {"pattern", settings_.pattern},
           {"content", contentJson()},
           {"recalibrate", recalibratePolicyName(config_.recalibrate)},
+          {"drift", driftPolicyJson()},
           {"operations", ops},
           {"log_level", logLevelName(logLevel())},
           {"outputs", outputsJson()},

@@ -271,6 +271,7 @@ Result<void> Daemon::reloadConfig() {
   for (size_t i = before; i < devices_.entries().size(); ++i) {
     broadcast("device-added", devices_.entries()[i].toJson());
   }
+  setupDriftCheck();
   broadcast("config", {{"config", config_.source}});
   logInfo("configuration reloaded from " + config_.source);
   return {};

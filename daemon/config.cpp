@@ -130,7 +130,9 @@ void parseDaemon(Checker& c, const toml::table& t, Config& cfg) {
 }
 
 void parsePolicy(Checker& c, const toml::table& t, Config& cfg) {
-  c.onlyKnown(t, "policy.", {"auto_keystone", "recalibrate"});
+  c.onlyKnown(t, "policy.",
+              {"auto_keystone", "recalibrate", "drift_period_s", "drift_threshold_px",
+               "drift_settle_s", "drift_frames"});
   if (auto* n = t.get("auto_keystone")) c.boolean(*n, "policy.auto_keystone", cfg.auto_keystone);
   if (auto* n = t.get("recalibrate")) {
     std::string s;
@@ -144,6 +146,17 @@ void parsePolicy(Checker& c, const toml::table& t, Config& cfg) {
       }
     }
   }
+  if (auto* n = t.get("drift_period_s")) {
+    c.number(*n, "policy.drift_period_s", 0.05, 60.0, cfg.drift.period_s);
+  }
+  if (auto* n = t.get("drift_threshold_px")) {
+    c.number(*n, "policy.drift_threshold_px", 0.05, 50.0, cfg.drift.threshold_px);
+  }
+  if (auto* n = t.get("drift_settle_s")) {
+    c.number(*n, "policy.drift_settle_s", 0.0, 60.0, cfg.drift.settle_s);
+  }
+  if (auto* n = t.get("drift_frames"))
+    c.integer(*n, "policy.drift_frames", 1, 16, cfg.drift.frames);
 }
 
 void parseSim(Checker& c, const toml::table& t, Config& cfg) {

@@ -61,6 +61,15 @@ struct CalibrationConfig {
   double latency_timeout_s = 1.0;  // the longest latency looked for
 };
 
+// [policy] drift_*: the drift check and correction of recalibrate = "on-drift"
+// (daemon/daemon_drift.cpp).
+struct DriftConfig {
+  double period_s = 0.25;     // between two checks of an output
+  double threshold_px = 0.5;  // misregistration (RMS, projector pixels) that is drift
+  double settle_s = 0.5;      // held this long before a correction
+  int frames = 2;             // camera frames averaged per check
+};
+
 struct Config {
   std::string source;  // file name, for messages
   LogLevel log_level = LogLevel::kInfo;
@@ -72,6 +81,7 @@ struct Config {
   double client_stall_timeout_s = 10.0;
   bool auto_keystone = false;
   RecalibratePolicy recalibrate = RecalibratePolicy::kOff;
+  DriftConfig drift;
   std::string sim_scene;
   // [content] viewer: the viewer's eye (world, metres) for 3D content when no tracker
   // has reported one.

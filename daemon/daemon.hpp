@@ -18,6 +18,7 @@
 #include "control_socket.hpp"
 #include "device_manager.hpp"
 #include "device_set.hpp"
+#include "drift_runtime.hpp"
 #include "event_loop.hpp"
 #include "geometry/intersect.hpp"
 #include "keystone/keystone_solver.hpp"
@@ -255,6 +256,16 @@ class Daemon {
   void followMeshViewer(PreparedMesh& prepared);
   void onMeshViewerSample();
   void addReadingStats(const DeviceEntry& entry, nlohmann::json& json) const;
+  // daemon_drift.cpp: recalibrate = "on-drift" on a fixed rig.
+  void setupDriftCheck();
+  void checkDrift();
+  void onDriftChecked(const DriftCheckPlan& plan, tl::expected<DriftCheck, CalibrationFailure> r);
+  void correctDrift(const std::string& output, const drift::Misregistration& m);
+  // The camera that checks `projector` (mapped onto the plane by `tile`), or null.
+  const rig::RigCamera* driftCamera(const rig::RigProjector& projector,
+                                    const geom::PlaneHomography& tile) const;
+  nlohmann::json driftJson(const std::string& output) const;  // null when the policy is off
+  nlohmann::json driftPolicyJson() const;
 
   struct Operation {
     std::string kind;
@@ -316,6 +327,7 @@ class Daemon {
   };
   std::optional<LiveContent> live_content_;  // set by `content share` / `stream`
   KeystoneRuntime keystone_rt_;
+  DriftRuntime drift_rt_;
   TrackerRuntime trackers_;
   MeshFollow mesh_follow_;
   // Destroyed in reverse order: server and workers before the loop they use.

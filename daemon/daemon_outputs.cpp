@@ -253,6 +253,11 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done, bool supersede
             }
             shown = true;
             drawn = drawn || r.drawn;
+            if (st != k.output_state.end()) {
+              st->second.shown_setup = r.setup;
+              st->second.shown_image = r.image;
+              if (r.drawn) st->second.shown_at = std::chrono::steady_clock::now();
+            }
             if (r.latency_s) latency = std::max(latency.value_or(0.0), *r.latency_s);
             if (r.stats) {
               k.shown[r.name] = {r.source,
@@ -352,6 +357,7 @@ json Daemon::outputsJson() const {
       if (!os.path_note.empty()) o["path_note"] = os.path_note;
       o["renderer"] = os.fallback ? "daemon-cpu" : "output";
     }
+    if (json drift = driftJson(name); !drift.is_null()) o["drift"] = std::move(drift);
     list.push_back(std::move(o));
   }
   json out = {{"frames", keystone_rt_.frames},

@@ -111,6 +111,10 @@ struct KeystoneRuntime {
     std::optional<Mat34> np_fixed;
     std::shared_ptr<const void> np_curved;  // the display across outputs it is a share of
     std::optional<Mat34> viewer;            // world -> content pixels of the frame drawn
+    // The frame the output last showed (setup and RGBA content) and when it was drawn.
+    std::shared_ptr<const render::RenderSetup> shown_setup;
+    std::shared_ptr<const cv::Mat> shown_image;
+    std::chrono::steady_clock::time_point shown_at;
   };
   std::map<std::string, OutputState> output_state;
   std::map<std::string, std::shared_ptr<const cv::Mat>> patterns;  // "name WxH" -> RGBA

@@ -79,6 +79,8 @@ OutputDrawn drawOutput(const OutputDraw& j) {
   r.homography = j.homography;
   r.tile = j.tile;
   r.configure_asked = j.configure;
+  r.setup = j.setup;
+  r.image = j.image;
   try {
     if (!j.device || !j.device->valid() || !j.setup) {
       r.error = "no device or setup";

@@ -59,6 +59,10 @@ struct OutputDrawn {
   std::string error;
   std::optional<render::FrameStats> stats;
   std::optional<double> latency_s;  // reading_arrival to shown, when a new frame was shown
+  // What the output shows when ok: the job's setup and content (the drift check draws it
+  // again to know what a camera should see).
+  std::shared_ptr<const render::RenderSetup> setup;
+  std::shared_ptr<const cv::Mat> image;
 };
 
 // Runs on a worker; never throws.

@@ -240,6 +240,33 @@ std::string progressBar(double fraction, int width, const std::string& stage) {
   return bar + pct + (stage.empty() ? "" : "  " + stage);
 }
 
+// Per output: where recalibrate = "on-drift" stands (status outputs.shown[].drift).
+static std::string driftText(const json& status) {
+  std::string out;
+  if (status.contains("drift") && status["drift"].is_object()) {
+    out += field("recalibrate", scalar(status["drift"]["policy"]));
+  }
+  if (!status.contains("outputs") || !status["outputs"].is_object()) return out;
+  for (const json& o : status["outputs"].value("shown", json::array())) {
+    if (!o.is_object() || !o.contains("drift") || !o["drift"].is_object()) continue;
+    const json& d = o["drift"];
+    std::string text;
+    if (d.contains("unavailable")) {
+      text = "not checked: " + scalar(d["unavailable"]);
+    } else {
+      char line[256];
+      std::snprintf(line, sizeof line, "%s, %.3f px (camera %s, %s tiles), %s correction(s)",
+                    scalar(d.value("state", json())).c_str(), d.value("misregistration_px", 0.0),
+                    scalar(d.value("camera", json())).c_str(),
+                    d.contains("tiles") ? scalar(d["tiles"]["used"]).c_str() : "no",
+                    scalar(d.value("corrections", json(0))).c_str());
+      text = line;
+    }
+    out += field(("drift " + scalar(o.value("name", json()))).c_str(), text);
+  }
+  return out;
+}
+
 std::string formatReply(const json& r) {
   const std::string cls = r.value("class", "");
   if (cls == "ERROR")
@@ -267,6 +294,7 @@ std::string formatReply(const json& r) {
     out += field("pattern", scalar(r["pattern"]));
     out += field("content", contentText(r["content"]));
     out += field("log level", scalar(r["log_level"]));
+    out += driftText(r);
     if (r.contains("viewer") && r["viewer"].is_object()) {
       out += field("viewer", pairList(r["viewer"]["position"]) + " m (tracker " +
                                  scalar(r["viewer"]["tracker"]) + ")");

@@ -110,6 +110,12 @@ TEST(Config, BadValuesNameKeyAndLine) {
        "rig.toml:2: policy.auto_keystone: expected true or false"},
       {"[policy]\nrecalibrate = \"always\"",
        "rig.toml:2: policy.recalibrate: 'always' is not one of"},
+      {"[policy]\ndrift_threshold_px = 0",
+       "rig.toml:2: policy.drift_threshold_px: 0 is out of range"},
+      {"[policy]\ndrift_frames = 17",
+       "rig.toml:2: policy.drift_frames: 17 is out of range [1, 16]"},
+      {"[policy]\ndrift_period_s = \"fast\"",
+       "rig.toml:2: policy.drift_period_s: expected a number"},
       {"[[camera]]\ndriver = \"v4l2\"", "rig.toml:1: camera[0].name: missing"},
       {"[[camera]]\nname = \"a\"\n[[tilt]]\nname = \"a\"",
        "rig.toml:4: tilt[0].name: duplicate device name 'a'"},
@@ -267,6 +273,24 @@ TEST(Config, OnlyARegularFileOfBoundedSizeIsRead) {
       contains(cfg.error().message, group + ":3: daemon.group: no group 'no-such-group-procam'"))
       << cfg.error().message;
   std::filesystem::remove_all(dir);
+}
+
+TEST(Config, DriftPolicyHasDefaultsAndBounds) {
+  auto defaults = parseConfig("[policy]\nrecalibrate = \"on-drift\"\n", "rig.toml");
+  ASSERT_TRUE(defaults) << defaults.error().message;
+  EXPECT_DOUBLE_EQ(defaults->drift.period_s, 0.25);
+  EXPECT_DOUBLE_EQ(defaults->drift.threshold_px, 0.5);
+  EXPECT_DOUBLE_EQ(defaults->drift.settle_s, 0.5);
+  EXPECT_EQ(defaults->drift.frames, 2);
+  auto set = parseConfig(
+      "[policy]\ndrift_period_s = 1\ndrift_threshold_px = 0.3\ndrift_settle_s = 0\n"
+      "drift_frames = 4\n",
+      "rig.toml");
+  ASSERT_TRUE(set) << set.error().message;
+  EXPECT_DOUBLE_EQ(set->drift.period_s, 1.0);
+  EXPECT_DOUBLE_EQ(set->drift.threshold_px, 0.3);
+  EXPECT_DOUBLE_EQ(set->drift.settle_s, 0.0);
+  EXPECT_EQ(set->drift.frames, 4);
 }
 
 TEST(Config, ExampleConfigParses) {

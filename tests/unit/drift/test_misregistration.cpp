@@ -18,26 +18,10 @@
 #include "sim/renderer.hpp"
 #include "sim/scene_library.hpp"
 #include "sim/truth_rig.hpp"
+#include "textured_content.hpp"
 
 namespace procam::drift {
 namespace {
-
-// Content with texture at every scale a projector shows: smooth noise of several
-// octaves (a natural image's spectrum falls off similarly).
-cv::Mat textured(cv::Size size, int seed) {
-  cv::Mat sum(size, CV_32F, cv::Scalar(0));
-  cv::RNG rng(seed);
-  for (int cell : {96, 32, 12}) {
-    cv::Mat coarse(size.height / cell + 2, size.width / cell + 2, CV_32F);
-    rng.fill(coarse, cv::RNG::UNIFORM, 0, 1);
-    cv::Mat up;
-    cv::resize(coarse, up, cv::Size(coarse.cols * cell, coarse.rows * cell), 0, 0, cv::INTER_CUBIC);
-    sum += up(cv::Rect(0, 0, size.width, size.height));
-  }
-  cv::Mat out;
-  sum.convertTo(out, CV_8U, 255.0 / 3.0);
-  return out;
-}
 
 // The device turned about its own centre by yaw/pitch/roll in its own frame.
 geom::Pose turned(const geom::Pose& pose, double yaw_deg, double pitch_deg) {
@@ -108,7 +92,7 @@ Vec2 whereTheRigSees(const Rig& rig, const geom::Pose& pose, const Vec2& p) {
 TEST(DriftCheck, AProjectorAtRestShowsNoMisregistration) {
   const Rig rig = restingRig();
   const geom::Pose rest = rig.scene.at(0).projectors.at(0).model.pose;
-  const View v = viewOf(rig, textured({1920, 1080}, 3), rest);
+  const View v = viewOf(rig, texturedContent({1920, 1080}, 3, {96, 32, 12}), rest);
   auto m = measureMisregistration(v.shown, v.camera, v.map, v.grid);
   ASSERT_TRUE(m) << m.error().message;
   std::printf(
@@ -139,7 +123,7 @@ TEST(DriftCheck, PlainContentIsTooPlainToTell) {
 TEST(DriftCheck, ABumpedProjectorIsMeasuredAndItsPoseCorrectedFromContent) {
   const Rig rig = restingRig();
   const geom::Pose rest = rig.scene.at(0).projectors.at(0).model.pose;
-  const cv::Mat content = textured({1920, 1080}, 5);
+  const cv::Mat content = texturedContent({1920, 1080}, 5, {96, 32, 12});
   for (auto [yaw, pitch] : {std::pair{0.5, 0.0}, std::pair{0.0, -2.0}, std::pair{1.2, 0.8}}) {
     SCOPED_TRACE(testing::Message() << "yaw " << yaw << " pitch " << pitch);
     const geom::Pose bumped = turned(rest, yaw, pitch);

@@ -1,0 +1,313 @@
+// recalibrate = "on-drift" on a fixed rig: while content plays, each output's frame is
+// compared with what the rig model says a camera should see of it (drift_check.hpp);
+// misregistration held over the threshold for the settle time is corrected with the
+// cheapest step: the projector's pose and plane collineation from the content's own
+// correspondences (drift/projector_correction.hpp), no pattern shown, written to
+// rig.json atomically; a failed step keeps the last good rig. Loop thread only; the
+// checks run on the compute worker between the outputs' frames.
+#include <cmath>
+
+#include "blend/rig_tiles.hpp"
+#include "daemon.hpp"
+#include "drift/projector_correction.hpp"
+#include "log.hpp"
+#include "protocol.hpp"
+#include "rig_store.hpp"
+
+namespace procam::daemon {
+
+using nlohmann::json;
+
+namespace {
+
+// Corrections in a row that did not bring the misregistration under the threshold
+// before the daemon stops trying (the projector keeps moving, or the surface or
+// camera moved, which the pose alone cannot explain).
+constexpr int kMaxPasses = 3;
+
+double secondsSince(DriftRuntime::Clock::time_point t) {
+  return std::chrono::duration<double>(DriftRuntime::Clock::now() - t).count();
+}
+
+json misregistrationJson(const drift::Misregistration& m) {
+  return {
+      {"misregistration_px", m.rms_px},
+      {"max_px", m.max_px},
+      {"confidence", m.confidence},
+      {"tiles", {{"seen", m.tiles_seen}, {"textured", m.tiles_textured}, {"used", m.tiles_used}}},
+      {"tile_rms_px", m.tile_rms_px},
+      {"too_plain", m.too_plain}};
+}
+
+}  // namespace
+
+void Daemon::setupDriftCheck() {
+  DriftRuntime& d = drift_rt_;
+  if (d.timer >= 0) {
+    loop_->removeTimer(d.timer);
+    d.timer = -1;
+  }
+  if (config_.recalibrate != RecalibratePolicy::kOnDrift) {
+    d.outputs.clear();
+    return;
+  }
+  const auto period = std::chrono::duration<double>(config_.drift.period_s);
+  auto timer = loop_->addTimer(std::chrono::duration_cast<std::chrono::nanoseconds>(period), true,
+                               [this] { checkDrift(); });
+  if (!timer) {
+    warn("drift check not started: " + timer.error().message);
+    return;
+  }
+  d.timer = *timer;
+}
+
+const rig::RigCamera* Daemon::driftCamera(const rig::RigProjector& projector,
+                                          const geom::PlaneHomography& tile) const {
+  // A posed camera standing on its own (one mounted on a projector moves with it) that is
+  // open and sees the centre of the projector's frame.
+  const Vec3 c = tile.H * Vec3((projector.width - 1) / 2.0, (projector.height - 1) / 2.0, 1.0);
+  if (!(std::abs(c.z()) > 1e-12)) return nullptr;
+  const Vec3 centre = tile.basis.toWorld({c.x() / c.z(), c.y() / c.z()});
+  for (const rig::RigCamera& cam : rig_.cameras) {
+    if (!cam.pose_known || !cam.attached_to.empty()) continue;
+    const DeviceEntry* e = const_cast<DeviceSet&>(devices_).find(cam.name);
+    if (!e || e->description.family != PROCAM_FAMILY_CAMERA || !e->usable()) continue;
+    auto px = cam.model.project(centre);
+    if (px && cam.model.inImage(*px)) return &cam;
+  }
+  return nullptr;
+}
+
+void Daemon::checkDrift() {
+  DriftRuntime& d = drift_rt_;
+  KeystoneRuntime& k = keystone_rt_;
+  if (d.checking || d.writing || calibrating() || k.yaw.measuring) return;
+  // The outputs in turn, one check at a time: the worker also draws the frames.
+  std::vector<DeviceEntry*> outputs;
+  for (auto& e : devices_.entries()) {
+    if (e.description.family == PROCAM_FAMILY_OUTPUT && e.usable()) outputs.push_back(&e);
+  }
+  for (auto it = d.outputs.begin(); it != d.outputs.end();) {
+    const bool open = std::any_of(outputs.begin(), outputs.end(),
+                                  [&](const DeviceEntry* e) { return e->name == it->first; });
+    it = open ? std::next(it) : d.outputs.erase(it);
+  }
+  if (outputs.empty()) return;
+  DeviceEntry& out = *outputs[d.next++ % outputs.size()];
+  DriftRuntime::Output& o = d.outputs[out.name];
+  const auto unavailable = [&](std::string why) {
+    o.unavailable = std::move(why);
+    o.camera.clear();
+    o.above.reset();
+  };
+  const rig::RigProjector* p = rig_.projectorForOutput(out.name);
+  if (!p) return unavailable("the rig model has no projector for the output");
+  if (settings_.auto_keystone) {
+    return unavailable("auto keystone corrects the projector from its tilt sensor");
+  }
+  auto tile = blend::displayTile(*p, rig_.surface);
+  if (!tile) return unavailable("not mapped onto a display plane: " + tile.error().message);
+  const rig::RigCamera* cam = driftCamera(*p, tile->projector_to_plane);
+  if (!cam) return unavailable("no open, posed, fixed camera of the rig model sees the frame");
+  auto st = k.output_state.find(out.name);
+  if (st == k.output_state.end() || !st->second.shown_image || !st->second.shown_setup) {
+    return unavailable("nothing shown yet");
+  }
+  if (live_content_ && !live_content_->ended) {
+    return unavailable("streamed content: the frame changes between camera frames");
+  }
+  // The camera must see the frame drawn, not the one before it: a frame's latency to
+  // the camera is a few output frames ([calibration] settle_frames, as calibrate waits).
+  const double settle = std::max(0.1, (config_.calibration.settle_frames + 2) / 60.0);
+  if (secondsSince(st->second.shown_at) < settle) return;
+  o.unavailable.clear();
+  o.camera = cam->name;
+  DeviceEntry* cam_entry = devices_.find(cam->name);
+  DriftCheckPlan plan;
+  plan.output = out.name;
+  plan.camera = {cam->name, cam_entry->device.share()};
+  plan.reference = o.reference;
+  plan.setup = st->second.shown_setup;
+  plan.image = st->second.shown_image;
+  plan.rig_generation = rig_generation_;
+  plan.projector_to_plane = tile->projector_to_plane;
+  plan.camera_model = cam->model;
+  plan.frames = config_.drift.frames;
+  d.checking = true;
+  compute_worker_->submit(
+      [this, plan] {
+        auto r = runDriftCheck(plan);
+        return [this, plan, r = std::move(r)]() mutable { onDriftChecked(plan, std::move(r)); };
+      },
+      [this, name = out.name](const std::string& what) {
+        drift_rt_.checking = false;
+        warn("drift check of output '" + name + "' failed: " + what);
+      });
+}
+
+void Daemon::onDriftChecked(const DriftCheckPlan& plan,
+                            tl::expected<DriftCheck, CalibrationFailure> r) {
+  DriftRuntime& d = drift_rt_;
+  d.checking = false;
+  auto it = d.outputs.find(plan.output);
+  if (it == d.outputs.end() || config_.recalibrate != RecalibratePolicy::kOnDrift) return;
+  DriftRuntime::Output& o = it->second;
+  o.checked_at = DriftRuntime::Clock::now();
+  if (!r) {
+    // The last good rig stays; a camera gone is the device manager's.
+    ++o.failures;
+    o.error = r.error().message;
+    o.above.reset();
+    warn("drift check: " + r.error().message);
+    if (!r.error().device.empty() && closesDevice(r.error().rc)) {
+      device_manager_->report(r.error().device, r.error().rc, r.error().message);
+    }
+    return;
+  }
+  o.error.clear();
+  o.reference = r->reference;
+  o.timing = {{"check_s", r->seconds},
+              {"reference_s", r->reference_s},
+              {"capture_s", r->capture_s},
+              {"measure_s", r->measure_s}};
+  ++o.checks;
+  const drift::Misregistration& m = r->misregistration;
+  o.last = m;
+  // A check made for an older rig model (a correction landed meanwhile) says nothing.
+  if (r->reference->rig_generation != rig_generation_) return;
+  const double threshold = config_.drift.threshold_px;
+  if (m.too_plain || m.rms_px <= threshold) {
+    if (!m.too_plain && o.passes > 0) {
+      logInfo("drift: output '" + plan.output + "' registered again: " + std::to_string(m.rms_px) +
+              " px after " + std::to_string(o.passes) + " correction(s)");
+      broadcast("drift", {{"output", plan.output},
+                          {"state", "corrected"},
+                          {"passes", o.passes},
+                          {"check", misregistrationJson(m)},
+                          {"timing", o.timing}});
+      o.passes = 0;
+    }
+    if (!m.too_plain) o.unresolved = false;
+    o.above.reset();
+    return;
+  }
+  if (!o.above) {
+    o.above = o.checked_at;
+    logInfo("drift: output '" + plan.output + "' misregistered by " + std::to_string(m.rms_px) +
+            " px (threshold " + std::to_string(threshold) + ")");
+    broadcast("drift", {{"output", plan.output},
+                        {"state", "detected"},
+                        {"check", misregistrationJson(m)},
+                        {"timing", o.timing}});
+  }
+  if (o.unresolved || secondsSince(*o.above) < config_.drift.settle_s) return;
+  correctDrift(plan.output, m);
+}
+
+void Daemon::correctDrift(const std::string& output, const drift::Misregistration& m) {
+  DriftRuntime& d = drift_rt_;
+  DriftRuntime::Output& o = d.outputs[output];
+  const rig::RigProjector* p = rig_.projectorForOutput(output);
+  if (!p) return;
+  const double held = o.above ? secondsSince(*o.above) : 0.0;
+  const auto refuse = [&](const std::string& why) {
+    o.unresolved = true;
+    o.last_correction = {{"step", "projector-pose"}, {"ok", false}, {"why", why}};
+    warn("drift: output '" + output + "': " + why + "; the rig model stays as it was");
+    broadcast("drift", {{"output", output},
+                        {"state", "unresolved"},
+                        {"why", why},
+                        {"check", misregistrationJson(m)}});
+  };
+  if (o.passes >= kMaxPasses) {
+    return refuse("the projector's pose from the content did not bring the misregistration under " +
+                  std::to_string(config_.drift.threshold_px) + " px in " +
+                  std::to_string(kMaxPasses) +
+                  " corrections: the surface or the camera may have moved; calibrate again");
+  }
+  auto tile = blend::displayTile(*p, rig_.surface);
+  if (!tile) return refuse(tile.error().message);
+  auto c = drift::correctProjector(*p, tile->projector_to_plane, m);
+  if (!c) return refuse("the projector's pose from the content: " + c.error().message);
+  rig::RigModel update;
+  update.projectors.push_back(c->projector);
+  update.projectors.back().calibrated = {
+      "drift correction: pose from content (" + std::to_string(c->tiles) + " tiles)", utcNow()};
+  ++o.passes;
+  const json why = {{"misregistration_px", m.rms_px},
+                    {"held_s", held},
+                    {"threshold_px", config_.drift.threshold_px}};
+  logInfo("drift: output '" + output + "': correcting projector '" + p->name +
+          "' from the content (" + std::to_string(m.rms_px) + " px held " + std::to_string(held) +
+          " s; " + std::to_string(c->tiles) + " tiles, pose fit " + std::to_string(c->pose_rms_px) +
+          " px)");
+  d.writing = true;
+  const std::string projector = p->name;
+  writeRig(std::move(update), {},
+           [this, output, projector, why, tiles = c->tiles,
+            fit = c->pose_rms_px](const Result<std::string>& written) {
+             DriftRuntime& d = drift_rt_;
+             d.writing = false;
+             DriftRuntime::Output& o = d.outputs[output];
+             o.above.reset();
+             json event = {{"output", output}, {"projector", projector}, {"step", "projector-pose"},
+                           {"why", why},       {"tiles", tiles},         {"pose_fit_px", fit},
+                           {"pass", o.passes}};
+             if (!written) {
+               event["state"] = "failed";
+               event["error"] = written.error().message;
+               o.last_correction = event;
+               warn("drift: " + written.error().message + "; the rig model stays as it was");
+               broadcast("drift", event);
+               return;
+             }
+             ++o.corrections;
+             event["state"] = "corrected-pose";
+             event["time"] = utcNow();
+             o.last_correction = event;
+             broadcast("drift", event);
+             refreshOutputs();
+           });
+}
+
+json Daemon::driftJson(const std::string& output) const {
+  if (config_.recalibrate != RecalibratePolicy::kOnDrift) return nullptr;
+  auto it = drift_rt_.outputs.find(output);
+  if (it == drift_rt_.outputs.end()) return {{"unavailable", "not checked yet"}};
+  const DriftRuntime::Output& o = it->second;
+  if (!o.unavailable.empty()) return {{"unavailable", o.unavailable}};
+  json j = {{"camera", o.camera},
+            {"checks", o.checks},
+            {"failures", o.failures},
+            {"corrections", o.corrections},
+            {"last_correction", o.last_correction}};
+  if (!o.error.empty()) j["error"] = o.error;
+  if (o.last) {
+    j.update(misregistrationJson(*o.last));
+    j["age_s"] = secondsSince(o.checked_at);
+    j.update(o.timing);
+  }
+  std::string state = "registered";
+  if (!o.last) {
+    state = "checking";
+  } else if (o.last->too_plain) {
+    state = "too plain to tell";
+  } else if (o.unresolved) {
+    state = "unresolved";
+  } else if (o.above) {
+    state = "drifted";
+  }
+  j["state"] = state;
+  return j;
+}
+
+json Daemon::driftPolicyJson() const {
+  const DriftConfig& c = config_.drift;
+  return {{"policy", recalibratePolicyName(config_.recalibrate)},
+          {"period_s", c.period_s},
+          {"threshold_px", c.threshold_px},
+          {"settle_s", c.settle_s},
+          {"frames", c.frames}};
+}
+
+}  // namespace procam::daemon

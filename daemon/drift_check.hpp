@@ -1,0 +1,60 @@
+#pragma once
+// One drift check of a fixed rig, on a worker: what the camera should see of the frame an
+// output shows (the frame drawn again on the CPU, resampled onto a framebuffer grid; the
+// grid's camera pixels from the rig model) against a few averaged camera frames
+// (drift/misregistration.hpp). Never touches daemon state.
+#include <memory>
+#include <opencv2/core.hpp>
+#include <tl/expected.hpp>
+
+#include "calibration_job.hpp"
+#include "drift/misregistration.hpp"
+#include "drift/projector_camera_map.hpp"
+#include "render/render_setup.hpp"
+
+namespace procam::daemon {
+
+// What the camera should see: made for one frame (setup and content) and one rig model,
+// reused while both stay.
+struct DriftReference {
+  std::shared_ptr<const render::RenderSetup> setup;
+  std::shared_ptr<const cv::Mat> image;
+  uint64_t rig_generation = 0;
+  std::string camera;
+  drift::WorkGrid grid;
+  cv::Mat shown;          // the frame's luminance on the grid, CV_32F, code values
+  cv::Mat map;            // grid -> camera pixels
+  double seen_share = 0;  // of the grid the camera sees
+};
+
+struct DriftCheckPlan {
+  std::string output;
+  CalibrationDevice camera;
+  std::shared_ptr<const DriftReference> reference;  // null or stale: made again
+  // What a new reference is made from.
+  std::shared_ptr<const render::RenderSetup> setup;
+  std::shared_ptr<const cv::Mat> image;  // RGBA content of the frame
+  uint64_t rig_generation = 0;
+  geom::PlaneHomography projector_to_plane;
+  geom::CameraModel camera_model;
+  int frames = 2;  // camera frames averaged
+};
+
+struct DriftCheck {
+  std::shared_ptr<const DriftReference> reference;
+  drift::Misregistration misregistration;
+  double seconds = 0;      // the whole check, capture included
+  double reference_s = 0;  // making the reference (0: reused)
+  double capture_s = 0;    // the camera frames
+  double measure_s = 0;    // the registration
+};
+
+// The plan's reference when it still fits (same setup, content, rig and camera).
+bool referenceFits(const DriftCheckPlan& plan);
+
+// The camera's failures (kIo, kNoDevice, ...); kFailed when the frame cannot be drawn
+// again, the camera's frames have another size than the rig model's or it sees too
+// little of the frame (under 10 %).
+tl::expected<DriftCheck, CalibrationFailure> runDriftCheck(const DriftCheckPlan& plan);
+
+}  // namespace procam::daemon

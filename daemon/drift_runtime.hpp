@@ -1,0 +1,41 @@
+#pragma once
+// The daemon's drift state for recalibrate = "on-drift" (daemon_drift.cpp): per output the
+// camera that watches it, the last check and where the correction stands. Loop thread only.
+#include <chrono>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "drift_check.hpp"
+
+namespace procam::daemon {
+
+struct DriftRuntime {
+  using Clock = std::chrono::steady_clock;
+  struct Output {
+    std::string camera;       // the camera that checks it (empty: none)
+    std::string unavailable;  // why it is not checked (empty: it is)
+    std::shared_ptr<const DriftReference> reference;
+    std::optional<drift::Misregistration> last;
+    Clock::time_point checked_at;
+    nlohmann::json timing =
+        nullptr;  // the last check's: {check_s, reference_s, capture_s, measure_s}
+    uint64_t checks = 0;
+    uint64_t failures = 0;
+    std::string error;                       // the last check's failure
+    std::optional<Clock::time_point> above;  // drift held since
+    int passes = 0;           // corrections since the misregistration was last under threshold
+    bool unresolved = false;  // the cheap step did not bring it under: left alone
+    uint64_t corrections = 0;
+    nlohmann::json last_correction = nullptr;
+  };
+  int timer = -1;
+  bool checking = false;  // a check on the compute worker
+  bool writing = false;   // a corrected rig model on its way to rig.json
+  uint64_t next = 0;      // round robin over the outputs
+  std::map<std::string, Output> outputs;
+};
+
+}  // namespace procam::daemon
