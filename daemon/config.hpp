@@ -64,7 +64,7 @@ struct CalibrationConfig {
 // [policy] drift_*: the drift check and correction of recalibrate = "on-drift"
 // (daemon/daemon_drift.cpp).
 struct DriftConfig {
-  double period_s = 0.25;     // between two checks of an output
+  double period_s = 0.25;     // between two checks (one output per check, in turn)
   double threshold_px = 0.5;  // misregistration (RMS, projector pixels) that is drift
   double settle_s = 0.5;      // held this long before a correction
   int frames = 2;             // camera frames averaged per check

@@ -259,7 +259,9 @@ class Daemon {
   // daemon_drift.cpp: recalibrate = "on-drift" on a fixed rig.
   void setupDriftCheck();
   void checkDrift();
-  void onDriftChecked(const DriftCheckPlan& plan, tl::expected<DriftCheck, CalibrationFailure> r);
+  void onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, CalibrationFailure> r);
+  // Why no check or correction may run now (empty: they may).
+  std::string driftPaused() const;
   void correctDrift(const std::string& output, const drift::Misregistration& m);
   // The camera that checks `projector` (mapped onto the plane by `tile`), or null.
   const rig::RigCamera* driftCamera(const rig::RigProjector& projector,

@@ -78,10 +78,20 @@ const rig::RigCamera* Daemon::driftCamera(const rig::RigProjector& projector,
   return nullptr;
 }
 
+std::string Daemon::driftPaused() const {
+  const KeystoneRuntime& k = keystone_rt_;
+  if (config_.recalibrate != RecalibratePolicy::kOnDrift) return "off";
+  if (calibrating() || !calibration_.op.empty()) return "an operation holds the devices";
+  if (k.yaw.measuring) return "the camera yaw's dot grid is shown";
+  // A frame in flight: what the output shows is about to change.
+  if (k.rendering || k.render_again) return "a frame is being drawn";
+  return {};
+}
+
 void Daemon::checkDrift() {
   DriftRuntime& d = drift_rt_;
   KeystoneRuntime& k = keystone_rt_;
-  if (d.checking || d.writing || calibrating() || k.yaw.measuring) return;
+  if (d.checking || d.writing || !driftPaused().empty()) return;
   // The outputs in turn, one check at a time: the worker also draws the frames.
   std::vector<DeviceEntry*> outputs;
   for (auto& e : devices_.entries()) {
@@ -105,6 +115,9 @@ void Daemon::checkDrift() {
   if (settings_.auto_keystone) {
     return unavailable("auto keystone corrects the projector from its tilt sensor");
   }
+  if (live_content_ && !live_content_->ended) {
+    return unavailable("streamed content: the frame changes between camera frames");
+  }
   auto tile = blend::displayTile(*p, rig_.surface);
   if (!tile) return unavailable("not mapped onto a display plane: " + tile.error().message);
   const rig::RigCamera* cam = driftCamera(*p, tile->projector_to_plane);
@@ -112,9 +125,6 @@ void Daemon::checkDrift() {
   auto st = k.output_state.find(out.name);
   if (st == k.output_state.end() || !st->second.shown_image || !st->second.shown_setup) {
     return unavailable("nothing shown yet");
-  }
-  if (live_content_ && !live_content_->ended) {
-    return unavailable("streamed content: the frame changes between camera frames");
   }
   // The camera must see the frame drawn, not the one before it: a frame's latency to
   // the camera is a few output frames ([calibration] settle_frames, as calibrate waits).
@@ -130,26 +140,32 @@ void Daemon::checkDrift() {
   plan.setup = st->second.shown_setup;
   plan.image = st->second.shown_image;
   plan.rig_generation = rig_generation_;
+  plan.framebuffer = {p->width, p->height};
   plan.projector_to_plane = tile->projector_to_plane;
   plan.camera_model = cam->model;
   plan.frames = config_.drift.frames;
+  // The device manager keeps off the camera while the check drives it.
+  d.camera_in_use = cam->name;
+  plan.fence = device_manager_->readFence({cam->name});
+  const DriftKey key{out.name, plan.setup, plan.image, st->second.shown_at, rig_generation_};
   d.checking = true;
   compute_worker_->submit(
-      [this, plan] {
+      [this, plan = std::move(plan), key] {
         auto r = runDriftCheck(plan);
-        return [this, plan, r = std::move(r)]() mutable { onDriftChecked(plan, std::move(r)); };
+        return [this, key, r = std::move(r)]() mutable { onDriftChecked(key, std::move(r)); };
       },
       [this, name = out.name](const std::string& what) {
         drift_rt_.checking = false;
+        drift_rt_.camera_in_use.clear();
         warn("drift check of output '" + name + "' failed: " + what);
       });
 }
 
-void Daemon::onDriftChecked(const DriftCheckPlan& plan,
-                            tl::expected<DriftCheck, CalibrationFailure> r) {
+void Daemon::onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, CalibrationFailure> r) {
   DriftRuntime& d = drift_rt_;
   d.checking = false;
-  auto it = d.outputs.find(plan.output);
+  d.camera_in_use.clear();
+  auto it = d.outputs.find(key.output);
   if (it == d.outputs.end() || config_.recalibrate != RecalibratePolicy::kOnDrift) return;
   DriftRuntime::Output& o = it->second;
   o.checked_at = DriftRuntime::Clock::now();
@@ -170,22 +186,31 @@ void Daemon::onDriftChecked(const DriftCheckPlan& plan,
               {"reference_s", r->reference_s},
               {"capture_s", r->capture_s},
               {"measure_s", r->measure_s}};
+  // What changed while the check ran makes it say nothing: another frame on the output,
+  // a new rig model (a correction landed), an operation or auto keystone taking over.
+  const auto st = keystone_rt_.output_state.find(key.output);
+  const bool same_frame =
+      st != keystone_rt_.output_state.end() && st->second.shown_setup == key.setup &&
+      st->second.shown_image == key.image && st->second.shown_at == key.shown_at;
+  if (!same_frame || key.rig_generation != rig_generation_ || settings_.auto_keystone ||
+      calibrating() || !calibration_.op.empty()) {
+    return;
+  }
   ++o.checks;
   const drift::Misregistration& m = r->misregistration;
   o.last = m;
-  // A check made for an older rig model (a correction landed meanwhile) says nothing.
-  if (r->reference->rig_generation != rig_generation_) return;
   const double threshold = config_.drift.threshold_px;
   if (m.too_plain || m.rms_px <= threshold) {
     if (!m.too_plain && o.passes > 0) {
-      logInfo("drift: output '" + plan.output + "' registered again: " + std::to_string(m.rms_px) +
+      logInfo("drift: output '" + key.output + "' registered again: " + std::to_string(m.rms_px) +
               " px after " + std::to_string(o.passes) + " correction(s)");
-      broadcast("drift", {{"output", plan.output},
+      broadcast("drift", {{"output", key.output},
                           {"state", "corrected"},
                           {"passes", o.passes},
                           {"check", misregistrationJson(m)},
                           {"timing", o.timing}});
       o.passes = 0;
+      o.before.reset();
     }
     if (!m.too_plain) o.unresolved = false;
     o.above.reset();
@@ -193,16 +218,27 @@ void Daemon::onDriftChecked(const DriftCheckPlan& plan,
   }
   if (!o.above) {
     o.above = o.checked_at;
-    logInfo("drift: output '" + plan.output + "' misregistered by " + std::to_string(m.rms_px) +
+    logInfo("drift: output '" + key.output + "' misregistered by " + std::to_string(m.rms_px) +
             " px (threshold " + std::to_string(threshold) + ")");
-    broadcast("drift", {{"output", plan.output},
+    broadcast("drift", {{"output", key.output},
                         {"state", "detected"},
                         {"check", misregistrationJson(m)},
                         {"timing", o.timing}});
   }
   if (o.unresolved || secondsSince(*o.above) < config_.drift.settle_s) return;
-  correctDrift(plan.output, m);
+  correctDrift(key.output, m);
 }
+
+namespace {
+
+// `camera` (world -> camera) rigidly mounted on a projector that moved from `from` to `to`
+// (world -> projector): the camera-from-projector pose stays.
+geom::Pose carried(const geom::Pose& camera, const geom::Pose& from, const geom::Pose& to) {
+  const geom::Pose rel = camera.relativeTo(from);
+  return {rel.R * to.R, rel.R * to.t + rel.t};
+}
+
+}  // namespace
 
 void Daemon::correctDrift(const std::string& output, const drift::Misregistration& m) {
   DriftRuntime& d = drift_rt_;
@@ -210,30 +246,61 @@ void Daemon::correctDrift(const std::string& output, const drift::Misregistratio
   const rig::RigProjector* p = rig_.projectorForOutput(output);
   if (!p) return;
   const double held = o.above ? secondsSince(*o.above) : 0.0;
-  const auto refuse = [&](const std::string& why) {
+  const auto giveUp = [&](const std::string& why) {
     o.unresolved = true;
     o.last_correction = {{"step", "projector-pose"}, {"ok", false}, {"why", why}};
-    warn("drift: output '" + output + "': " + why + "; the rig model stays as it was");
     broadcast("drift", {{"output", output},
                         {"state", "unresolved"},
                         {"why", why},
                         {"check", misregistrationJson(m)}});
   };
   if (o.passes >= kMaxPasses) {
-    return refuse("the projector's pose from the content did not bring the misregistration under " +
-                  std::to_string(config_.drift.threshold_px) + " px in " +
-                  std::to_string(kMaxPasses) +
-                  " corrections: the surface or the camera may have moved; calibrate again");
+    // Corrections that do not converge are not kept: the projector as it was before them
+    // (the last one a check confirmed) goes back into rig.json.
+    const std::string why =
+        "the projector's pose from the content did not bring the misregistration under " +
+        std::to_string(config_.drift.threshold_px) + " px in " + std::to_string(kMaxPasses) +
+        " corrections (the surface or the camera may have moved); calibrate again";
+    warn("drift: output '" + output + "': " + why + "; the rig model before them is restored");
+    giveUp(why);
+    if (o.before) {
+      d.writing = true;
+      writeRig(*o.before, {}, [this, output](const Result<std::string>& written) {
+        drift_rt_.writing = false;
+        if (!written)
+          warn("drift: the rig model before the corrections: " + written.error().message);
+        if (written) refreshOutputs();
+      });
+      o.before.reset();
+    }
+    o.passes = 0;
+    return;
   }
   auto tile = blend::displayTile(*p, rig_.surface);
-  if (!tile) return refuse(tile.error().message);
+  if (!tile) {
+    warn("drift: output '" + output + "': " + tile.error().message);
+    return giveUp(tile.error().message);
+  }
   auto c = drift::correctProjector(*p, tile->projector_to_plane, m);
-  if (!c) return refuse("the projector's pose from the content: " + c.error().message);
+  if (!c) {
+    const std::string why = "the projector's pose from the content: " + c.error().message;
+    warn("drift: output '" + output + "': " + why + "; the rig model stays as it was");
+    return giveUp(why);
+  }
   rig::RigModel update;
   update.projectors.push_back(c->projector);
   update.projectors.back().calibrated = {
       "drift correction: pose from content (" + std::to_string(c->tiles) + " tiles)", utcNow()};
-  ++o.passes;
+  rig::RigModel before;
+  before.projectors.push_back(*p);
+  // Cameras mounted on the projector moved with it.
+  for (const rig::RigCamera& cam : rig_.cameras) {
+    if (cam.attached_to != p->name || !cam.pose_known || !p->pose_known) continue;
+    before.cameras.push_back(cam);
+    update.cameras.push_back(cam);
+    update.cameras.back().model.pose = carried(cam.model.pose, p->pose, c->projector.pose);
+  }
+  if (!o.before) o.before = std::move(before);
   const json why = {{"misregistration_px", m.rms_px},
                     {"held_s", held},
                     {"threshold_px", config_.drift.threshold_px}};
@@ -248,11 +315,12 @@ void Daemon::correctDrift(const std::string& output, const drift::Misregistratio
             fit = c->pose_rms_px](const Result<std::string>& written) {
              DriftRuntime& d = drift_rt_;
              d.writing = false;
-             DriftRuntime::Output& o = d.outputs[output];
+             auto it = d.outputs.find(output);
+             if (it == d.outputs.end()) return;  // the output went away meanwhile
+             DriftRuntime::Output& o = it->second;
              o.above.reset();
              json event = {{"output", output}, {"projector", projector}, {"step", "projector-pose"},
-                           {"why", why},       {"tiles", tiles},         {"pose_fit_px", fit},
-                           {"pass", o.passes}};
+                           {"why", why},       {"tiles", tiles},         {"pose_fit_px", fit}};
              if (!written) {
                event["state"] = "failed";
                event["error"] = written.error().message;
@@ -261,7 +329,9 @@ void Daemon::correctDrift(const std::string& output, const drift::Misregistratio
                broadcast("drift", event);
                return;
              }
+             ++o.passes;
              ++o.corrections;
+             event["pass"] = o.passes;
              event["state"] = "corrected-pose";
              event["time"] = utcNow();
              o.last_correction = event;
@@ -275,13 +345,16 @@ json Daemon::driftJson(const std::string& output) const {
   auto it = drift_rt_.outputs.find(output);
   if (it == drift_rt_.outputs.end()) return {{"unavailable", "not checked yet"}};
   const DriftRuntime::Output& o = it->second;
-  if (!o.unavailable.empty()) return {{"unavailable", o.unavailable}};
-  json j = {{"camera", o.camera},
-            {"checks", o.checks},
+  json j = {{"checks", o.checks},
             {"failures", o.failures},
             {"corrections", o.corrections},
             {"last_correction", o.last_correction}};
   if (!o.error.empty()) j["error"] = o.error;
+  if (!o.unavailable.empty()) {
+    j["unavailable"] = o.unavailable;
+    return j;
+  }
+  j["camera"] = o.camera;
   if (o.last) {
     j.update(misregistrationJson(*o.last));
     j["age_s"] = secondsSince(o.checked_at);

@@ -62,8 +62,10 @@ void Daemon::setupTrackers() {
     warn("tracker registrations not restored: " + loaded.error().message);
   }
   // calibrate captures its cameras on a worker: the manager keeps off them meanwhile.
+  // So does the drift check with the camera it drives.
   device_manager_->setReadGate([this](const std::string& name) {
     const auto& used = calibration_.devices;
+    if (drift_rt_.checking && name == drift_rt_.camera_in_use) return false;
     return calibration_.op.empty() || std::find(used.begin(), used.end(), name) == used.end();
   });
   device_manager_->onReading([this](const DeviceEntry& e, const Reading& r) {

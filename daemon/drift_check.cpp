@@ -29,6 +29,12 @@ tl::expected<std::shared_ptr<const DriftReference>, CalibrationFailure> makeRefe
   if (auto drawn = cpu.render(render::Content(plan.image.get(), nullptr, 1)); !drawn) {
     return failed(drawn.error().message);
   }
+  if (cpu.frame().size() != plan.framebuffer) {
+    return failed("the output shows " + std::to_string(cpu.frame().cols) + "x" +
+                  std::to_string(cpu.frame().rows) + " frames; the rig model calibrated " +
+                  std::to_string(plan.framebuffer.width) + "x" +
+                  std::to_string(plan.framebuffer.height));
+  }
   auto ref = std::make_shared<DriftReference>();
   ref->setup = plan.setup;
   ref->image = plan.image;
@@ -39,6 +45,13 @@ tl::expected<std::shared_ptr<const DriftReference>, CalibrationFailure> makeRefe
   cv::cvtColor(cpu.frame(), grey, cv::COLOR_RGBA2GRAY);
   grey.convertTo(f, CV_32F);
   cv::resize(f, ref->shown, ref->grid.size(), 0, 0, cv::INTER_AREA);
+  if (!plan.setup->final_stage.alpha.empty()) {
+    // Only where this projector alone lights the wall: the camera sees the sum of the
+    // projectors in a blended overlap, the reference only this one's share.
+    cv::Mat full = plan.setup->final_stage.alpha == 255;
+    cv::erode(full, full, cv::Mat(), cv::Point(-1, -1), kGridFactor);
+    cv::resize(full, ref->usable, ref->grid.size(), 0, 0, cv::INTER_NEAREST);
+  }
   auto map = drift::projectorCameraMap(plan.projector_to_plane, plan.camera_model, ref->grid);
   if (!map) return failed(map.error().message);
   ref->map = std::move(*map);
@@ -77,6 +90,7 @@ tl::expected<DriftCheck, CalibrationFailure> runDriftCheck(const DriftCheckPlan&
     out.reference_s = since(start);
   }
   const auto capture = Clock::now();
+  plan.fence.wait();
   cv::Mat sum;
   for (int i = 0; i < std::max(1, plan.frames); ++i) {
     auto grey = captureGray(plan.camera);
@@ -95,7 +109,7 @@ tl::expected<DriftCheck, CalibrationFailure> runDriftCheck(const DriftCheckPlan&
   out.capture_s = since(capture);
   const auto measure = Clock::now();
   const DriftReference& ref = *out.reference;
-  auto m = drift::measureMisregistration(ref.shown, sum, ref.map, ref.grid);
+  auto m = drift::measureMisregistration(ref.shown, sum, ref.map, ref.grid, {}, ref.usable);
   out.measure_s = since(measure);
   if (!m) {
     return tl::unexpected(CalibrationFailure{

@@ -10,6 +10,7 @@
 #include "calibration_job.hpp"
 #include "drift/misregistration.hpp"
 #include "drift/projector_camera_map.hpp"
+#include "read_fence.hpp"
 #include "render/render_setup.hpp"
 
 namespace procam::daemon {
@@ -24,6 +25,7 @@ struct DriftReference {
   drift::WorkGrid grid;
   cv::Mat shown;          // the frame's luminance on the grid, CV_32F, code values
   cv::Mat map;            // grid -> camera pixels
+  cv::Mat usable;         // CV_8U of the grid: 0 where the frame is blended with a neighbour's
   double seen_share = 0;  // of the grid the camera sees
 };
 
@@ -35,9 +37,12 @@ struct DriftCheckPlan {
   std::shared_ptr<const render::RenderSetup> setup;
   std::shared_ptr<const cv::Mat> image;  // RGBA content of the frame
   uint64_t rig_generation = 0;
+  cv::Size framebuffer;  // the rig model's, which the frame must have
   geom::PlaneHomography projector_to_plane;
   geom::CameraModel camera_model;
   int frames = 2;  // camera frames averaged
+  // Waited on before the first capture: the device manager's reads of the camera end.
+  ReadFence fence;
 };
 
 struct DriftCheck {
@@ -53,8 +58,8 @@ struct DriftCheck {
 bool referenceFits(const DriftCheckPlan& plan);
 
 // The camera's failures (kIo, kNoDevice, ...); kFailed when the frame cannot be drawn
-// again, the camera's frames have another size than the rig model's or it sees too
-// little of the frame (under 10 %).
+// again, it is not the rig model's framebuffer size, the camera's frames have another size
+// than the rig model's or it sees too little of the frame (under 10 %).
 tl::expected<DriftCheck, CalibrationFailure> runDriftCheck(const DriftCheckPlan& plan);
 
 }  // namespace procam::daemon

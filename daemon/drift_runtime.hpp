@@ -9,8 +9,18 @@
 #include <string>
 
 #include "drift_check.hpp"
+#include "rig/rig_model.hpp"
 
 namespace procam::daemon {
+
+// What a check was made for: its result is dropped when any of it changed meanwhile.
+struct DriftKey {
+  std::string output;
+  std::shared_ptr<const render::RenderSetup> setup;
+  std::shared_ptr<const cv::Mat> image;
+  std::chrono::steady_clock::time_point shown_at;
+  uint64_t rig_generation = 0;
+};
 
 struct DriftRuntime {
   using Clock = std::chrono::steady_clock;
@@ -30,11 +40,15 @@ struct DriftRuntime {
     bool unresolved = false;  // the cheap step did not bring it under: left alone
     uint64_t corrections = 0;
     nlohmann::json last_correction = nullptr;
+    // The projector (and cameras mounted on it) before the corrections since it was last
+    // registered: restored when they do not converge.
+    std::optional<rig::RigModel> before;
   };
   int timer = -1;
-  bool checking = false;  // a check on the compute worker
-  bool writing = false;   // a corrected rig model on its way to rig.json
-  uint64_t next = 0;      // round robin over the outputs
+  bool checking = false;      // a check on the compute worker
+  std::string camera_in_use;  // the camera it drives: the device manager keeps off it
+  bool writing = false;       // a corrected rig model on its way to rig.json
+  uint64_t next = 0;          // round robin over the outputs
   std::map<std::string, Output> outputs;
 };
 

@@ -95,13 +95,17 @@ Vec2 globalShift(const cv::Mat& shown, const cv::Mat& seen, const cv::Mat& seen_
 
 Result<Misregistration> measureMisregistration(const cv::Mat& shown, const cv::Mat& camera,
                                                const cv::Mat& map, const WorkGrid& grid,
-                                               const MisregistrationOptions& options) {
+                                               const MisregistrationOptions& options,
+                                               const cv::Mat& usable) {
   const cv::Size size = grid.size();
   if (shown.type() != CV_32F || shown.size() != size || map.type() != CV_32FC2 ||
       map.size() != size || camera.type() != CV_32F || camera.empty()) {
     return fail(ErrorCode::kInvalidInput,
                 "drift check: the shown frame and the map must be CV_32F / CV_32FC2 of the work "
                 "grid's size, the camera frame CV_32F");
+  }
+  if (!usable.empty() && (usable.type() != CV_8U || usable.size() != size)) {
+    return fail(ErrorCode::kInvalidInput, "drift check: the usable mask must be CV_8U of the grid");
   }
   if (options.tile < 16 || options.tile > 512) {
     return fail(ErrorCode::kInvalidInput, "drift check: tiles of 16 to 512 pixels");
@@ -143,6 +147,7 @@ Result<Misregistration> measureMisregistration(const cv::Mat& shown, const cv::M
                         T + 1 + 2 * pad);
       };
       if (!seenIn(around(global, margin))) continue;  // partly outside the camera's view
+      if (!usable.empty() && cv::countNonZero(usable(cv::Rect(x0, y0, T, T))) < T * T) continue;
       ++m.tiles_seen;
       const cv::Mat shown_tile = shown(cv::Rect(x0, y0, T, T));
       cv::Scalar mean, sd;
@@ -172,8 +177,9 @@ Result<Misregistration> measureMisregistration(const cv::Mat& shown, const cv::M
     }
     std::vector<unsigned char> inliers;
     const cv::Mat H = cv::findHomography(from, to, cv::RANSAC, options.ransac_px, inliers);
+    // No consensus: no tile is trusted (the check then reports too little to tell).
     for (std::size_t i = 0; i < tiles.size(); ++i) {
-      tiles[i].inlier = H.empty() || (i < inliers.size() && inliers[i] != 0);
+      tiles[i].inlier = !H.empty() && i < inliers.size() && inliers[i] != 0;
     }
   }
   // The misregistration is the collineation's over the inlier tiles: each tile's own
@@ -185,7 +191,7 @@ Result<Misregistration> measureMisregistration(const cv::Mat& shown, const cv::M
     if (!t.inlier) continue;
     drawn.push_back(t.drawn);
     seen_at.push_back(t.seen_at);
-    response += t.response;
+    response += std::min(1.0, t.response);  // the peak's sum can pass 1 by rounding
   }
   m.tiles_used = static_cast<int>(drawn.size());
   if (m.tiles_used < options.min_tiles) m.too_plain = true;

@@ -64,9 +64,12 @@ struct Misregistration {
 
 // `shown`: the frame on the output at the grid's work size (CV_32F, code values
 // 0..255); `camera`: the camera's frame (CV_32F, any scale); `map`: from
-// projectorCameraMap for the same grid. kInvalidInput for mismatched sizes or types.
+// projectorCameraMap for the same grid; `usable` (optional, CV_8U of the grid): tiles
+// with any zero pixel are left out (where another projector adds its light: a blended
+// overlap). kInvalidInput for mismatched sizes or types.
 Result<Misregistration> measureMisregistration(const cv::Mat& shown, const cv::Mat& camera,
                                                const cv::Mat& map, const WorkGrid& grid,
-                                               const MisregistrationOptions& options = {});
+                                               const MisregistrationOptions& options = {},
+                                               const cv::Mat& usable = {});
 
 }  // namespace procam::drift

@@ -30,7 +30,11 @@ Result<cv::Mat> projectorCameraMap(const geom::PlaneHomography& projector_to_pla
       if (!(ab.z() * lit_sign > 1e-12)) continue;  // at or past the plane's horizon
       const Vec3 world = projector_to_plane.basis.toWorld({ab.x() / ab.z(), ab.y() / ab.z()});
       const auto px = camera.project(world);
-      if (!px || !camera.inImage(*px)) continue;
+      // Inside the outermost pixel centres: resampling there reads no pixel off the image.
+      if (!px || !(px->x() >= 0 && px->y() >= 0 && px->x() <= camera.width - 1 &&
+                   px->y() <= camera.height - 1)) {
+        continue;
+      }
       row[x] = cv::Vec2f(static_cast<float>(px->x()), static_cast<float>(px->y()));
     }
   }

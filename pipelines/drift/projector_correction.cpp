@@ -5,10 +5,13 @@
 #include <opencv2/core/eigen.hpp>
 #include <vector>
 
+#include "geometry/intersect.hpp"
+
 namespace procam::drift {
 namespace {
 
 constexpr int kMinTiles = 8;
+constexpr double kMaxPoseRmsPx = 1.0;
 
 // The camera pose of `before` refined to framebuffer pixels `px` of world points `world`
 // (Levenberg-Marquardt from the old pose: a bump is small).
@@ -84,16 +87,30 @@ Result<ProjectorCorrection> correctProjector(const rig::RigProjector& before,
     out.projector.plane_homography = ph;
   }
   if (before.pose_known && before.intrinsics_known) {
+    // The wall points by the projector's own model (its lens distortion included, as the
+    // PnP below models it), on the display plane.
+    const geom::CameraModel model = before.model();
+    const Vec3 n = tile.basis.normal().normalized();
+    const geom::Plane plane{n, -n.dot(tile.basis.origin)};
     std::vector<Vec3> world;
     for (const Vec2& s : seen) {
-      const Vec3 ab = tile.H * Vec3(s.x(), s.y(), 1.0);
-      if (!(std::abs(ab.z()) > 1e-12)) {
-        return fail(ErrorCode::kDegenerate, "drift correction: a tile lies on the plane's horizon");
+      auto ray = model.backproject(s);
+      auto hit = ray ? geom::intersectPlane(*ray, plane) : std::nullopt;
+      if (!hit) {
+        return fail(ErrorCode::kDegenerate, "drift correction: a tile's ray misses the plane");
       }
-      world.push_back(tile.basis.toWorld({ab.x() / ab.z(), ab.y() / ab.z()}));
+      world.push_back(hit->point);
     }
     auto pose = refinePose(before, world, drawn);
     if (!pose) return tl::unexpected(pose.error());
+    // The tiles scatter by about 0.2 px about one collineation: a pose that fits them far
+    // worse is not a moved projector (a non-planar surface moved, a bad match).
+    if (pose->second > kMaxPoseRmsPx) {
+      return fail(ErrorCode::kIllConditioned, "drift correction: the new pose fits the tiles to " +
+                                                  std::to_string(pose->second) +
+                                                  " px RMS (at most " +
+                                                  std::to_string(kMaxPoseRmsPx) + ")");
+    }
     out.projector.pose = pose->first;
     out.pose_rms_px = pose->second;
   }

@@ -22,8 +22,9 @@ struct ProjectorCorrection {
 };
 
 // `tile`: the collineation the drift check's map used (blend::displayTile of `before`).
-// kTooFewPoints under 8 inlier tiles; kIllConditioned / kDegenerate from the fits (tiles
-// in a line); kInvalidInput for non-finite input.
+// kTooFewPoints under 8 inlier tiles; kIllConditioned when the new pose fits the tiles
+// worse than 1 px RMS, kDegenerate when a tile's ray misses the plane; kInvalidInput for
+// non-finite input.
 Result<ProjectorCorrection> correctProjector(const rig::RigProjector& before,
                                              const geom::PlaneHomography& tile,
                                              const Misregistration& drift);
