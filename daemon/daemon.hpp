@@ -263,9 +263,15 @@ class Daemon {
   // Why no check or correction may run now (empty: they may).
   std::string driftPaused() const;
   void correctDrift(const std::string& output, const drift::Misregistration& m);
-  // The camera that checks `projector` (mapped onto the plane by `tile`), or null.
-  const rig::RigCamera* driftCamera(const rig::RigProjector& projector,
-                                    const geom::PlaneHomography& tile) const;
+  void correctCamera(const std::string& output, const std::string& camera,
+                     const drift::Misregistration& m);
+  // Merges a correction into rig.json; `event` (a drift event's body) goes out with
+  // `state` when written, "failed" otherwise.
+  void writeDriftCorrection(const std::string& output, rig::RigModel update, nlohmann::json event,
+                            const char* state);
+  // The cameras that check `projector` (mapped onto the plane by `tile`).
+  std::vector<const rig::RigCamera*> driftCameras(const rig::RigProjector& projector,
+                                                  const geom::PlaneHomography& tile) const;
   nlohmann::json driftJson(const std::string& output) const;  // null when the policy is off
   nlohmann::json driftPolicyJson() const;
 

@@ -1,14 +1,18 @@
 // recalibrate = "on-drift" on a fixed rig: while content plays, each output's frame is
-// compared with what the rig model says a camera should see of it (drift_check.hpp);
-// misregistration held over the threshold for the settle time is corrected with the
-// cheapest step: the projector's pose and plane collineation from the content's own
-// correspondences (drift/projector_correction.hpp), no pattern shown, written to
-// rig.json atomically; a failed step keeps the last good rig. Loop thread only; the
-// checks run on the compute worker between the outputs' frames.
+// compared with what the rig model says each fixed camera should see of it
+// (drift_check.hpp); misregistration held over the threshold for the settle time is
+// corrected with the cheapest step, from the content's own correspondences and with no
+// pattern shown: a camera that sees drift where another camera sees the output
+// registered has moved and gets its pose again (drift/camera_correction.hpp); drift that
+// every camera sees is the projector's, whose pose and plane collineation are fitted
+// again (drift/projector_correction.hpp). Written to rig.json atomically; a failed step
+// keeps the last good rig. Loop thread only; the checks run on the compute worker between
+// the outputs' frames.
 #include <cmath>
 
 #include "blend/rig_tiles.hpp"
 #include "daemon.hpp"
+#include "drift/camera_correction.hpp"
 #include "drift/projector_correction.hpp"
 #include "log.hpp"
 #include "protocol.hpp"
@@ -21,12 +25,21 @@ using nlohmann::json;
 namespace {
 
 // Corrections in a row that did not bring the misregistration under the threshold
-// before the daemon stops trying (the projector keeps moving, or the surface or
-// camera moved, which the pose alone cannot explain).
+// before the daemon stops trying (the projector keeps moving, or the surface moved,
+// which no pose explains).
 constexpr int kMaxPasses = 3;
 
 double secondsSince(DriftRuntime::Clock::time_point t) {
   return std::chrono::duration<double>(DriftRuntime::Clock::now() - t).count();
+}
+
+// How long the output's drift has been seen (by the camera that saw it first).
+double heldFor(const DriftRuntime::Output& o) {
+  double held = 0;
+  for (const auto& [name, v] : o.views) {
+    if (v.above) held = std::max(held, secondsSince(*v.above));
+  }
+  return held;
 }
 
 json misregistrationJson(const drift::Misregistration& m) {
@@ -61,21 +74,22 @@ void Daemon::setupDriftCheck() {
   d.timer = *timer;
 }
 
-const rig::RigCamera* Daemon::driftCamera(const rig::RigProjector& projector,
-                                          const geom::PlaneHomography& tile) const {
-  // A posed camera standing on its own (one mounted on a projector moves with it) that is
-  // open and sees the centre of the projector's frame.
+std::vector<const rig::RigCamera*> Daemon::driftCameras(const rig::RigProjector& projector,
+                                                        const geom::PlaneHomography& tile) const {
+  // Posed cameras standing on their own (one mounted on a projector moves with it) that
+  // are open and see the centre of the projector's frame.
+  std::vector<const rig::RigCamera*> out;
   const Vec3 c = tile.H * Vec3((projector.width - 1) / 2.0, (projector.height - 1) / 2.0, 1.0);
-  if (!(std::abs(c.z()) > 1e-12)) return nullptr;
+  if (!(std::abs(c.z()) > 1e-12)) return out;
   const Vec3 centre = tile.basis.toWorld({c.x() / c.z(), c.y() / c.z()});
   for (const rig::RigCamera& cam : rig_.cameras) {
     if (!cam.pose_known || !cam.attached_to.empty()) continue;
     const DeviceEntry* e = const_cast<DeviceSet&>(devices_).find(cam.name);
     if (!e || e->description.family != PROCAM_FAMILY_CAMERA || !e->usable()) continue;
     auto px = cam.model.project(centre);
-    if (px && cam.model.inImage(*px)) return &cam;
+    if (px && cam.model.inImage(*px)) out.push_back(&cam);
   }
-  return nullptr;
+  return out;
 }
 
 std::string Daemon::driftPaused() const {
@@ -108,7 +122,7 @@ void Daemon::checkDrift() {
   const auto unavailable = [&](std::string why) {
     o.unavailable = std::move(why);
     o.camera.clear();
-    o.above.reset();
+    o.forgetDrift();
   };
   const rig::RigProjector* p = rig_.projectorForOutput(out.name);
   if (!p) return unavailable("the rig model has no projector for the output");
@@ -120,8 +134,16 @@ void Daemon::checkDrift() {
   }
   auto tile = blend::displayTile(*p, rig_.surface);
   if (!tile) return unavailable("not mapped onto a display plane: " + tile.error().message);
-  const rig::RigCamera* cam = driftCamera(*p, tile->projector_to_plane);
-  if (!cam) return unavailable("no open, posed, fixed camera of the rig model sees the frame");
+  const auto cams = driftCameras(*p, tile->projector_to_plane);
+  if (cams.empty())
+    return unavailable("no open, posed, fixed camera of the rig model sees the frame");
+  o.cameras.clear();
+  for (const rig::RigCamera* c : cams) o.cameras.push_back(c->name);
+  for (auto v = o.views.begin(); v != o.views.end();) {
+    const bool sees = std::find(o.cameras.begin(), o.cameras.end(), v->first) != o.cameras.end();
+    v = sees ? std::next(v) : o.views.erase(v);
+  }
+  const rig::RigCamera* cam = cams[o.next_camera++ % cams.size()];
   auto st = k.output_state.find(out.name);
   if (st == k.output_state.end() || !st->second.shown_image || !st->second.shown_setup) {
     return unavailable("nothing shown yet");
@@ -136,7 +158,7 @@ void Daemon::checkDrift() {
   DriftCheckPlan plan;
   plan.output = out.name;
   plan.camera = {cam->name, cam_entry->device.share()};
-  plan.reference = o.reference;
+  plan.reference = o.views[cam->name].reference;
   plan.setup = st->second.shown_setup;
   plan.image = st->second.shown_image;
   plan.rig_generation = rig_generation_;
@@ -147,7 +169,8 @@ void Daemon::checkDrift() {
   // The device manager keeps off the camera while the check drives it.
   d.camera_in_use = cam->name;
   plan.fence = device_manager_->readFence({cam->name});
-  const DriftKey key{out.name, plan.setup, plan.image, st->second.shown_at, rig_generation_};
+  const DriftKey key{out.name,   cam->name,           plan.setup,
+                     plan.image, st->second.shown_at, rig_generation_};
   d.checking = true;
   compute_worker_->submit(
       [this, plan = std::move(plan), key] {
@@ -168,12 +191,14 @@ void Daemon::onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, Calibr
   auto it = d.outputs.find(key.output);
   if (it == d.outputs.end() || config_.recalibrate != RecalibratePolicy::kOnDrift) return;
   DriftRuntime::Output& o = it->second;
-  o.checked_at = DriftRuntime::Clock::now();
+  DriftRuntime::View& v = o.views[key.camera];
+  o.camera = key.camera;
+  v.checked_at = DriftRuntime::Clock::now();
   if (!r) {
     // The last good rig stays; a camera gone is the device manager's.
     ++o.failures;
     o.error = r.error().message;
-    o.above.reset();
+    v.above.reset();
     warn("drift check: " + r.error().message);
     if (!r.error().device.empty() && closesDevice(r.error().rc)) {
       device_manager_->report(r.error().device, r.error().rc, r.error().message);
@@ -181,8 +206,8 @@ void Daemon::onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, Calibr
     return;
   }
   o.error.clear();
-  o.reference = r->reference;
-  o.timing = {{"check_s", r->seconds},
+  v.reference = r->reference;
+  v.timing = {{"check_s", r->seconds},
               {"reference_s", r->reference_s},
               {"capture_s", r->capture_s},
               {"measure_s", r->measure_s}};
@@ -198,34 +223,53 @@ void Daemon::onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, Calibr
   }
   ++o.checks;
   const drift::Misregistration& m = r->misregistration;
-  o.last = m;
+  v.last = m;
   const double threshold = config_.drift.threshold_px;
   if (m.too_plain || m.rms_px <= threshold) {
-    if (!m.too_plain && o.passes > 0) {
-      logInfo("drift: output '" + key.output + "' registered again: " + std::to_string(m.rms_px) +
-              " px after " + std::to_string(o.passes) + " correction(s)");
+    v.above.reset();
+    if (!m.too_plain && o.passes > 0 && !o.drifted()) {
+      logInfo("drift: output '" + key.output + "' registered again (camera '" + key.camera +
+              "'): " + std::to_string(m.rms_px) + " px after " + std::to_string(o.passes) +
+              " correction(s)");
       broadcast("drift", {{"output", key.output},
+                          {"camera", key.camera},
                           {"state", "corrected"},
                           {"passes", o.passes},
                           {"check", misregistrationJson(m)},
-                          {"timing", o.timing}});
+                          {"timing", v.timing}});
       o.passes = 0;
       o.before.reset();
     }
     if (!m.too_plain) o.unresolved = false;
-    o.above.reset();
     return;
   }
-  if (!o.above) {
-    o.above = o.checked_at;
+  if (!v.above) {
+    v.above = v.checked_at;
     logInfo("drift: output '" + key.output + "' misregistered by " + std::to_string(m.rms_px) +
-            " px (threshold " + std::to_string(threshold) + ")");
+            " px in camera '" + key.camera + "' (threshold " + std::to_string(threshold) + ")");
     broadcast("drift", {{"output", key.output},
+                        {"camera", key.camera},
                         {"state", "detected"},
                         {"check", misregistrationJson(m)},
-                        {"timing", o.timing}});
+                        {"timing", v.timing}});
   }
-  if (o.unresolved || secondsSince(*o.above) < config_.drift.settle_s) return;
+  if (o.unresolved || secondsSince(*v.above) < config_.drift.settle_s) return;
+  // Whose drift: another camera's check captured after this one first saw it tells. One
+  // that sees the output registered means this camera moved; drift in every camera is
+  // the projector's. With one camera the two cannot be told apart (on a plane both move
+  // the content by a collineation): the projector is assumed to have moved.
+  bool other_registered = false, other_drifted = false;
+  for (const std::string& name : o.cameras) {
+    if (name == key.camera) continue;
+    auto ov = o.views.find(name);
+    if (ov == o.views.end() || !ov->second.last || ov->second.last->too_plain ||
+        ov->second.checked_at <= *v.above) {
+      continue;
+    }
+    (ov->second.last->rms_px <= threshold ? other_registered : other_drifted) = true;
+  }
+  if (other_registered) return correctCamera(key.output, key.camera, m);
+  if (o.cameras.size() > 1 && !other_drifted) return;  // the others have not looked since
   correctDrift(key.output, m);
 }
 
@@ -245,7 +289,7 @@ void Daemon::correctDrift(const std::string& output, const drift::Misregistratio
   DriftRuntime::Output& o = d.outputs[output];
   const rig::RigProjector* p = rig_.projectorForOutput(output);
   if (!p) return;
-  const double held = o.above ? secondsSince(*o.above) : 0.0;
+  const double held = heldFor(o);
   const auto giveUp = [&](const std::string& why) {
     o.unresolved = true;
     o.last_correction = {{"step", "projector-pose"}, {"ok", false}, {"why", why}};
@@ -308,36 +352,100 @@ void Daemon::correctDrift(const std::string& output, const drift::Misregistratio
           "' from the content (" + std::to_string(m.rms_px) + " px held " + std::to_string(held) +
           " s; " + std::to_string(c->tiles) + " tiles, pose fit " + std::to_string(c->pose_rms_px) +
           " px)");
-  d.writing = true;
-  const std::string projector = p->name;
-  writeRig(std::move(update), {},
-           [this, output, projector, why, tiles = c->tiles,
-            fit = c->pose_rms_px](const Result<std::string>& written) {
-             DriftRuntime& d = drift_rt_;
-             d.writing = false;
-             auto it = d.outputs.find(output);
-             if (it == d.outputs.end()) return;  // the output went away meanwhile
-             DriftRuntime::Output& o = it->second;
-             o.above.reset();
-             json event = {{"output", output}, {"projector", projector}, {"step", "projector-pose"},
-                           {"why", why},       {"tiles", tiles},         {"pose_fit_px", fit}};
-             if (!written) {
-               event["state"] = "failed";
-               event["error"] = written.error().message;
-               o.last_correction = event;
-               warn("drift: " + written.error().message + "; the rig model stays as it was");
-               broadcast("drift", event);
-               return;
-             }
-             ++o.passes;
-             ++o.corrections;
-             event["pass"] = o.passes;
-             event["state"] = "corrected-pose";
-             event["time"] = utcNow();
-             o.last_correction = event;
-             broadcast("drift", event);
-             refreshOutputs();
-           });
+  writeDriftCorrection(output, std::move(update),
+                       {{"output", output},
+                        {"projector", p->name},
+                        {"step", "projector-pose"},
+                        {"why", why},
+                        {"tiles", c->tiles},
+                        {"pose_fit_px", c->pose_rms_px}},
+                       "corrected-pose");
+}
+
+void Daemon::correctCamera(const std::string& output, const std::string& camera,
+                           const drift::Misregistration& m) {
+  DriftRuntime& d = drift_rt_;
+  DriftRuntime::Output& o = d.outputs[output];
+  const rig::RigProjector* p = rig_.projectorForOutput(output);
+  const rig::RigCamera* cam = rig_.camera(camera);
+  const DriftRuntime::View& v = o.views[camera];
+  if (!p || !cam || !v.reference) return;
+  const double held = heldFor(o);
+  const auto giveUp = [&](const std::string& why) {
+    o.unresolved = true;
+    o.last_correction = {{"step", "camera-pose"}, {"camera", camera}, {"ok", false}, {"why", why}};
+    warn("drift: camera '" + camera + "': " + why + "; the rig model stays as it was");
+    broadcast("drift", {{"output", output},
+                        {"camera", camera},
+                        {"state", "unresolved"},
+                        {"why", why},
+                        {"check", misregistrationJson(m)}});
+  };
+  if (o.passes >= kMaxPasses) {
+    return giveUp("re-registering the camera did not bring the misregistration under " +
+                  std::to_string(config_.drift.threshold_px) + " px in " +
+                  std::to_string(kMaxPasses) + " corrections; calibrate again");
+  }
+  auto tile = blend::displayTile(*p, rig_.surface);
+  if (!tile) return giveUp(tile.error().message);
+  auto c =
+      drift::correctCamera(*cam, tile->projector_to_plane, m, v.reference->map, v.reference->grid);
+  if (!c) return giveUp("the camera's pose from the content: " + c.error().message);
+  rig::RigModel update;
+  update.cameras.push_back(c->camera);
+  update.cameras.back().calibrated = {
+      "drift correction: pose from content (" + std::to_string(c->tiles) + " tiles)", utcNow()};
+  if (!o.before) {
+    o.before.emplace();
+    o.before->cameras.push_back(*cam);
+  }
+  const json why = {{"misregistration_px", m.rms_px},
+                    {"held_s", held},
+                    {"threshold_px", config_.drift.threshold_px},
+                    {"registered_in", "another camera sees the output registered"}};
+  logInfo("drift: output '" + output + "' misregistered in camera '" + camera +
+          "' only: re-registering the camera from the content (" + std::to_string(m.rms_px) +
+          " px held " + std::to_string(held) + " s; " + std::to_string(c->tiles) +
+          " tiles, pose fit " + std::to_string(c->pose_rms_px) + " camera px)");
+  writeDriftCorrection(output, std::move(update),
+                       {{"output", output},
+                        {"camera", camera},
+                        {"step", "camera-pose"},
+                        {"why", why},
+                        {"tiles", c->tiles},
+                        {"pose_fit_px", c->pose_rms_px}},
+                       "corrected-camera");
+}
+
+void Daemon::writeDriftCorrection(const std::string& output, rig::RigModel update, json event,
+                                  const char* state) {
+  drift_rt_.writing = true;
+  writeRig(
+      std::move(update), {},
+      [this, output, event = std::move(event), state](const Result<std::string>& written) mutable {
+        DriftRuntime& d = drift_rt_;
+        d.writing = false;
+        auto it = d.outputs.find(output);
+        if (it == d.outputs.end()) return;  // the output went away meanwhile
+        DriftRuntime::Output& o = it->second;
+        o.forgetDrift();
+        if (!written) {
+          event["state"] = "failed";
+          event["error"] = written.error().message;
+          o.last_correction = event;
+          warn("drift: " + written.error().message + "; the rig model stays as it was");
+          broadcast("drift", event);
+          return;
+        }
+        ++o.passes;
+        ++o.corrections;
+        event["pass"] = o.passes;
+        event["state"] = state;
+        event["time"] = utcNow();
+        o.last_correction = event;
+        broadcast("drift", event);
+        refreshOutputs();  // a new projector mapping moves the keystone
+      });
 }
 
 json Daemon::driftJson(const std::string& output) const {
@@ -354,20 +462,34 @@ json Daemon::driftJson(const std::string& output) const {
     j["unavailable"] = o.unavailable;
     return j;
   }
+  // The last check's figures, and each camera's.
   j["camera"] = o.camera;
-  if (o.last) {
-    j.update(misregistrationJson(*o.last));
-    j["age_s"] = secondsSince(o.checked_at);
-    j.update(o.timing);
+  if (const DriftRuntime::View* v = o.lastView(); v && v->last) {
+    j.update(misregistrationJson(*v->last));
+    j["age_s"] = secondsSince(v->checked_at);
+    j.update(v->timing);
   }
+  json cameras = json::array();
+  bool checked = false, plain = true;
+  for (const auto& [name, v] : o.views) {
+    if (!v.last) continue;
+    checked = true;
+    plain = plain && v.last->too_plain;
+    cameras.push_back({{"camera", name},
+                       {"misregistration_px", v.last->rms_px},
+                       {"too_plain", v.last->too_plain},
+                       {"drifted", v.above.has_value()},
+                       {"age_s", secondsSince(v.checked_at)}});
+  }
+  j["cameras"] = std::move(cameras);
   std::string state = "registered";
-  if (!o.last) {
+  if (!checked) {
     state = "checking";
-  } else if (o.last->too_plain) {
+  } else if (plain) {
     state = "too plain to tell";
   } else if (o.unresolved) {
     state = "unresolved";
-  } else if (o.above) {
+  } else if (o.drifted()) {
     state = "drifted";
   }
   j["state"] = state;

@@ -1,12 +1,15 @@
 #pragma once
 // The daemon's drift state for recalibrate = "on-drift" (daemon_drift.cpp): per output the
-// camera that watches it, the last check and where the correction stands. Loop thread only.
+// cameras that watch it, each one's last check, and where the correction stands. Loop
+// thread only.
+#include <algorithm>
 #include <chrono>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "drift_check.hpp"
 #include "rig/rig_model.hpp"
@@ -16,6 +19,7 @@ namespace procam::daemon {
 // What a check was made for: its result is dropped when any of it changed meanwhile.
 struct DriftKey {
   std::string output;
+  std::string camera;
   std::shared_ptr<const render::RenderSetup> setup;
   std::shared_ptr<const cv::Mat> image;
   std::chrono::steady_clock::time_point shown_at;
@@ -24,25 +28,41 @@ struct DriftKey {
 
 struct DriftRuntime {
   using Clock = std::chrono::steady_clock;
-  struct Output {
-    std::string camera;       // the camera that checks it (empty: none)
-    std::string unavailable;  // why it is not checked (empty: it is)
+  // One camera's view of an output: its reference and last check.
+  struct View {
     std::shared_ptr<const DriftReference> reference;
     std::optional<drift::Misregistration> last;
     Clock::time_point checked_at;
+    std::optional<Clock::time_point> above;  // drift seen by this camera since
     nlohmann::json timing =
         nullptr;  // the last check's: {check_s, reference_s, capture_s, measure_s}
+  };
+  struct Output {
+    std::vector<std::string> cameras;  // the fixed cameras that see it
+    std::string camera;                // the one of the last check
+    std::string unavailable;           // why it is not checked (empty: it is)
+    std::map<std::string, View> views;
+    uint64_t next_camera = 0;  // round robin over `cameras`
     uint64_t checks = 0;
     uint64_t failures = 0;
-    std::string error;                       // the last check's failure
-    std::optional<Clock::time_point> above;  // drift held since
+    std::string error;        // the last check's failure
     int passes = 0;           // corrections since the misregistration was last under threshold
-    bool unresolved = false;  // the cheap step did not bring it under: left alone
+    bool unresolved = false;  // the cheap steps did not bring it under: left alone
     uint64_t corrections = 0;
     nlohmann::json last_correction = nullptr;
-    // The projector (and cameras mounted on it) before the corrections since it was last
-    // registered: restored when they do not converge.
+    // The projector, cameras mounted on it or a camera re-registered, before the
+    // corrections since it was last registered: restored when they do not converge.
     std::optional<rig::RigModel> before;
+    const View* lastView() const {
+      auto it = views.find(camera);
+      return it == views.end() ? nullptr : &it->second;
+    }
+    bool drifted() const {
+      return std::any_of(views.begin(), views.end(), [](const auto& v) { return v.second.above; });
+    }
+    void forgetDrift() {
+      for (auto& [name, v] : views) v.above.reset();
+    }
   };
   int timer = -1;
   bool checking = false;      // a check on the compute worker

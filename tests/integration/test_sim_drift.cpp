@@ -342,5 +342,125 @@ TEST(SimDrift, ACameraUnpluggedAfterDriftWasSeenLeavesTheRigUntilItIsBack) {
   EXPECT_LE(rig_px, 0.5);
 }
 
+// A second fixed camera looking at the projector's image from the other side.
+const char* kSecondCamera = R"([[cameras]]
+name = "cam2"
+resolution = [1280, 960]
+intrinsics = { fx = 1000.0, fy = 1000.0, cx = 639.1, cy = 481.0 }
+distortion = { k1 = -0.05, k2 = 0.01, p1 = 0.0, p2 = 0.0, k3 = 0.0 }
+pose = { position = [0.9, -0.6, 1.2], look_at = [-0.4, 3.0, 1.4] }
+exposure = 1.0
+gain = 1.0
+bit_depth = 8
+response_gamma = 1.0
+read_noise_dn = 0.8
+full_well_e = 12000.0
+channels = 1
+psf_sigma_px = 0.8
+supersamples = 4
+
+)";
+
+// The `drift` event of the correction `state` (none of `wrong`, none unresolved), then
+// whether a check found the output registered after it (within 25 s).
+std::optional<json> awaitCorrection(Connection& watcher, const std::string& state,
+                                    const std::string& wrong, bool& registered) {
+  std::optional<json> corrected;
+  registered = false;
+  const auto deadline = Clock::now() + 25s * kSlowdown;
+  while (Clock::now() < deadline && !registered) {
+    auto e = watcher.next(1s);
+    if (!e || (*e)["event"] != "drift") continue;
+    EXPECT_NE((*e)["state"], wrong) << e->dump();
+    EXPECT_NE((*e)["state"], "unresolved") << e->dump();
+    if ((*e)["state"] == state) corrected = *e;
+    registered = corrected && (*e)["state"] == "corrected";
+  }
+  return corrected;
+}
+
+// Two fixed cameras, one of them bumped: the other still sees the content where the rig
+// puts it, so the bumped camera is re-registered and the projector left as it is; then the
+// projector bumped, which both cameras see.
+TEST(SimDrift, ABumpedCameraIsReregisteredAndTheProjectorLeftAlone) {
+  TempDir dir;
+  const std::string scene_file = sceneWithEvents(
+      dir, std::string(kSecondCamera) +
+               "[[events]]\nt = 6.0\ntarget = \"cam\"\nrotate_deg = [0.3, 0.0, 0.0]\n\n"
+               "[[events]]\nt = 16.0\ntarget = \"proj\"\nrotate_deg = [0.5, 0.0, 0.0]\n");
+  auto scene = sim::resolveScene(scene_file);
+  ASSERT_TRUE(scene) << scene.error().message;
+  DaemonProcess d(dir, driftDaemon(dir, "on-drift", scene_file));
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  Connection watcher(d.socketPath());
+  ASSERT_TRUE(watcher.call({{"cmd", "watch"}}));
+  ASSERT_NO_FATAL_FAILURE(showContent(c, texturedContent(dir)));
+  const auto projectorOf = [&] {
+    auto rig = rig::rigFromText(rigText(dir), "rig.json");
+    return rig ? rig::rigToJson(*rig)["projectors"] : json(nullptr);
+  };
+  const json projector_before = projectorOf();
+  bool registered = false;
+  const std::optional<json> corrected =
+      awaitCorrection(watcher, "corrected-camera", "corrected-pose", registered);
+  ASSERT_TRUE(corrected) << outputDrift(c).dump() << d.log();
+  EXPECT_EQ((*corrected)["camera"], "cam");
+  EXPECT_EQ((*corrected)["step"], "camera-pose");
+  EXPECT_TRUE(registered) << outputDrift(c).dump();
+  EXPECT_EQ(projector_before, projectorOf());
+  // The re-registered camera against the true bumped one, over the content on the wall
+  // (what the camera watches, where the pose is fitted: the keystone's rectangle).
+  auto k = c.call({{"cmd", "keystone"}});
+  ASSERT_TRUE(k && (*k)["mode"] == "rig");
+  const Mat3 H = matrixOf((*k)["homography"]);
+  const int cw = (*k)["content_size"][0], ch = (*k)["content_size"][1];
+  auto rig = rig::rigFromText(rigText(dir), "rig.json");
+  ASSERT_TRUE(rig) << rig.error().message;
+  const geom::CameraModel truth = scene->at(7.0).cameras.at(0).model;
+  const geom::CameraModel projector = scene->at(7.0).projectors.at(0).model;
+  const rig::RigCamera* fixed = rig->camera("cam");
+  ASSERT_TRUE(fixed);
+  double worst = 0;
+  int seen = 0;
+  for (int y = 0; y < ch; y += 30) {
+    for (int x = 0; x < cw; x += 30) {
+      const Vec3 f = H * Vec3(x, y, 1.0);
+      auto ray = projector.backproject(f.head<2>() / f.z());
+      auto hit = ray ? geom::intersectPlane(*ray, *rig->surface.plane) : std::nullopt;
+      auto want = hit ? truth.project(hit->point) : std::nullopt;
+      if (!want || !truth.inImage(*want)) continue;
+      auto back = fixed->model.project(hit->point);
+      ASSERT_TRUE(back);
+      worst = std::max(worst, (*back - *want).norm());
+      ++seen;
+    }
+  }
+  ASSERT_GT(seen, 200);
+  const json dr = outputDrift(c);
+  std::printf(
+      "[ figures  ] camera bumped 0.3 deg: re-registered from %d tiles (fit %.3f px); "
+      "against the true camera %.3f camera px at worst; now %.3f px; projector "
+      "unchanged\n",
+      (*corrected)["tiles"].get<int>(), (*corrected)["pose_fit_px"].get<double>(), worst,
+      dr.value("misregistration_px", -1.0));
+  // A camera pixel covers about 2.5 projector pixels here: 0.2 camera px keeps the
+  // registration it measures within the 0.5 projector px bound.
+  EXPECT_LE(worst, 0.2);
+
+  // Then the projector bumped (at 16 s): both cameras see it, so it is the projector's
+  // pose that is corrected.
+  const std::optional<json> pose =
+      awaitCorrection(watcher, "corrected-pose", "corrected-camera", registered);
+  ASSERT_TRUE(pose) << outputDrift(c).dump() << d.log();
+  EXPECT_TRUE(registered) << outputDrift(c).dump();
+  const double rig_px = rigAgainstTruth(dir, scene->at(17.0).projectors.at(0).model);
+  std::printf(
+      "[ figures  ] then the projector bumped 0.5 deg, seen by both cameras: its pose "
+      "corrected, the rig against the true projector %.3f px\n",
+      rig_px);
+  EXPECT_LE(rig_px, 0.5);
+}
+
 }  // namespace
 }  // namespace procam::itest
