@@ -184,6 +184,7 @@ int main(int argc, char** argv) {
   std::filesystem::path out = "bench-out/bench_drift";
   int runs = 20;
   if (!bench::benchOptions(argc, argv, "bench_drift", out, runs, 5)) return 2;
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // a line at a time: the soak runs ten minutes
   Setup s{*sim::resolveScene("wall_oblique"), {}, {}, drift::WorkGrid{{1920, 1080}, 2}, {}};
   s.rig = *sim::truthRig(s.scene, 0.0);
   s.tile = blend::displayTile(s.rig.projectors.at(0), s.rig.surface)->projector_to_plane;
@@ -263,7 +264,7 @@ int main(int argc, char** argv) {
                       : (", correction " + std::to_string(correct_ms) + " ms").c_str());
       csv << c.name << "," << ref.median_ms << "," << meas.median_ms << "," << ecc.median_ms
           << ",33.3," << p99 << "," << bump << "," << truth << "," << measured << "," << ecc_err
-          << "," << correct_ms << "\n";
+          << "," << correct_ms << std::endl;
     }
   }
 

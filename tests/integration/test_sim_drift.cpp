@@ -26,6 +26,15 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// Scene events run on the wall clock; under the sanitizers the daemon and the virtual
+// camera are kSlowdown times slower, so the scene's times stretch with them.
+double at(double seconds) {
+  return seconds * kSlowdown;
+}
+std::string atText(double seconds) {
+  return std::to_string(at(seconds));
+}
+
 // wall_oblique with `events` appended, written into `dir`.
 std::string sceneWithEvents(const TempDir& dir, const std::string& events) {
   const char* src = std::getenv("PROCAM_SOURCE_DIR");
@@ -133,7 +142,7 @@ struct Bump {
 
 TEST(SimDrift, ABumpedProjectorIsCorrectedFromTheContentWithoutAScan) {
   // Still for 8 s (about thirty checks), then bumped 0.5 degrees, then 2 degrees more.
-  const Bump bumps[] = {{8.0, 0.5, 0.0}, {18.0, 0.0, -2.0}};
+  const Bump bumps[] = {{at(8.0), 0.5, 0.0}, {at(18.0), 0.0, -2.0}};
   TempDir dir;
   std::string events;
   for (const Bump& b : bumps) {
@@ -205,7 +214,7 @@ TEST(SimDrift, ABumpedProjectorIsCorrectedFromTheContentWithoutAScan) {
       EXPECT_NE(state, "failed") << e->dump();
     }
     ASSERT_TRUE(detected && corrected && registered) << d.log();
-    const geom::CameraModel truth = scene->at(b.t + 1.0).projectors.at(0).model;
+    const geom::CameraModel truth = scene->at(b.t + at(1.0)).projectors.at(0).model;
     const double rig_px = rigAgainstTruth(dir, truth);
     const Measured m = keystoneAgainstTruth(c, truth);
     const json dr = outputDrift(c);
@@ -253,8 +262,9 @@ TEST(SimDrift, PlainContentIsReportedAndOffDoesNothing) {
   for (const std::string policy : {"on-drift", "off"}) {
     SCOPED_TRACE(policy);
     TempDir dir;
-    const std::string scene_file = sceneWithEvents(
-        dir, "[[events]]\nt = 4.0\ntarget = \"proj\"\nrotate_deg = [1.0, 0.0, 0.0]\n");
+    const std::string scene_file =
+        sceneWithEvents(dir, "[[events]]\nt = " + atText(4.0) +
+                                 "\ntarget = \"proj\"\nrotate_deg = [1.0, 0.0, 0.0]\n");
     const auto spawned = Clock::now();
     DaemonProcess d(dir, driftDaemon(dir, policy, scene_file));
     ASSERT_TRUE(d.started()) << d.log();
@@ -269,7 +279,7 @@ TEST(SimDrift, PlainContentIsReportedAndOffDoesNothing) {
       png = texturedContent(dir);
     }
     ASSERT_NO_FATAL_FAILURE(showContent(c, png));
-    while (std::chrono::duration<double>(Clock::now() - spawned).count() < 7.0) {
+    while (std::chrono::duration<double>(Clock::now() - spawned).count() < at(7.0)) {
       std::this_thread::sleep_for(250ms);
     }
     const json dr = outputDrift(c);
@@ -295,12 +305,14 @@ TEST(SimDrift, PlainContentIsReportedAndOffDoesNothing) {
 // resume and correct the projector.
 TEST(SimDrift, ACameraUnpluggedAfterDriftWasSeenLeavesTheRigUntilItIsBack) {
   TempDir dir;
-  const std::string scene_file = sceneWithEvents(
-      dir, "[[events]]\nt = 5.0\ntarget = \"proj\"\nrotate_deg = [0.0, 1.0, 0.0]\n");
+  const std::string scene_file =
+      sceneWithEvents(dir, "[[events]]\nt = " + atText(5.0) +
+                               "\ntarget = \"proj\"\nrotate_deg = [0.0, 1.0, 0.0]\n");
   auto scene = sim::resolveScene(scene_file);
   ASSERT_TRUE(scene) << scene.error().message;
-  DaemonProcess d(dir, driftDaemon(dir, "on-drift", scene_file, {"PROCAM_SIM_UNPLUG=cam@8.0-11.0"},
-                                   "drift_settle_s = 4\n"));
+  DaemonProcess d(dir, driftDaemon(dir, "on-drift", scene_file,
+                                   {"PROCAM_SIM_UNPLUG=cam@" + atText(8.0) + "-" + atText(11.0)},
+                                   "drift_settle_s = " + atText(4.0) + "\n"));
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
   Connection watcher(d.socketPath());
@@ -312,7 +324,7 @@ TEST(SimDrift, ACameraUnpluggedAfterDriftWasSeenLeavesTheRigUntilItIsBack) {
     return std::chrono::duration<double>(Clock::now() - started).count();
   };
   std::optional<double> detected;
-  while (sceneTime() < 10.0) {
+  while (sceneTime() < at(10.0)) {
     auto e = watcher.next(250ms);
     if (!e || (*e)["event"] != "drift") continue;
     if ((*e)["state"] == "detected" && !detected) detected = sceneTime();
@@ -320,7 +332,7 @@ TEST(SimDrift, ACameraUnpluggedAfterDriftWasSeenLeavesTheRigUntilItIsBack) {
   }
   // Seen before the camera went (at 8 s), not corrected while it is gone.
   ASSERT_TRUE(detected) << d.log();
-  EXPECT_LT(*detected, 8.0);
+  EXPECT_LT(*detected, at(8.0));
   const json gone = outputDrift(c);
   ASSERT_TRUE(gone.is_object()) << d.log();
   EXPECT_EQ(gone.value("corrections", 0), 0) << gone.dump();
@@ -334,11 +346,11 @@ TEST(SimDrift, ACameraUnpluggedAfterDriftWasSeenLeavesTheRigUntilItIsBack) {
       },
       15s * kSlowdown))
       << outputDrift(c).dump() << d.log();
-  const double rig_px = rigAgainstTruth(dir, scene->at(6.0).projectors.at(0).model);
+  const double rig_px = rigAgainstTruth(dir, scene->at(at(6.0)).projectors.at(0).model);
   std::printf(
-      "[ figures  ] drift seen at %.2f s, the camera gone 8-11 s, corrected after it came back: "
-      "the rig against the true projector %.3f px\n",
-      *detected, rig_px);
+      "[ figures  ] drift seen at %.2f s, the camera gone %.0f-%.0f s, corrected after it came "
+      "back: the rig against the true projector %.3f px\n",
+      *detected, at(8.0), at(11.0), rig_px);
   EXPECT_LE(rig_px, 0.5);
 }
 
@@ -385,9 +397,10 @@ std::optional<json> awaitCorrection(Connection& watcher, const std::string& stat
 TEST(SimDrift, ABumpedCameraIsReregisteredAndTheProjectorLeftAlone) {
   TempDir dir;
   const std::string scene_file = sceneWithEvents(
-      dir, std::string(kSecondCamera) +
-               "[[events]]\nt = 6.0\ntarget = \"cam\"\nrotate_deg = [0.3, 0.0, 0.0]\n\n"
-               "[[events]]\nt = 16.0\ntarget = \"proj\"\nrotate_deg = [0.5, 0.0, 0.0]\n");
+      dir, std::string(kSecondCamera) + "[[events]]\nt = " + atText(6.0) +
+               "\ntarget = \"cam\"\nrotate_deg = [0.3, 0.0, 0.0]\n\n"
+               "[[events]]\nt = " +
+               atText(16.0) + "\ntarget = \"proj\"\nrotate_deg = [0.5, 0.0, 0.0]\n");
   auto scene = sim::resolveScene(scene_file);
   ASSERT_TRUE(scene) << scene.error().message;
   DaemonProcess d(dir, driftDaemon(dir, "on-drift", scene_file));
@@ -417,8 +430,8 @@ TEST(SimDrift, ABumpedCameraIsReregisteredAndTheProjectorLeftAlone) {
   const int cw = (*k)["content_size"][0], ch = (*k)["content_size"][1];
   auto rig = rig::rigFromText(rigText(dir), "rig.json");
   ASSERT_TRUE(rig) << rig.error().message;
-  const geom::CameraModel truth = scene->at(7.0).cameras.at(0).model;
-  const geom::CameraModel projector = scene->at(7.0).projectors.at(0).model;
+  const geom::CameraModel truth = scene->at(at(7.0)).cameras.at(0).model;
+  const geom::CameraModel projector = scene->at(at(7.0)).projectors.at(0).model;
   const rig::RigCamera* fixed = rig->camera("cam");
   ASSERT_TRUE(fixed);
   double worst = 0;
@@ -454,7 +467,7 @@ TEST(SimDrift, ABumpedCameraIsReregisteredAndTheProjectorLeftAlone) {
       awaitCorrection(watcher, "corrected-pose", "corrected-camera", registered);
   ASSERT_TRUE(pose) << outputDrift(c).dump() << d.log();
   EXPECT_TRUE(registered) << outputDrift(c).dump();
-  const double rig_px = rigAgainstTruth(dir, scene->at(17.0).projectors.at(0).model);
+  const double rig_px = rigAgainstTruth(dir, scene->at(at(17.0)).projectors.at(0).model);
   std::printf(
       "[ figures  ] then the projector bumped 0.5 deg, seen by both cameras: its pose "
       "corrected, the rig against the true projector %.3f px\n",
