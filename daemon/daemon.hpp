@@ -260,9 +260,13 @@ class Daemon {
   void setupDriftCheck();
   void checkDrift();
   void onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, CalibrationFailure> r);
-  // Why no check or correction may run now (empty: they may).
-  std::string driftPaused() const;
-  void correctDrift(const std::string& output, const drift::Misregistration& m);
+  // Whether a check may start now.
+  bool driftMayRun() const;
+  void correctDrift(const std::string& output, const std::string& camera,
+                    const drift::Misregistration& m);
+  // The output left alone until a check finds it registered: `step` could not be made.
+  void unresolveDrift(const std::string& output, const std::string& camera, const char* step,
+                      const std::string& why, const drift::Misregistration& m);
   void correctCamera(const std::string& output, const std::string& camera,
                      const drift::Misregistration& m);
   // Merges a correction into rig.json; `event` (a drift event's body) goes out with

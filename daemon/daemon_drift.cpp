@@ -92,20 +92,18 @@ std::vector<const rig::RigCamera*> Daemon::driftCameras(const rig::RigProjector&
   return out;
 }
 
-std::string Daemon::driftPaused() const {
+bool Daemon::driftMayRun() const {
   const KeystoneRuntime& k = keystone_rt_;
-  if (config_.recalibrate != RecalibratePolicy::kOnDrift) return "off";
-  if (calibrating() || !calibration_.op.empty()) return "an operation holds the devices";
-  if (k.yaw.measuring) return "the camera yaw's dot grid is shown";
-  // A frame in flight: what the output shows is about to change.
-  if (k.rendering || k.render_again) return "a frame is being drawn";
-  return {};
+  // Not while an operation holds the devices, the camera yaw's dot grid is shown or a
+  // frame is in flight (what the output shows is about to change).
+  return config_.recalibrate == RecalibratePolicy::kOnDrift && !calibrating() &&
+         calibration_.op.empty() && !k.yaw.measuring && !k.rendering && !k.render_again;
 }
 
 void Daemon::checkDrift() {
   DriftRuntime& d = drift_rt_;
   KeystoneRuntime& k = keystone_rt_;
-  if (d.checking || d.writing || !driftPaused().empty()) return;
+  if (d.checking || d.writing || !driftMayRun()) return;
   // The outputs in turn, one check at a time: the worker also draws the frames.
   std::vector<DeviceEntry*> outputs;
   for (auto& e : devices_.entries()) {
@@ -268,15 +266,66 @@ void Daemon::onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, Calibr
     }
     (ov->second.last->rms_px <= threshold ? other_registered : other_drifted) = true;
   }
+  if (!other_registered && o.cameras.size() > 1 && !other_drifted) return;  // not looked since
+  const char* step = other_registered ? "camera-pose" : "projector-pose";
+  if (o.passes >= kMaxPasses) {
+    // Corrections that do not converge are not kept: the devices as they were before
+    // them (the last state a check confirmed) go back into rig.json.
+    unresolveDrift(key.output, key.camera, step,
+                   "corrections from the content did not bring the misregistration under " +
+                       std::to_string(threshold) + " px in " + std::to_string(kMaxPasses) +
+                       " passes (the surface may have moved); calibrate again",
+                   m);
+    if (o.before) {
+      d.writing = true;
+      writeRig(*o.before, {}, [this](const Result<std::string>& written) {
+        drift_rt_.writing = false;
+        if (!written) {
+          warn("drift: the rig model before the corrections: " + written.error().message);
+        } else {
+          refreshOutputs();
+        }
+      });
+      o.before.reset();
+    }
+    o.passes = 0;
+    return;
+  }
   if (other_registered) return correctCamera(key.output, key.camera, m);
-  if (o.cameras.size() > 1 && !other_drifted) return;  // the others have not looked since
-  correctDrift(key.output, m);
+  correctDrift(key.output, key.camera, m);
+}
+
+void Daemon::unresolveDrift(const std::string& output, const std::string& camera, const char* step,
+                            const std::string& why, const drift::Misregistration& m) {
+  DriftRuntime::Output& o = drift_rt_.outputs[output];
+  o.unresolved = true;
+  o.last_correction = {{"step", step}, {"camera", camera}, {"ok", false}, {"why", why}};
+  warn("drift: output '" + output + "' (camera '" + camera + "'): " + why);
+  broadcast("drift", {{"output", output},
+                      {"camera", camera},
+                      {"state", "unresolved"},
+                      {"step", step},
+                      {"why", why},
+                      {"check", misregistrationJson(m)}});
 }
 
 namespace {
 
 // `camera` (world -> camera) rigidly mounted on a projector that moved from `from` to `to`
 // (world -> projector): the camera-from-projector pose stays.
+// Keeps `projector` (or, given, `camera`) as it was before the first of the corrections
+// since the output was last registered: restored when they do not converge.
+void keepBefore(DriftRuntime::Output& o, const rig::RigProjector& projector,
+                const rig::RigCamera* camera) {
+  if (!o.before) o.before.emplace();
+  rig::RigModel& b = *o.before;
+  if (camera) {
+    if (!b.camera(camera->name)) b.cameras.push_back(*camera);
+  } else if (!b.projector(projector.name)) {
+    b.projectors.push_back(projector);
+  }
+}
+
 geom::Pose carried(const geom::Pose& camera, const geom::Pose& from, const geom::Pose& to) {
   const geom::Pose rel = camera.relativeTo(from);
   return {rel.R * to.R, rel.R * to.t + rel.t};
@@ -284,67 +333,31 @@ geom::Pose carried(const geom::Pose& camera, const geom::Pose& from, const geom:
 
 }  // namespace
 
-void Daemon::correctDrift(const std::string& output, const drift::Misregistration& m) {
-  DriftRuntime& d = drift_rt_;
-  DriftRuntime::Output& o = d.outputs[output];
+void Daemon::correctDrift(const std::string& output, const std::string& camera,
+                          const drift::Misregistration& m) {
+  DriftRuntime::Output& o = drift_rt_.outputs[output];
   const rig::RigProjector* p = rig_.projectorForOutput(output);
   if (!p) return;
   const double held = heldFor(o);
   const auto giveUp = [&](const std::string& why) {
-    o.unresolved = true;
-    o.last_correction = {{"step", "projector-pose"}, {"ok", false}, {"why", why}};
-    broadcast("drift", {{"output", output},
-                        {"state", "unresolved"},
-                        {"why", why},
-                        {"check", misregistrationJson(m)}});
+    unresolveDrift(output, camera, "projector-pose", why + "; the rig model stays as it was", m);
   };
-  if (o.passes >= kMaxPasses) {
-    // Corrections that do not converge are not kept: the projector as it was before them
-    // (the last one a check confirmed) goes back into rig.json.
-    const std::string why =
-        "the projector's pose from the content did not bring the misregistration under " +
-        std::to_string(config_.drift.threshold_px) + " px in " + std::to_string(kMaxPasses) +
-        " corrections (the surface or the camera may have moved); calibrate again";
-    warn("drift: output '" + output + "': " + why + "; the rig model before them is restored");
-    giveUp(why);
-    if (o.before) {
-      d.writing = true;
-      writeRig(*o.before, {}, [this, output](const Result<std::string>& written) {
-        drift_rt_.writing = false;
-        if (!written)
-          warn("drift: the rig model before the corrections: " + written.error().message);
-        if (written) refreshOutputs();
-      });
-      o.before.reset();
-    }
-    o.passes = 0;
-    return;
-  }
   auto tile = blend::displayTile(*p, rig_.surface);
-  if (!tile) {
-    warn("drift: output '" + output + "': " + tile.error().message);
-    return giveUp(tile.error().message);
-  }
+  if (!tile) return giveUp(tile.error().message);
   auto c = drift::correctProjector(*p, tile->projector_to_plane, m);
-  if (!c) {
-    const std::string why = "the projector's pose from the content: " + c.error().message;
-    warn("drift: output '" + output + "': " + why + "; the rig model stays as it was");
-    return giveUp(why);
-  }
+  if (!c) return giveUp("the projector's pose from the content: " + c.error().message);
   rig::RigModel update;
   update.projectors.push_back(c->projector);
   update.projectors.back().calibrated = {
       "drift correction: pose from content (" + std::to_string(c->tiles) + " tiles)", utcNow()};
-  rig::RigModel before;
-  before.projectors.push_back(*p);
+  keepBefore(o, *p, nullptr);
   // Cameras mounted on the projector moved with it.
   for (const rig::RigCamera& cam : rig_.cameras) {
     if (cam.attached_to != p->name || !cam.pose_known || !p->pose_known) continue;
-    before.cameras.push_back(cam);
+    keepBefore(o, *p, &cam);
     update.cameras.push_back(cam);
     update.cameras.back().model.pose = carried(cam.model.pose, p->pose, c->projector.pose);
   }
-  if (!o.before) o.before = std::move(before);
   const json why = {{"misregistration_px", m.rms_px},
                     {"held_s", held},
                     {"threshold_px", config_.drift.threshold_px}};
@@ -372,20 +385,8 @@ void Daemon::correctCamera(const std::string& output, const std::string& camera,
   if (!p || !cam || !v.reference) return;
   const double held = heldFor(o);
   const auto giveUp = [&](const std::string& why) {
-    o.unresolved = true;
-    o.last_correction = {{"step", "camera-pose"}, {"camera", camera}, {"ok", false}, {"why", why}};
-    warn("drift: camera '" + camera + "': " + why + "; the rig model stays as it was");
-    broadcast("drift", {{"output", output},
-                        {"camera", camera},
-                        {"state", "unresolved"},
-                        {"why", why},
-                        {"check", misregistrationJson(m)}});
+    unresolveDrift(output, camera, "camera-pose", why + "; the rig model stays as it was", m);
   };
-  if (o.passes >= kMaxPasses) {
-    return giveUp("re-registering the camera did not bring the misregistration under " +
-                  std::to_string(config_.drift.threshold_px) + " px in " +
-                  std::to_string(kMaxPasses) + " corrections; calibrate again");
-  }
   auto tile = blend::displayTile(*p, rig_.surface);
   if (!tile) return giveUp(tile.error().message);
   auto c =
@@ -395,10 +396,7 @@ void Daemon::correctCamera(const std::string& output, const std::string& camera,
   update.cameras.push_back(c->camera);
   update.cameras.back().calibrated = {
       "drift correction: pose from content (" + std::to_string(c->tiles) + " tiles)", utcNow()};
-  if (!o.before) {
-    o.before.emplace();
-    o.before->cameras.push_back(*cam);
-  }
+  keepBefore(o, *p, cam);
   const json why = {{"misregistration_px", m.rms_px},
                     {"held_s", held},
                     {"threshold_px", config_.drift.threshold_px},

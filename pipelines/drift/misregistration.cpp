@@ -136,7 +136,6 @@ Result<Misregistration> measureMisregistration(const cv::Mat& shown, const cv::M
   cv::Mat window;
   cv::createHanningWindow(window, cv::Size(T, T), CV_32F);
   Misregistration m;
-  m.global_shift = global * grid.factor;
   std::vector<TileShift> tiles;
   for (int y0 = 0; y0 + T <= size.height; y0 += T) {
     for (int x0 = 0; x0 + T <= size.width; x0 += T) {
@@ -167,8 +166,7 @@ Result<Misregistration> measureMisregistration(const cv::Mat& shown, const cv::M
       tiles.push_back(t);
     }
   }
-  m.too_plain = static_cast<int>(tiles.size()) < options.min_tiles ||
-                m.tiles_textured < options.min_textured_share * m.tiles_seen;
+  m.too_plain = m.tiles_textured < options.min_textured_share * m.tiles_seen;
   if (tiles.size() >= 4) {
     std::vector<cv::Point2f> from, to;
     for (const TileShift& t : tiles) {
@@ -202,22 +200,15 @@ Result<Misregistration> measureMisregistration(const cv::Mat& shown, const cv::M
   } else {
     m.drawn_to_seen = field->H / field->H(2, 2);
     m.tile_rms_px = field->rms;
-    std::vector<double> lengths;
     double sum_sq = 0;
     for (const Vec2& p : drawn) {
       const Vec3 q = m.drawn_to_seen * Vec3(p.x(), p.y(), 1.0);
-      const Vec2 shift = q.head<2>() / q.z() - p;
-      const double len = shift.norm();
-      lengths.push_back(len);
+      const double len = (q.head<2>() / q.z() - p).norm();
       sum_sq += len * len;
       m.max_px = std::max(m.max_px, len);
-      m.mean_shift += shift;
     }
-    const double n = static_cast<double>(lengths.size());
+    const double n = static_cast<double>(drawn.size());
     m.rms_px = std::sqrt(sum_sq / n);
-    m.mean_shift /= n;
-    std::nth_element(lengths.begin(), lengths.begin() + lengths.size() / 2, lengths.end());
-    m.median_px = lengths[lengths.size() / 2];
     m.confidence = (n / std::max(1, m.tiles_textured)) * (response / n);
   }
   m.tiles = std::move(tiles);

@@ -53,10 +53,7 @@ struct Misregistration {
   Mat3 drawn_to_seen = Mat3::Identity();
   double rms_px = 0;
   double max_px = 0;
-  double median_px = 0;
   double tile_rms_px = 0;  // the tiles' scatter about it (the measurement's noise)
-  Vec2 mean_shift = Vec2::Zero();
-  Vec2 global_shift = Vec2::Zero();  // the whole view's, before the tiles (framebuffer px)
   // used / textured tiles times their mean peak: 0 (nothing) .. 1 (every tile sharp).
   double confidence = 0;
   std::vector<TileShift> tiles;  // every registered tile, inliers marked

@@ -4,6 +4,8 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 
+#include "calibration/opencv_camera.hpp"
+
 namespace procam::drift {
 
 Result<PoseRefit> refitPose(const geom::CameraModel& before, const std::vector<Vec3>& world,
@@ -21,9 +23,7 @@ Result<PoseRefit> refitPose(const geom::CameraModel& before, const std::vector<V
     object.emplace_back(world[i].x(), world[i].y(), world[i].z());
     image.emplace_back(pixels[i].x(), pixels[i].y());
   }
-  const geom::Distortion& d = before.dist;
-  cv::Mat K, dist = (cv::Mat_<double>(1, 5) << d.k1, d.k2, d.p1, d.p2, d.k3);
-  cv::eigen2cv(Mat3(before.K.matrix()), K);
+  const cv::Mat K = calib::detail::cameraMatrix(before), dist = calib::detail::distCoeffs(before);
   cv::Mat R, rvec, tvec;
   cv::eigen2cv(Mat3(before.pose.R), R);
   cv::Rodrigues(R, rvec);
@@ -31,10 +31,8 @@ Result<PoseRefit> refitPose(const geom::CameraModel& before, const std::vector<V
   if (!cv::solvePnP(object, image, K, dist, rvec, tvec, true, cv::SOLVEPNP_ITERATIVE)) {
     return fail(ErrorCode::kNoConvergence, "pose refit: the solver did not converge");
   }
-  cv::Rodrigues(rvec, R);
   PoseRefit out;
-  cv::cv2eigen(R, out.pose.R);
-  cv::cv2eigen(tvec, out.pose.t);
+  out.pose = calib::detail::poseFromRvec(rvec, tvec);
   std::vector<cv::Point2d> back;
   cv::projectPoints(object, rvec, tvec, K, dist, back);
   double sq = 0;
