@@ -14,6 +14,7 @@
 #include "daemon.hpp"
 #include "json_matrix.hpp"
 #include "log.hpp"
+#include "render/post_render_warp.hpp"
 
 namespace procam::daemon {
 
@@ -23,6 +24,7 @@ namespace {
 
 struct CurvedInput {
   std::string output;
+  geom::CameraModel model;  // the rig's: its lens gives the post-rendering warp without pixels
   Mat34 projector;
   cv::Size size;
   std::shared_ptr<const void> surface;  // holds `intersector`
@@ -40,6 +42,8 @@ std::string curvedKey(cv::Size content, const Vec3& eye, const std::vector<Curve
     key << ' ' << in.output << ' ' << in.size.width << 'x' << in.size.height << ' '
         << in.surface.get();
     for (int i = 0; i < 12; ++i) key << ' ' << in.projector(i / 4, i % 4);
+    const geom::Distortion& d = in.model.dist;
+    key << " lens " << d.k1 << ' ' << d.k2 << ' ' << d.p1 << ' ' << d.p2 << ' ' << d.k3;
     key << in.response.key;
   }
   return key.str();
@@ -58,8 +62,9 @@ const KeystoneRuntime::Curved* Daemon::curvedDisplay(cv::Size content, const Vie
     if (!mode || mode->width != p->width || mode->height != p->height) continue;
     auto surface = rigSurfaceFor(p->name);
     if (!surface) continue;
-    inputs.push_back({e.name, p->model().projectionMatrix(), *mode, surface, &surface->intersector,
-                      rigResponse(*p)});
+    const geom::CameraModel model = p->model();
+    inputs.push_back({e.name, model, model.projectionMatrix(), *mode, surface,
+                      &surface->intersector, rigResponse(*p)});
   }
   if (inputs.size() < 2 || content.width < 1 || content.height < 1) {
     k.curved.reset();
@@ -80,14 +85,26 @@ const KeystoneRuntime::Curved* Daemon::curvedDisplay(cv::Size content, const Vie
         auto made = std::make_shared<KeystoneRuntime::Curved>();
         std::vector<blend::SurfaceProjector> projectors;
         std::vector<std::optional<blend::ProjectorResponse>> responses;
+        std::string error;
         for (const auto& in : inputs) {
-          projectors.push_back({in.intersector, in.projector, in.size});
+          // The pinhole draws what the projector's pixels lit through the post-rendering
+          // warp ([Raskar02] §4.1.3): measured from the mesh's pixels, or its lens.
+          auto warp = render::projectorPostRenderWarp(in.intersector->mesh(), in.model);
+          if (!warp) {
+            error = in.output + "'s post-rendering warp: " + warp.error().message;
+            break;
+          }
+          std::shared_ptr<const render::WarpGrid> grid;
+          if (*warp) grid = std::shared_ptr<const render::WarpGrid>(*warp, &(*warp)->grid);
+          projectors.push_back({in.intersector, in.projector, in.size, grid});
           responses.push_back(in.response.response);
           made->outputs.push_back(in.output);
           made->surfaces.push_back(in.surface);
+          made->post_warps.push_back(*warp);
         }
-        std::string error;
-        auto blended = blend::makeCurvedBlend(projectors, responses, eye.position, content);
+        Result<blend::CurvedBlend> blended = fail(ErrorCode::kInvalidInput, error);
+        if (error.empty())
+          blended = blend::makeCurvedBlend(projectors, responses, eye.position, content);
         if (blended) {
           static_cast<blend::CurvedBlend&>(*made) = std::move(*blended);
           made->weights.clear();  // the outputs take the 8-bit mask
@@ -137,9 +154,11 @@ json Daemon::curvedDisplayJson() const {
   const auto& d = k.curved->display;
   json tiles = json::array();
   for (std::size_t t = 0; t < k.curved->outputs.size(); ++t) {
-    tiles.push_back({{"output", k.curved->outputs[t]},
-                     {"response_gamma", k.curved->gamma[t]},
-                     {"gain", k.curved->gain[t]}});
+    json tile = {{"output", k.curved->outputs[t]},
+                 {"response_gamma", k.curved->gamma[t]},
+                 {"gain", k.curved->gain[t]}};
+    if (const auto& w = k.curved->post_warps[t]) tile["post_warp"] = blend::postWarpJson(*w);
+    tiles.push_back(std::move(tile));
   }
   json eye = k.curved->eye_source;
   eye["position"] = {d.eye.x(), d.eye.y(), d.eye.z()};

@@ -23,6 +23,7 @@
 #include "keystone_latency.hpp"
 #include "output_frames.hpp"
 #include "render/cpu_renderer.hpp"
+#include "render/post_render_warp.hpp"
 
 namespace procam::daemon {
 
@@ -155,6 +156,8 @@ struct KeystoneRuntime {
   // from are held while it is in use.
   struct Curved : blend::CurvedBlend, DisplayShares {
     std::vector<std::shared_ptr<const void>> surfaces;
+    // Per output, its post-rendering warp ([Raskar02] §4.1.3); null: none needed.
+    std::vector<std::shared_ptr<const render::PostRenderWarp>> post_warps;
     nlohmann::json eye_source;  // where the eye came from (config, rig)
   };
   std::shared_ptr<const Curved> curved;

@@ -151,6 +151,8 @@ Result<std::shared_ptr<const render::RenderSetup>> Daemon::nonPlanarSetup(
       setup.projector = P;
       setup.viewer =
           render::contentViewMatrix(curved->display.rotation, *eye, curved->display.rect, content);
+      // What the pinhole drew, moved to the pixels that lit it ([Raskar02] §4.1.3).
+      if (const auto& warp = curved->post_warps[index]) setup.post_warp = warp->grid;
     } else {
       setup.path = render::RenderPath::kLookupWarp;
       setup.lookup = curved->display.lookup[index];

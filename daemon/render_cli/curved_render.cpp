@@ -68,9 +68,20 @@ Result<json> renderCurved(const CurvedRenderInput& in) {
                 "names none)");
   std::vector<blend::SurfaceProjector> projectors;
   std::vector<std::optional<blend::ProjectorResponse>> responses;
+  std::vector<std::shared_ptr<const render::PostRenderWarp>> warps;
   for (std::size_t t = 0; t < chosen.size(); ++t) {
-    projectors.push_back({&surfaces[t], chosen[t]->model().projectionMatrix(),
-                          cv::Size(chosen[t]->width, chosen[t]->height)});
+    // The pinhole's image moved to the pixels that lit the surface ([Raskar02] §4.1.3).
+    const geom::CameraModel model = chosen[t]->model();
+    auto warp = render::projectorPostRenderWarp(surfaces[t].mesh(), model);
+    if (!warp) {
+      return fail(warp.error().code,
+                  chosen[t]->name + "'s post-rendering warp: " + warp.error().message);
+    }
+    std::shared_ptr<const render::WarpGrid> grid;
+    if (*warp) grid = std::shared_ptr<const render::WarpGrid>(*warp, &(*warp)->grid);
+    warps.push_back(*warp);
+    projectors.push_back({&surfaces[t], model.projectionMatrix(),
+                          cv::Size(chosen[t]->width, chosen[t]->height), grid});
     responses.push_back(blend::projectorResponse(*chosen[t]));
   }
   auto made = blend::makeCurvedBlend(projectors, responses, *eye, in.content.size());
@@ -95,6 +106,7 @@ Result<json> renderCurved(const CurvedRenderInput& in) {
                       {"path", "lookup-warp"},
                       {"response_gamma", made->gamma[t]},
                       {"gain", made->gain[t]}});
+    if (warps[t]) shares.back()["post_warp"] = blend::postWarpJson(*warps[t]);
   }
   if (!in.mpcdi.empty()) {
     std::vector<std::string> names;

@@ -30,6 +30,10 @@ Result<geom::TriangleMesh> checked(geom::TriangleMesh mesh, const std::string& o
   for (const auto& v : mesh.vertices) {
     if (!v.allFinite()) return fail(ErrorCode::kParse, origin + ": non-finite vertex");
   }
+  if (mesh.uv.size() != mesh.vertices.size()) mesh.uv.clear();  // not every vertex has one
+  for (const auto& t : mesh.uv) {
+    if (!t.allFinite()) return fail(ErrorCode::kParse, origin + ": non-finite vertex u v");
+  }
   return mesh;
 }
 
@@ -268,8 +272,15 @@ Result<geom::TriangleMesh> parsePly(std::string_view bytes, const std::string& o
   geom::TriangleMesh mesh;
   PlyReader reader(bytes.substr(body_start + 1), binary);
   for (const auto& e : elements) {
+    // A vertex's u v (a measured surface's projector pixel) is kept when both are given.
+    const auto has = [&e](const char* name) {
+      return std::any_of(e.props.begin(), e.props.end(),
+                         [name](const PlyProperty& p) { return !p.is_list && p.name == name; });
+    };
+    const bool with_uv = e.name == "vertex" && has("u") && has("v");
     for (std::size_t i = 0; i < e.count; ++i) {
       Vec3 v = Vec3::Zero();
+      Vec2 uv = Vec2::Zero();
       for (const auto& p : e.props) {
         if (p.is_list) {
           double count = 0;
@@ -299,12 +310,14 @@ Result<geom::TriangleMesh> parsePly(std::string_view bytes, const std::string& o
             return fail(ErrorCode::kParse, origin + ": truncated " + e.name + " data");
           if (e.name == "vertex" && p.name.size() == 1 && p.name[0] >= 'x' && p.name[0] <= 'z')
             v[p.name[0] - 'x'] = value;
+          if (with_uv && (p.name == "u" || p.name == "v")) uv[p.name == "u" ? 0 : 1] = value;
         }
       }
       if (e.name == "vertex") {
         if (mesh.vertices.size() >= limits.vertices)
           return tooLarge(origin, "vertices", limits.vertices);
         mesh.vertices.push_back(v);
+        if (with_uv) mesh.uv.push_back(uv);
       }
     }
   }

@@ -105,6 +105,7 @@ Result<Renderer> Renderer::create(const Scene& scene, SceneState state, const Fr
     lamp.projector = i;
     lamp.P = p.model.projectionMatrix();
     lamp.center = p.model.pose.center();
+    lamp.distorted = !p.model.dist.isZero();
     if (const auto it = shown.find(p.spec.name); it != shown.end()) {
       auto image = ProjectorImage::create(it->second, p.spec);
       if (!image) return tl::unexpected(image.error());
@@ -123,11 +124,17 @@ PixelTruth::Light Renderer::light(const Lamp& lamp, const Vec3& point, const Vec
   const Vec3 h = lamp.P * point.homogeneous();
   if (!(h.z() > 0)) return out;
   out.in_front = true;
-  out.pixel = h.head<2>() / h.z();
+  const geom::CameraModel& m = state_.projectors[lamp.projector].model;
+  if (lamp.distorted) {
+    const auto pixel = m.project(point);
+    if (!pixel) return out;
+    out.pixel = *pixel;
+  } else {
+    out.pixel = h.head<2>() / h.z();
+  }
   const Vec3 to_lamp = lamp.center - point;
   out.distance = to_lamp.norm();
   out.cos_incidence = normal.dot(to_lamp) / out.distance;
-  const geom::CameraModel& m = state_.projectors[lamp.projector].model;
   const bool in_frame = out.pixel.x() >= -0.5 && out.pixel.x() < m.width - 0.5 &&
                         out.pixel.y() >= -0.5 && out.pixel.y() < m.height - 0.5;
   if (!in_frame || out.cos_incidence <= 0) return out;

@@ -89,6 +89,7 @@ class Renderer {
     std::optional<ProjectorImage> image;
     Mat34 P;  // K [R | t]
     Vec3 center;
+    bool distorted = false;  // the lens bends the rays: project through the full model
   };
 
   Renderer(const Scene& scene, SceneState state) : scene_(&scene), state_(std::move(state)) {}

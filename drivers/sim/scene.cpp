@@ -85,6 +85,7 @@ SceneState Scene::at(double time) const {
   for (const auto& spec : projectors_) {
     geom::CameraModel m;
     m.K = spec.K;
+    m.dist = spec.dist;
     m.pose = withEvents(placementPose(spec.placement, time), SceneEvent::Target::kProjector,
                         spec.name, time);
     m.width = spec.width;

@@ -32,6 +32,7 @@ struct ProjectorSpec {
   std::string name;
   int width = 0, height = 0;
   geom::Intrinsics K;
+  geom::Distortion dist;  // the lens: where a framebuffer pixel's light leaves
   Placement placement;
   double gamma = 2.2;          // framebuffer value v in [0,1] emits v^gamma
   double blur_sigma_px = 0.0;  // Gaussian pixel footprint, framebuffer pixels
@@ -109,7 +110,7 @@ struct SceneEvent {
 // True state of every device at one time.
 struct ProjectorState {
   ProjectorSpec spec;
-  geom::CameraModel model;  // K, pose, resolution (no distortion)
+  geom::CameraModel model;  // K, distortion, pose, resolution
 };
 struct CameraState {
   CameraSpec spec;

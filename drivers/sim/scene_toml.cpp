@@ -72,6 +72,20 @@ geom::Intrinsics readIntrinsics(const Fields& f, int width, int height) {
   return K;
 }
 
+// OpenCV's radial-tangential model; all zero when the table is absent.
+geom::Distortion readDistortion(const Fields& f) {
+  geom::Distortion dist;
+  if (!f.has("distortion")) return dist;
+  const Fields d = f.table("distortion");
+  dist.k1 = d.numberIn("k1", 0, -10, 10);
+  dist.k2 = d.numberIn("k2", 0, -10, 10);
+  dist.p1 = d.numberIn("p1", 0, -1, 1);
+  dist.p2 = d.numberIn("p2", 0, -1, 1);
+  dist.k3 = d.numberIn("k3", 0, -10, 10);
+  d.finish();
+  return dist;
+}
+
 class Reader {
  public:
   Reader(const std::filesystem::path& base_dir) : base_dir_(base_dir) {}
@@ -145,6 +159,7 @@ class Reader {
     s.width = res[0];
     s.height = res[1];
     s.K = readIntrinsics(f.table("intrinsics"), s.width, s.height);
+    s.dist = readDistortion(f);
     s.placement = placement(f, false);
     s.gamma = f.numberIn("gamma", 2.2, 0.1, 10);
     s.blur_sigma_px = f.numberIn("blur_sigma_px", 0, 0, 50);
@@ -160,15 +175,7 @@ class Reader {
     s.width = res[0];
     s.height = res[1];
     s.K = readIntrinsics(f.table("intrinsics"), s.width, s.height);
-    if (f.has("distortion")) {
-      const Fields d = f.table("distortion");
-      s.dist.k1 = d.numberIn("k1", 0, -10, 10);
-      s.dist.k2 = d.numberIn("k2", 0, -10, 10);
-      s.dist.p1 = d.numberIn("p1", 0, -1, 1);
-      s.dist.p2 = d.numberIn("p2", 0, -1, 1);
-      s.dist.k3 = d.numberIn("k3", 0, -10, 10);
-      d.finish();
-    }
+    s.dist = readDistortion(f);
     s.placement = placement(f, true);
     s.exposure = f.numberIn("exposure", 1, 0, 1e9, true);
     s.gain = f.numberIn("gain", 1, 0, 1e6, true);

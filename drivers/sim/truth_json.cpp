@@ -25,6 +25,10 @@ json vecJson(const Vec3& v) {
   return json::array({v.x(), v.y(), v.z()});
 }
 
+json distortionJson(const geom::Distortion& d) {
+  return {{"k1", d.k1}, {"k2", d.k2}, {"p1", d.p1}, {"p2", d.p2}, {"k3", d.k3}};
+}
+
 json modelJson(const std::string& name, const geom::CameraModel& m) {
   json j;
   j["name"] = name;
@@ -94,6 +98,7 @@ json truthJson(const Scene& scene, const SceneState& state) {
   out["projectors"] = json::array();
   for (const auto& p : state.projectors) {
     json j = modelJson(p.spec.name, p.model);
+    j["distortion"] = distortionJson(p.model.dist);
     j["placement"] = placementJson(p.spec.placement);
     j["gamma"] = p.spec.gamma;
     j["blur_sigma_px"] = p.spec.blur_sigma_px;
@@ -103,8 +108,7 @@ json truthJson(const Scene& scene, const SceneState& state) {
   out["cameras"] = json::array();
   for (const auto& c : state.cameras) {
     json j = modelJson(c.spec.name, c.model);
-    const auto& d = c.model.dist;
-    j["distortion"] = {{"k1", d.k1}, {"k2", d.k2}, {"p1", d.p1}, {"p2", d.p2}, {"k3", d.k3}};
+    j["distortion"] = distortionJson(c.model.dist);
     j["placement"] = placementJson(c.spec.placement);
     j["bit_depth"] = c.spec.bit_depth;
     j["channels"] = c.spec.channels;

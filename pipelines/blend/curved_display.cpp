@@ -96,7 +96,16 @@ Result<CurvedDisplay> solveCurvedDisplay(std::span<const SurfaceProjector> proje
       const auto hit = projectors[m].surface->intersect(ray);
       if (!hit) continue;
       const Vec3 u = projectors[m].projector * hit->point.homogeneous();
-      if (u.z() > 0 && render::gridSource(d.lookup[m], u.hnormalized())) return true;
+      if (!(u.z() > 0)) continue;
+      // The framebuffer pixel whose post-rendering warp lands on the pinhole's pixel.
+      const Vec2 pinhole = u.hnormalized();
+      Vec2 pixel = pinhole;
+      for (int it = 0; it < 3 && projectors[m].post_warp; ++it) {
+        const auto to = render::gridSource(*projectors[m].post_warp, pixel);
+        if (!to) break;
+        pixel -= *to - pinhole;
+      }
+      if (render::gridSource(d.lookup[m], pixel)) return true;
     }
     return false;
   };
@@ -107,7 +116,8 @@ Result<CurvedDisplay> solveCurvedDisplay(std::span<const SurfaceProjector> proje
     out.lookup.clear();
     for (std::size_t m = 0; m < projectors.size(); ++m) {
       auto grid = render::lookupGridForViewer(*projectors[m].surface, projectors[m].projector,
-                                              projectors[m].size, out.viewer, options.lookup_step);
+                                              projectors[m].size, out.viewer, options.lookup_step,
+                                              projectors[m].post_warp);
       if (!grid) return tl::unexpected(grid.error());
       out.lookup.push_back(std::move(*grid));
     }
@@ -153,6 +163,14 @@ Result<CurvedBlend> makeCurvedBlend(std::span<const SurfaceProjector> projectors
   static_cast<BlendTables&>(out) = std::move(*tables);
   out.display = std::move(*display);
   return out;
+}
+
+nlohmann::json postWarpJson(const render::PostRenderWarp& warp) {
+  const bool measured = warp.source == render::PostRenderWarp::Source::kMeasured;
+  nlohmann::json j = {
+      {"source", measured ? "measured" : "lens"}, {"rms_px", warp.rms_px}, {"max_px", warp.max_px}};
+  if (measured) j["points"] = warp.points;
+  return j;
 }
 
 }  // namespace procam::blend

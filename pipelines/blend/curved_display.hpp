@@ -8,6 +8,7 @@
 // pixels to that content (render/viewer_view.hpp) and its eq. 4.3 weights
 // (curved_feather.hpp), and the blend tables apply them in linear light
 // (blend_tables.hpp). The daemon and procam-render draw from the same result.
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <span>
 #include <vector>
@@ -16,6 +17,7 @@
 #include "blend/curved_feather.hpp"
 #include "core/error.hpp"
 #include "keystone/inscribed_rect.hpp"
+#include "render/post_render_warp.hpp"
 #include "render/warp_map.hpp"
 
 namespace procam::blend {
@@ -55,5 +57,10 @@ Result<CurvedBlend> makeCurvedBlend(std::span<const SurfaceProjector> projectors
                                     std::span<const std::optional<ProjectorResponse>> responses,
                                     const Vec3& eye, cv::Size content,
                                     const CurvedDisplayOptions& options = {});
+
+// A projector's post-rendering warp for status and display.json: {"source": "measured"
+// or "lens", "rms_px", "max_px" (how far it moves the pinhole's pixels), "points" (the
+// measured vertices)}.
+nlohmann::json postWarpJson(const render::PostRenderWarp& warp);
 
 }  // namespace procam::blend

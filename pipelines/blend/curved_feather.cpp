@@ -129,7 +129,7 @@ Result<std::vector<render::PixelRays>> surfaceProjectorRays(
     if (!p.surface) return fail(ErrorCode::kInvalidInput, name + " has no surface");
     if (p.size.width < 2 || p.size.height < 2 || p.size.width > 16384 || p.size.height > 16384)
       return fail(ErrorCode::kInvalidInput, name + ": bad framebuffer size");
-    auto r = render::pixelRays(p.projector);
+    auto r = render::pixelRays(p.projector, p.post_warp);
     if (!r) return fail(ErrorCode::kInvalidInput, name + ": " + r.error().message);
     rays.push_back(*r);
   }

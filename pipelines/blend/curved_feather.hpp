@@ -25,6 +25,9 @@ struct SurfaceProjector {
   const geom::MeshIntersector* surface = nullptr;  // the surface it lights (its measured mesh)
   Mat34 projector = Mat34::Zero();                 // world -> pixels, third row positive in front
   cv::Size size;                                   // framebuffer
+  // Framebuffer pixel -> pixel of `projector`'s pinhole image ([Raskar02] §4.1.3); null:
+  // the matrix is the projector.
+  std::shared_ptr<const render::WarpGrid> post_warp;
 };
 
 struct CurvedFeatherOptions {

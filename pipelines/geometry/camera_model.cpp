@@ -1,6 +1,7 @@
 #include "geometry/camera_model.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace procam::geom {
@@ -66,6 +67,25 @@ Vec2 Distortion::apply(const Vec2& p) const {
   const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
   return {x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x),
           y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y};
+}
+
+bool Distortion::radialMonotonicUpTo(double r2) const {
+  // d/dr [r (1 + k1 r^2 + k2 r^4 + k3 r^6)] as a cubic in s = r^2; positive at s = 0. It
+  // stays positive on [0, r2] when it is at r2 and at its turning points inside.
+  const auto slope = [this](double s) { return 1 + s * (3 * k1 + s * (5 * k2 + s * 7 * k3)); };
+  if (!(slope(r2) > 0)) return false;
+  // Turning points: 21 k3 s^2 + 10 k2 s + 3 k1 = 0.
+  const double a = 21 * k3, b = 10 * k2, c = 3 * k1;
+  std::array<double, 2> roots = {-1, -1};
+  if (a == 0) {
+    if (b != 0) roots[0] = -c / b;
+  } else if (const double disc = b * b - 4 * a * c; disc >= 0) {
+    roots = {(-b - std::sqrt(disc)) / (2 * a), (-b + std::sqrt(disc)) / (2 * a)};
+  }
+  for (const double s : roots) {
+    if (s > 0 && s < r2 && !(slope(s) > 0)) return false;
+  }
+  return true;
 }
 
 Result<Vec2> Distortion::remove(const Vec2& distorted) const {
@@ -177,6 +197,9 @@ std::optional<Vec2> CameraModel::project(const Vec3& world) const {
   const Vec3 d = pose.toDevice(world);
   if (!d.allFinite() || !(d.z() > 0)) return std::nullopt;
   const Vec2 n(d.x() / d.z(), d.y() / d.z());
+  // Past the lens model's fold the polynomial turns back and would put a point far off
+  // the axis into the frame: no pixel images it.
+  if (!dist.isZero() && !dist.radialMonotonicUpTo(n.squaredNorm())) return std::nullopt;
   const Vec2 p = normalizedToPixel(K, dist.isZero() ? n : dist.apply(n));
   if (!finite(p)) return std::nullopt;
   return p;

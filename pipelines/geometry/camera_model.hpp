@@ -22,6 +22,9 @@ struct Distortion {
 
   bool isZero() const { return k1 == 0 && k2 == 0 && p1 == 0 && p2 == 0 && k3 == 0; }
   Vec2 apply(const Vec2& normalized) const;
+  // Whether the radial part r (1 + k1 r^2 + k2 r^4 + k3 r^6) still grows with r over
+  // [0, sqrt(r2)]: beyond its first turning point (the fold) the model images nothing.
+  bool radialMonotonicUpTo(double r2) const;
   // Inverse of apply() on the branch through the centre (Newton with continuation);
   // kNoConvergence for points beyond the model's fold (no physical preimage),
   // kInvalidInput for NaN/Inf.

@@ -212,11 +212,15 @@ std::optional<Hit> intersectTriangle(const Ray& ray, const Vec3& a, const Vec3& 
   if (!(std::abs(det) > 1e-12 * n_len * ray.dir.norm())) return std::nullopt;
   const double inv = 1.0 / det;
   const Vec3 s = ray.origin - a;
+  // Edges belong to both triangles that share them, within rounding: a ray along a mesh's
+  // inner edge (a post-rendering warp sends node rays exactly along the images of the
+  // mesh's edges) would otherwise miss both.
+  constexpr double kEdge = 1e-13;
   const double u = s.dot(p) * inv;
-  if (!(u >= 0 && u <= 1)) return std::nullopt;
+  if (!(u >= -kEdge && u <= 1 + kEdge)) return std::nullopt;
   const Vec3 q = s.cross(e1);
   const double v = ray.dir.dot(q) * inv;
-  if (!(v >= 0 && u + v <= 1)) return std::nullopt;
+  if (!(v >= -kEdge && u + v <= 1 + kEdge)) return std::nullopt;
   const double t = e2.dot(q) * inv;
   if (!inRange(t, range)) return std::nullopt;
   return makeHit(ray, t, n, 0);

@@ -74,6 +74,9 @@ std::optional<Hit> intersectTriangle(const Ray& ray, const Vec3& a, const Vec3& 
 struct TriangleMesh {
   std::vector<Vec3> vertices;
   std::vector<Eigen::Vector3i> faces;  // indices into vertices
+  // Per vertex, when the file gives them (PLY u v): a measured display surface's
+  // projector pixel that lit the vertex. Empty otherwise.
+  std::vector<Vec2> uv;
 };
 
 // Mesh intersector: brute force for small meshes, a BVH (SAH-binned) above

@@ -9,13 +9,13 @@
 namespace procam::render {
 namespace {}  // namespace
 
-Result<PixelRays> pixelRays(const Mat34& P) {
+Result<PixelRays> pixelRays(const Mat34& P, std::shared_ptr<const WarpGrid> post_warp) {
   const Mat3 M = P.leftCols<3>();
   if (!P.allFinite() || std::abs(M.determinant()) < 1e-300) {
     return fail(ErrorCode::kInvalidInput, "viewer view: singular projector matrix");
   }
   const Mat3 Minv = M.inverse();
-  return PixelRays{Minv, -Minv * P.col(3)};
+  return PixelRays{Minv, -Minv * P.col(3), std::move(post_warp)};
 }
 
 Result<Mat3> uprightEyeRotation(const Vec3& forward) {
@@ -141,19 +141,14 @@ Result<Mat34> viewerContentMatrix(const geom::MeshIntersector& surface, const Ma
 }
 
 Result<WarpGrid> lookupGridForViewer(const geom::MeshIntersector& surface, const Mat34& projector,
-                                     cv::Size size, const Mat34& viewer, int step) {
+                                     cv::Size size, const Mat34& viewer, int step,
+                                     std::shared_ptr<const WarpGrid> post_warp) {
   if (size.width < 2 || size.height < 2 || step < 1 || !viewer.allFinite()) {
     return fail(ErrorCode::kInvalidInput, "lookup grid: bad size, step or viewer");
   }
-  auto rays = pixelRays(projector);
+  auto rays = pixelRays(projector, std::move(post_warp));
   if (!rays) return tl::unexpected(rays.error());
-  WarpGrid g;
-  g.cols = (size.width - 1 + step - 1) / step + 1;
-  g.rows = (size.height - 1 + step - 1) / step + 1;
-  g.origin = Vec2(0, 0);
-  // Nodes span pixel centre 0 to the last pixel centre exactly.
-  g.step = Vec2(double(size.width - 1) / (g.cols - 1), double(size.height - 1) / (g.rows - 1));
-  g.source.assign(static_cast<size_t>(g.cols) * g.rows, Vec2(kOutside, kOutside));
+  WarpGrid g = framebufferGrid(size, step);
   cv::parallel_for_(cv::Range(0, g.rows), [&](const cv::Range& range) {
     for (int j = range.start; j < range.end; ++j) {
       for (int i = 0; i < g.cols; ++i) {

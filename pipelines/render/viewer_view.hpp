@@ -7,6 +7,7 @@
 // the content pixel where the eye's ray through that pixel's surface point crosses the
 // plane: the two-pass path draws exactly that (§3.2.3), the lookup warp samples it on a
 // grid (§4.1.5).
+#include <memory>
 #include <opencv2/core.hpp>
 
 #include "core/error.hpp"
@@ -21,13 +22,21 @@ namespace procam::render {
 struct PixelRays {
   Mat3 Minv;  // inverse of the matrix's left 3x3
   Vec3 centre;
+  // Framebuffer pixel -> pixel of the matrix's pinhole image ([Raskar02] §4.1.3,
+  // render/post_render_warp.hpp); null: the matrix is the projector.
+  std::shared_ptr<const WarpGrid> post_warp;
   geom::Ray through(double x, double y) const {
-    return {centre, (Minv * Vec3(x, y, 1)).normalized()};
+    Vec2 m(x, y);
+    if (post_warp) {
+      if (auto s = gridSource(*post_warp, m)) m = *s;
+    }
+    return {centre, (Minv * m.homogeneous()).normalized()};
   }
 };
 
 // kInvalidInput for a non-finite or singular projector matrix.
-Result<PixelRays> pixelRays(const Mat34& projector);
+Result<PixelRays> pixelRays(const Mat34& projector,
+                            std::shared_ptr<const WarpGrid> post_warp = nullptr);
 
 // The eye's frame looking along `forward`: rows x right, y down, z forward, world +Z
 // up. kDegenerate when `forward` is (nearly) vertical.
@@ -49,7 +58,9 @@ Result<Mat34> viewerContentMatrix(const geom::MeshIntersector& surface, const Ma
 // The lookup warp for that viewer: nodes every `step` projector pixels (the last row and
 // column on the frame's edge) holding the content pixel each shows; nodes whose ray misses
 // the surface or lands behind the eye hold kOutside.
+// `post_warp`: the projector's post-rendering warp, as pixelRays takes it.
 Result<WarpGrid> lookupGridForViewer(const geom::MeshIntersector& surface, const Mat34& projector,
-                                     cv::Size projector_size, const Mat34& viewer, int step = 8);
+                                     cv::Size projector_size, const Mat34& viewer, int step = 8,
+                                     std::shared_ptr<const WarpGrid> post_warp = nullptr);
 
 }  // namespace procam::render

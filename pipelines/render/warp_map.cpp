@@ -30,6 +30,16 @@ WarpMap identityMap(cv::Size size) {
   return map;
 }
 
+WarpGrid framebufferGrid(cv::Size size, int step) {
+  WarpGrid g;
+  g.cols = (size.width - 1 + step - 1) / step + 1;
+  g.rows = (size.height - 1 + step - 1) / step + 1;
+  g.origin = Vec2(0, 0);
+  g.step = Vec2(double(size.width - 1) / (g.cols - 1), double(size.height - 1) / (g.rows - 1));
+  g.source.assign(static_cast<size_t>(g.cols) * g.rows, Vec2(kOutside, kOutside));
+  return g;
+}
+
 Result<WarpMap> homographyMap(const Mat3& H, cv::Size output_size) {
   if (!finite(H) || output_size.width <= 0 || output_size.height <= 0) {
     return fail(ErrorCode::kInvalidInput, "homographyMap: non-finite H or empty output size");

@@ -33,6 +33,11 @@ struct WarpGrid {
   const Vec2& at(int i, int j) const { return source[static_cast<size_t>(j) * cols + i]; }
 };
 
+// A grid over a framebuffer with nodes about `step` pixels apart, the first on pixel
+// centre 0 and the last on the last pixel centre of each axis, every source kOutside.
+// Needs size >= 2 x 2 and step >= 1.
+WarpGrid framebufferGrid(cv::Size size, int step);
+
 // Map of an output image related to the source by dst ~ H * src ([Raskar02] §4.2.1 eq. 4.6).
 // kInvalidInput for non-finite H or empty size, kDegenerate when H is singular.
 Result<WarpMap> homographyMap(const Mat3& H, cv::Size output_size);

@@ -18,6 +18,7 @@
 #include "blend/curved_display.hpp"
 #include "blend/rig_tiles.hpp"
 #include "content/mesh_content.hpp"
+#include "render/post_render_warp.hpp"
 #include "render/render_setup.hpp"
 #include "render/viewer_view.hpp"
 #include "render/warp_map.hpp"
@@ -67,9 +68,10 @@ inline std::optional<Vec2> showing(const render::WarpGrid& g, const Vec2& c) {
 
 struct Calibrated {
   rig::RigModel rig;
-  std::vector<geom::MeshIntersector> surfaces;  // per output, in the order asked
-  std::vector<render::SurfaceMesh> meshes;      // the same, as the two-pass path draws them
-  std::vector<blend::SurfaceProjector> projectors;
+  std::vector<geom::MeshIntersector> surfaces;      // per output, in the order asked
+  std::vector<render::SurfaceMesh> meshes;          // the same, as the two-pass path draws them
+  std::vector<blend::SurfaceProjector> projectors;  // with their post-rendering warps
+  std::vector<std::shared_ptr<const render::PostRenderWarp>> warps;
   std::vector<std::optional<blend::ProjectorResponse>> responses;
 };
 
@@ -99,8 +101,13 @@ inline void readCalibrated(const std::string& state_dir, const std::vector<std::
   }
   for (std::size_t t = 0; t < outputs.size(); ++t) {
     const rig::RigProjector* p = out.rig.projectorForOutput(outputs[t]);
+    auto warp = render::projectorPostRenderWarp(out.surfaces[t].mesh(), p->model());
+    ASSERT_TRUE(warp) << warp.error().message;
+    out.warps.push_back(*warp);
+    std::shared_ptr<const render::WarpGrid> grid;
+    if (*warp) grid = std::shared_ptr<const render::WarpGrid>(*warp, &(*warp)->grid);
     out.projectors.push_back(
-        {&out.surfaces[t], p->model().projectionMatrix(), cv::Size(p->width, p->height)});
+        {&out.surfaces[t], p->model().projectionMatrix(), cv::Size(p->width, p->height), grid});
     out.responses.push_back(blend::projectorResponse(*p));
   }
 }
@@ -112,9 +119,9 @@ struct TrueRig {
 
   // The TRUE surface point TRUE projector m's pixel u lights.
   std::optional<Vec3> lit(std::size_t m, const Vec2& u) const {
-    auto rays = render::pixelRays(projectors[m].projectionMatrix());
-    if (!rays) return std::nullopt;
-    auto hit = scene->world().intersect(rays->through(u.x(), u.y()));
+    auto ray = projectors[m].backproject(u);  // through the lens
+    if (!ray) return std::nullopt;
+    auto hit = scene->world().intersect(*ray);
     return hit ? std::optional<Vec3>(hit->hit.point) : std::nullopt;
   }
   bool inFrame(std::size_t m, const Vec2& u, double margin) const {

@@ -1,10 +1,11 @@
 // One display across projectors on a curved wall for a viewer a head tracker follows:
-// cylinder3 with its sweet-spot viewer walking 0.6 m side to side and a tracker on the
-// head, the TRUE rig handed over explicitly (poses, the wall as a mesh, each projector's
-// true response and brightness: this checks drawing, not calibration, which
-// SimCurvedWall checks). The display is made for the sweet spot ([content] viewer) and
-// every output draws it for the tracked eye through the two-pass path ([Raskar02]
-// §3.2.3, §4.1.2). Judged with the TRUE projectors and wall for the eye the outputs drew
+// cylinder3 (its projectors with lenses) with its sweet-spot viewer walking 0.6 m side
+// to side and a tracker on the head, the TRUE rig handed over explicitly (poses, lenses,
+// the wall as a mesh, each projector's true response and brightness: this checks
+// drawing, not calibration, which SimCurvedWall checks). The display is made for the
+// sweet spot ([content] viewer) and every output draws it for the tracked eye through
+// the two-pass path ([Raskar02] §3.2.3, §4.1.2) and its lens's post-rendering warp
+// (§4.1.3). Judged with the TRUE projectors and wall for the eye the outputs drew
 // for: all outputs share one display (seams), content lines stay straight, the daemon's
 // frame statistics match the frames rebuilt from the rig, and white seen by the viewer
 // standing there has no step above 2 %.
@@ -19,9 +20,9 @@
 #include "blend/brightness_map.hpp"
 #include "curved_display_checks.hpp"
 #include "cylinder_mesh.hpp"
+#include "cylinder_scene.hpp"
 #include "daemon_harness.hpp"
 #include "render/cpu_renderer.hpp"
-#include "sim/embedded_scenes.hpp"
 #include "sim/renderer.hpp"
 #include "sim/truth_rig.hpp"
 #include "true_brightness.hpp"
@@ -33,14 +34,10 @@ const std::vector<std::string> kOutputs = {"proj_l", "proj_c", "proj_r"};
 constexpr int kW = 2400, kH = 450;  // a panorama
 const Vec3 kSweetSpot(0.0, -0.6, 1.6);
 
-// cylinder3 with its viewer walking x = -0.3 ... 0.3 m in 4 s and back, and a head
+// cylinder3 with lenses, its viewer walking x = -0.3 ... 0.3 m in 4 s and back, and a head
 // tracker (1 mm noise, 60 Hz) reporting it.
 std::string walkingCylinder() {
-  std::string text;
-  for (std::size_t i = 0; i < sim::detail::kEmbeddedSceneCount; ++i) {
-    if (sim::detail::kEmbeddedScenes[i].name == "cylinder3")
-      text = std::string(sim::detail::kEmbeddedScenes[i].text);
-  }
+  const std::string text = withProjectorLenses(cylinder3Text());
   const auto viewer = text.find("[viewer]");
   EXPECT_NE(viewer, std::string::npos);
   if (viewer == std::string::npos) return "";
@@ -151,7 +148,13 @@ TEST(SimCurvedTracked, EveryOutputDrawsTheSweetSpotDisplayForTheTrackedEye) {
   std::vector<std::optional<blend::ProjectorResponse>> responses;
   for (std::size_t t = 0; t < 3; ++t) {
     const rig::RigProjector* p = rig->projectorForOutput(kOutputs[t]);
-    projectors.push_back({&*wall, p->model().projectionMatrix(), cv::Size(p->width, p->height)});
+    // The rig's lenses: each output draws the pinhole through its lens's warp.
+    auto warp = render::projectorPostRenderWarp(wall->mesh(), p->model());
+    ASSERT_TRUE(warp && *warp) << kOutputs[t];
+    EXPECT_EQ((*warp)->source, render::PostRenderWarp::Source::kLens);
+    EXPECT_EQ(display["tiles"][t]["post_warp"], blend::postWarpJson(**warp)) << display.dump();
+    projectors.push_back({&*wall, p->model().projectionMatrix(), cv::Size(p->width, p->height),
+                          std::shared_ptr<const render::WarpGrid>(*warp, &(*warp)->grid)});
     responses.push_back(blend::projectorResponse(*p));
   }
   auto blend = blend::makeCurvedBlend(projectors, responses, kSweetSpot, {kW, kH});
@@ -177,7 +180,8 @@ TEST(SimCurvedTracked, EveryOutputDrawsTheSweetSpotDisplayForTheTrackedEye) {
   const Mat34& V0 = V[kOutputs[0]];
   std::vector<render::WarpGrid> lookup;
   for (std::size_t m = 0; m < 3; ++m) {
-    auto g = render::lookupGridForViewer(*wall, projectors[m].projector, projectors[m].size, V0, 8);
+    auto g = render::lookupGridForViewer(*wall, projectors[m].projector, projectors[m].size, V0, 8,
+                                         projectors[m].post_warp);
     ASSERT_TRUE(g) << g.error().message;
     lookup.push_back(std::move(*g));
   }
@@ -195,6 +199,17 @@ TEST(SimCurvedTracked, EveryOutputDrawsTheSweetSpotDisplayForTheTrackedEye) {
       seams.pairs, seams.rms, seams.worst);
   EXPECT_LE(seams.rms, 0.3);
   EXPECT_LE(seams.worst, 1.0);
+  // The same pinholes drawn without their lenses' warps: the seams open by the lenses.
+  std::vector<render::WarpGrid> pinhole;
+  for (std::size_t m = 0; m < 3; ++m) {
+    auto g = render::lookupGridForViewer(*wall, projectors[m].projector, projectors[m].size, V0);
+    ASSERT_TRUE(g) << g.error().message;
+    pinhole.push_back(std::move(*g));
+  }
+  const SeamFigures open = seamsOnTheTrueSurface(pinhole, true_rig, {kW, kH});
+  std::printf("[ figures  ] without the lenses' warps: seams RMS %.3f px, max %.3f px\n", open.rms,
+              open.worst);
+  EXPECT_GT(open.worst, 1.0);
   const double bent = bentOnTheTrueSurface(lookup, true_rig, V0, {kW, kH});
   std::printf(
       "[ figures  ] content lines seen from the tracked eye: %.3f content px from "
@@ -213,6 +228,7 @@ TEST(SimCurvedTracked, EveryOutputDrawsTheSweetSpotDisplayForTheTrackedEye) {
     setup.surface = drawn;
     setup.projector = projectors[t].projector;
     setup.viewer = viewer;
+    setup.post_warp = *projectors[t].post_warp;
     setup.final_stage.alpha = blend->alpha[t];
     setup.final_stage.weight_lut = blend->weight_lut[t];
     render::CpuRenderer cpu;

@@ -1,10 +1,12 @@
 // Three projectors on a curved wall shown as one display for a viewer at the sweet
 // spot, end to end on the virtual rig over the socket only: cylinder3 (three 1280x800
-// projectors with unmatched responses inside a cylinder, two cameras) with nothing
+// projectors with unmatched responses, here with lenses, inside a cylinder, two
+// cameras) with nothing
 // handed over but the cameras' calibration (TruthParts::kCamerasOnly) and the viewer's
 // position in procamd.toml. calibrate (route a) triangulates each projector's pose and
 // its piece of the wall, content load makes one display of them ([Raskar02] §4.1.5)
-// feathered in the overlaps (eq. 4.3), and the daemon's lookup warps and weights,
+// feathered in the overlaps (eq. 4.3) and drawn through each projector's
+// post-rendering warp (§4.1.3), and the daemon's lookup warps and weights,
 // rebuilt from the rig.json it wrote and the viewer matrix it reports, are judged with
 // the TRUE projectors and wall.
 #include <gtest/gtest.h>
@@ -21,6 +23,7 @@
 #include "blend/rig_tiles.hpp"
 #include "content/mesh_content.hpp"
 #include "curved_display_checks.hpp"
+#include "cylinder_scene.hpp"
 #include "daemon_harness.hpp"
 #include "render/cpu_renderer.hpp"
 #include "render/viewer_view.hpp"
@@ -42,7 +45,10 @@ Mat34 rowMajor34(const json& j) {
 }
 
 TEST(SimCurvedWall, ThreeProjectorsCalibratedIntoOneDisplayForTheSweetSpot) {
-  auto scene = sim::resolveScene("cylinder3");
+  TempDir dir;
+  dir.write("cylinder3_lenses.toml", withProjectorLenses(cylinder3Text()));
+  const std::string scene_file = dir.file("cylinder3_lenses.toml");
+  auto scene = sim::resolveScene(scene_file);
   ASSERT_TRUE(scene) << scene.error().message;
   const sim::SceneState state = scene->at(0);
   std::map<std::string, geom::CameraModel> truth;
@@ -52,13 +58,12 @@ TEST(SimCurvedWall, ThreeProjectorsCalibratedIntoOneDisplayForTheSweetSpot) {
     spec[p.spec.name] = p.spec;
   }
   const Vec3 eye = state.viewer.pose.center();
-  TempDir dir;
-  dir.write("procamd.toml", "[sim]\nscene = \"cylinder3\"\n[content]\nviewer = [" +
+  dir.write("procamd.toml", "[sim]\nscene = \"" + scene_file + "\"\n[content]\nviewer = [" +
                                 std::to_string(eye.x()) + ", " + std::to_string(eye.y()) + ", " +
                                 std::to_string(eye.z()) + "]\n");
   DaemonProcess d(dir,
                   DaemonProcess::Launch{{"--config", dir.file("procamd.toml"), "--rig",
-                                         truthRigFile(dir, "cylinder3", TruthParts::kCamerasOnly)},
+                                         truthRigFile(dir, scene_file, TruthParts::kCamerasOnly)},
                                         {},
                                         -1,
                                         true});
@@ -100,11 +105,12 @@ TEST(SimCurvedWall, ThreeProjectorsCalibratedIntoOneDisplayForTheSweetSpot) {
   // triangulations of the same wall differ by their noise; after, by far less.
   const json& unified = (*done)["unified"];
   ASSERT_TRUE(unified.is_object()) << done->dump();
-  std::printf("[ figures  ] meshes unified: %d of %d vertices shared, %.3f mm apart RMS (max "
-              "%.3f) before, %.3f mm (max %.3f) after\n",
-              unified["shared"].get<int>(), unified["vertices"].get<int>(),
-              unified["gap_rms_mm"].get<double>(), unified["gap_max_mm"].get<double>(),
-              unified["gap_after_rms_mm"].get<double>(), unified["gap_after_max_mm"].get<double>());
+  std::printf(
+      "[ figures  ] meshes unified: %d of %d vertices shared, %.3f mm apart RMS (max "
+      "%.3f) before, %.3f mm (max %.3f) after\n",
+      unified["shared"].get<int>(), unified["vertices"].get<int>(),
+      unified["gap_rms_mm"].get<double>(), unified["gap_max_mm"].get<double>(),
+      unified["gap_after_rms_mm"].get<double>(), unified["gap_after_max_mm"].get<double>());
   EXPECT_EQ(unified["meshes"], 3);
   EXPECT_GT(unified["shared"].get<int>(), 100);
   EXPECT_LT(unified["gap_after_rms_mm"].get<double>(), 0.5 * unified["gap_rms_mm"].get<double>());
@@ -174,6 +180,29 @@ TEST(SimCurvedWall, ThreeProjectorsCalibratedIntoOneDisplayForTheSweetSpot) {
               seams.pairs, seams.rms, seams.worst);
   EXPECT_LE(seams.rms, 0.3);
   EXPECT_LE(seams.worst, 1.0);
+  // Each projector's post-rendering warp ([Raskar02] §4.1.3), measured from its mesh's
+  // pixels: the lens the pinhole left out. Without it the seams open by the lenses'
+  // difference.
+  for (std::size_t t = 0; t < 3; ++t) {
+    ASSERT_TRUE(cal.warps[t]) << kOutputs[t];
+    EXPECT_EQ(cal.warps[t]->source, render::PostRenderWarp::Source::kMeasured);
+    const json& reported = display["tiles"][t]["post_warp"];
+    std::printf(
+        "[ figures  ] %s: post-rendering warp from %d vertices, moves the pinhole's "
+        "pixels %.3f px RMS, %.3f px at most (daemon: %s)\n",
+        kOutputs[t], cal.warps[t]->points, cal.warps[t]->rms_px, cal.warps[t]->max_px,
+        reported.dump().c_str());
+    EXPECT_EQ(reported["source"], "measured") << kOutputs[t];
+    EXPECT_NEAR(reported["rms_px"].get<double>(), cal.warps[t]->rms_px, 1e-9) << kOutputs[t];
+  }
+  std::vector<blend::SurfaceProjector> pinholes = cal.projectors;
+  for (auto& p : pinholes) p.post_warp.reset();
+  auto pinhole_only = blend::makeCurvedBlend(pinholes, cal.responses, eye, {kW, kH});
+  ASSERT_TRUE(pinhole_only) << pinhole_only.error().message;
+  const SeamFigures open = seamsOnTheTrueSurface(pinhole_only->display.lookup, true_rig, {kW, kH});
+  std::printf("[ figures  ] the pinholes alone, no warp: seams RMS %.3f px, max %.3f px\n",
+              open.rms, open.worst);
+  EXPECT_LT(seams.rms, open.rms);
 
   // Straight lines of the content stay straight for the viewer: within 0.5 content px.
   const double bent = bentOnTheTrueSurface(lookup, true_rig, V, {kW, kH});

@@ -47,7 +47,7 @@ void trueRig(Rig& rig) {
   const sim::SceneState s = scene->at(0);
   for (const auto& p : s.projectors) {
     rig.projectors.push_back(
-        {&rig.wall, p.model.projectionMatrix(), cv::Size(p.model.width, p.model.height)});
+        {&rig.wall, p.model.projectionMatrix(), cv::Size(p.model.width, p.model.height), nullptr});
   }
   rig.eye = s.viewer.pose.center();
 }

@@ -80,6 +80,32 @@ TEST(Distortion, RemoveReportsPointsWithoutPreimage) {
   EXPECT_EQ(nan.error().code, ErrorCode::kInvalidInput);
 }
 
+TEST(Distortion, FoldIsWhereTheRadialPolynomialStopsGrowing) {
+  // r (1 + k1 r^2): its slope 1 + 3 k1 r^2 reaches 0 at r^2 = 1 / (3 |k1|).
+  Distortion barrel;
+  barrel.k1 = -0.015;
+  EXPECT_TRUE(barrel.radialMonotonicUpTo(22.0));
+  EXPECT_FALSE(barrel.radialMonotonicUpTo(22.5));
+  // A k2 that turns the slope up again before it reaches 0: no fold anywhere.
+  Distortion held = barrel;
+  held.k2 = 0.004;
+  EXPECT_TRUE(held.radialMonotonicUpTo(1e6));
+  // A slope that dips below 0 inside the range and recovers past it: folded.
+  Distortion dip;
+  dip.k1 = -0.6;
+  dip.k2 = 0.13;
+  EXPECT_FALSE(dip.radialMonotonicUpTo(1e4));
+  EXPECT_TRUE(dip.radialMonotonicUpTo(0.5));
+  // The camera model images nothing past it, where apply() would fold a point off the
+  // axis back into the frame.
+  CameraModel cam = testing::makeCamera({0, 0, 0}, {0, 1, 0});
+  cam.dist = barrel;
+  const Vec3 axis = cam.pose.R.transpose().col(2), right = cam.pose.R.transpose().col(0);
+  EXPECT_TRUE(cam.project(cam.pose.center() + axis + 4.6 * right).has_value());
+  EXPECT_FALSE(cam.project(cam.pose.center() + axis + 4.8 * right).has_value());
+  EXPECT_FALSE(cam.project(cam.pose.center() + axis + 9.0 * right).has_value());
+}
+
 TEST(Pose, InverseComposesToIdentity) {
   const Pose p = Pose::lookAt({1, -4, 2}, {0.3, 0.2, 0.5}, Vec3::UnitZ());
   const Pose q = p.inverse();

@@ -324,6 +324,24 @@ TEST(MeshIntersector, TessellatedSphereAgreesWithAnalyticSphere) {
   EXPECT_LT(R - h_min, 0.01);  // the bound itself is tight enough to mean something
 }
 
+TEST(MeshIntersector, RaysAlongAnInnerEdgeHitOneOfItsTriangles) {
+  // Two triangles of a curved wall sharing the diagonal a-c, seen from a projector: rays
+  // aimed at points of the diagonal must not slip between them by rounding.
+  TriangleMesh quad;
+  quad.vertices = {Vec3(-0.71, 2.31, 1.07), Vec3(-0.63, 2.35, 1.09), Vec3(-0.62, 2.36, 1.17),
+                   Vec3(-0.70, 2.32, 1.15)};
+  quad.faces = {Eigen::Vector3i(0, 1, 2), Eigen::Vector3i(0, 2, 3)};
+  auto mesh = MeshIntersector::build(quad);
+  ASSERT_TRUE(mesh);
+  const Vec3 origin(-0.31, -0.25, 1.29);
+  int missed = 0;
+  for (int i = 1; i < 10000; ++i) {
+    const Vec3 on_edge = quad.vertices[0] + (i / 10000.0) * (quad.vertices[2] - quad.vertices[0]);
+    if (!mesh->intersect(Ray{origin, (on_edge - origin).normalized()})) ++missed;
+  }
+  EXPECT_EQ(missed, 0);
+}
+
 TEST(MeshIntersector, FlatGridWithAxisAlignedAndGrazingRays) {
   // Zero-thickness BVH nodes (all z = 0) with rays whose direction has zero components.
   const TriangleMesh grid = test::flatGrid(60, 6.0);  // 7200 triangles

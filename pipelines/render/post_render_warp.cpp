@@ -1,0 +1,168 @@
+#include "render/post_render_warp.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <vector>
+
+namespace procam::render {
+namespace {
+
+bool goodGrid(cv::Size size, int step) {
+  return size.width >= 2 && size.height >= 2 && size.width <= 16384 && size.height <= 16384 &&
+         step >= 1;
+}
+
+// Nodes without a value take their nearest valued neighbour's (breadth first over the
+// lattice): the warp stays smooth past the measured region's edge. False when no node has
+// a value.
+bool fillFromNearest(WarpGrid& g, std::vector<Vec2>& shift) {
+  std::vector<char> known(shift.size(), 0);
+  std::deque<std::size_t> queue;
+  for (std::size_t k = 0; k < shift.size(); ++k) {
+    if (shift[k].allFinite()) {
+      known[k] = 1;
+      queue.push_back(k);
+    }
+  }
+  if (queue.empty()) return false;
+  while (!queue.empty()) {
+    const std::size_t k = queue.front();
+    queue.pop_front();
+    const int i = static_cast<int>(k % g.cols), j = static_cast<int>(k / g.cols);
+    const int di[] = {1, -1, 0, 0}, dj[] = {0, 0, 1, -1};
+    for (int n = 0; n < 4; ++n) {
+      const int a = i + di[n], b = j + dj[n];
+      if (a < 0 || b < 0 || a >= g.cols || b >= g.rows) continue;
+      const std::size_t q = static_cast<std::size_t>(b) * g.cols + a;
+      if (known[q]) continue;
+      known[q] = 1;
+      shift[q] = shift[k];
+      queue.push_back(q);
+    }
+  }
+  for (int j = 0; j < g.rows; ++j) {
+    for (int i = 0; i < g.cols; ++i) {
+      const std::size_t k = static_cast<std::size_t>(j) * g.cols + i;
+      g.source[k] = g.node(i, j) + shift[k];
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+Result<PostRenderWarp> measuredPostRenderWarp(const geom::TriangleMesh& mesh, const Mat34& P,
+                                              cv::Size size, int step) {
+  if (!goodGrid(size, step) || !P.allFinite()) {
+    return fail(ErrorCode::kInvalidInput, "post-rendering warp: bad size, step or matrix");
+  }
+  if (mesh.uv.size() != mesh.vertices.size() || mesh.vertices.empty()) {
+    return fail(ErrorCode::kInvalidInput,
+                "post-rendering warp: the mesh has no projector pixel for its vertices");
+  }
+  // m'' - m per vertex (NaN behind the projector).
+  const Vec2 none = Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
+  std::vector<Vec2> moved(mesh.vertices.size(), none);
+  PostRenderWarp out;
+  double sum = 0;
+  for (std::size_t k = 0; k < mesh.vertices.size(); ++k) {
+    const Vec3 h = P * mesh.vertices[k].homogeneous();
+    if (!(h.z() > 0) || !mesh.uv[k].allFinite()) continue;
+    moved[k] = h.hnormalized() - mesh.uv[k];
+    if (!moved[k].allFinite()) {
+      moved[k] = none;
+      continue;
+    }
+    const double d = moved[k].norm();
+    sum += d * d;
+    out.max_px = std::max(out.max_px, d);
+    ++out.points;
+  }
+  if (out.points > 0) out.rms_px = std::sqrt(sum / out.points);
+
+  // Every node inside a triangle (in projector space) takes the triangle's linear
+  // interpolation of its corners' shifts.
+  out.grid = framebufferGrid(size, step);
+  WarpGrid& g = out.grid;
+  std::vector<Vec2> shift(g.source.size(), none);
+  for (const auto& f : mesh.faces) {
+    const Vec2 &a = mesh.uv[f[0]], &b = mesh.uv[f[1]], &c = mesh.uv[f[2]];
+    const Vec2 &sa = moved[f[0]], &sb = moved[f[1]], &sc = moved[f[2]];
+    if (!sa.allFinite() || !sb.allFinite() || !sc.allFinite()) continue;
+    const double area = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+    if (!(std::abs(area) > 1e-9)) continue;
+    const double lo_x = std::min({a.x(), b.x(), c.x()}), hi_x = std::max({a.x(), b.x(), c.x()});
+    const double lo_y = std::min({a.y(), b.y(), c.y()}), hi_y = std::max({a.y(), b.y(), c.y()});
+    const int i0 = std::max(0, static_cast<int>(std::ceil(lo_x / g.step.x())));
+    const int i1 = std::min(g.cols - 1, static_cast<int>(std::floor(hi_x / g.step.x())));
+    const int j0 = std::max(0, static_cast<int>(std::ceil(lo_y / g.step.y())));
+    const int j1 = std::min(g.rows - 1, static_cast<int>(std::floor(hi_y / g.step.y())));
+    for (int j = j0; j <= j1; ++j) {
+      for (int i = i0; i <= i1; ++i) {
+        const Vec2 p = g.node(i, j);
+        const double wb = ((p - a).x() * (c - a).y() - (p - a).y() * (c - a).x()) / area;
+        const double wc = ((b - a).x() * (p - a).y() - (b - a).y() * (p - a).x()) / area;
+        const double wa = 1 - wb - wc;
+        constexpr double kEdge = -1e-9;
+        if (wa < kEdge || wb < kEdge || wc < kEdge) continue;
+        shift[static_cast<std::size_t>(j) * g.cols + i] = wa * sa + wb * sb + wc * sc;
+      }
+    }
+  }
+  if (!fillFromNearest(g, shift)) {
+    return fail(ErrorCode::kTooFewPoints,
+                "post-rendering warp: no triangle of the mesh lies in front of the projector");
+  }
+  return out;
+}
+
+Result<PostRenderWarp> lensPostRenderWarp(const geom::CameraModel& projector, int step) {
+  const cv::Size size(projector.width, projector.height);
+  if (!goodGrid(size, step)) {
+    return fail(ErrorCode::kInvalidInput, "post-rendering warp: bad size or step");
+  }
+  PostRenderWarp out;
+  out.source = PostRenderWarp::Source::kLens;
+  out.grid = framebufferGrid(size, step);
+  WarpGrid& g = out.grid;
+  const Vec2 none = Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
+  std::vector<Vec2> shift(g.source.size(), none);
+  double sum = 0;
+  int nodes = 0;
+  for (int j = 0; j < g.rows; ++j) {
+    for (int i = 0; i < g.cols; ++i) {
+      const Vec2 m = g.node(i, j);
+      const auto ideal = projector.undistortPixel(m);
+      if (!ideal || !ideal->allFinite()) continue;
+      const Vec2 d = *ideal - m;
+      shift[static_cast<std::size_t>(j) * g.cols + i] = d;
+      sum += d.squaredNorm();
+      out.max_px = std::max(out.max_px, d.norm());
+      ++nodes;
+    }
+  }
+  if (!fillFromNearest(g, shift)) {
+    return fail(ErrorCode::kInvalidInput, "post-rendering warp: the lens model inverts nowhere");
+  }
+  out.rms_px = std::sqrt(sum / nodes);
+  return out;
+}
+
+Result<std::shared_ptr<const PostRenderWarp>> projectorPostRenderWarp(
+    const geom::TriangleMesh& surface, const geom::CameraModel& projector, int step) {
+  const auto shared =
+      [](Result<PostRenderWarp> w) -> Result<std::shared_ptr<const PostRenderWarp>> {
+    if (!w) return tl::unexpected(w.error());
+    return std::make_shared<const PostRenderWarp>(std::move(*w));
+  };
+  if (!surface.uv.empty()) {
+    return shared(measuredPostRenderWarp(surface, projector.projectionMatrix(),
+                                         cv::Size(projector.width, projector.height), step));
+  }
+  if (!projector.dist.isZero()) return shared(lensPostRenderWarp(projector, step));
+  return std::shared_ptr<const PostRenderWarp>();
+}
+
+}  // namespace procam::render
