@@ -18,6 +18,7 @@
 #include "control_socket.hpp"
 #include "device_manager.hpp"
 #include "device_set.hpp"
+#include "drift/wall_from_views.hpp"
 #include "drift_runtime.hpp"
 #include "event_loop.hpp"
 #include "geometry/intersect.hpp"
@@ -269,6 +270,11 @@ class Daemon {
                       const std::string& why, const drift::Misregistration& m);
   void correctCamera(const std::string& output, const std::string& camera,
                      const drift::Misregistration& m);
+  // The wall as two cameras that see the output drift triangulate it, when it stands off
+  // the rig's plane; nullopt when it does not or cannot be told.
+  std::optional<drift::WallSeen> movedWall(const std::string& output, const std::string& camera);
+  void correctSurface(const std::string& output, const std::string& camera,
+                      const drift::Misregistration& m, const drift::WallSeen& wall);
   // Merges a correction into rig.json; `event` (a drift event's body) goes out with
   // `state` when written, "failed" otherwise.
   void writeDriftCorrection(const std::string& output, rig::RigModel update, nlohmann::json event,

@@ -4,8 +4,10 @@
 // corrected with the cheapest step, from the content's own correspondences and with no
 // pattern shown: a camera that sees drift where another camera sees the output
 // registered has moved and gets its pose again (drift/camera_correction.hpp); drift that
-// every camera sees is the projector's, whose pose and plane collineation are fitted
-// again (drift/projector_correction.hpp). Written to rig.json atomically; a failed step
+// two cameras see and triangulate off the rig's wall is the wall's, whose plane is
+// measured again (drift/wall_from_views.hpp); other drift that every camera sees is the
+// projector's, whose pose and plane collineation are fitted again
+// (drift/projector_correction.hpp). Written to rig.json atomically; a failed step
 // keeps the last good rig. Loop thread only; the checks run on the compute worker between
 // the outputs' frames.
 #include <cmath>
@@ -14,6 +16,7 @@
 #include "daemon.hpp"
 #include "drift/camera_correction.hpp"
 #include "drift/projector_correction.hpp"
+#include "drift/wall_from_views.hpp"
 #include "log.hpp"
 #include "protocol.hpp"
 #include "rig_store.hpp"
@@ -182,6 +185,30 @@ void Daemon::checkDrift() {
       });
 }
 
+namespace {
+
+// Keeps `projector` (or, given, `camera`) as it was before the first of the corrections
+// since the output was last registered: restored when they do not converge.
+void keepBefore(DriftRuntime::Output& o, const rig::RigProjector& projector,
+                const rig::RigCamera* camera) {
+  if (!o.before) o.before.emplace();
+  rig::RigModel& b = *o.before;
+  if (camera) {
+    if (!b.camera(camera->name)) b.cameras.push_back(*camera);
+  } else if (!b.projector(projector.name)) {
+    b.projectors.push_back(projector);
+  }
+}
+
+// `camera` (world -> camera) rigidly mounted on a projector that moved from `from` to `to`
+// (world -> projector): the camera-from-projector pose stays.
+geom::Pose carried(const geom::Pose& camera, const geom::Pose& from, const geom::Pose& to) {
+  const geom::Pose rel = camera.relativeTo(from);
+  return {rel.R * to.R, rel.R * to.t + rel.t};
+}
+
+}  // namespace
+
 void Daemon::onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, CalibrationFailure> r) {
   DriftRuntime& d = drift_rt_;
   d.checking = false;
@@ -292,7 +319,103 @@ void Daemon::onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, Calibr
     return;
   }
   if (other_registered) return correctCamera(key.output, key.camera, m);
+  if (other_drifted) {
+    // Two cameras that see drift tell a moved wall from a moved projector: where both
+    // found the same content, their rays meet on the wall as it stands now.
+    if (auto wall = movedWall(key.output, key.camera)) {
+      return correctSurface(key.output, key.camera, m, *wall);
+    }
+  }
   correctDrift(key.output, key.camera, m);
+}
+
+std::optional<drift::WallSeen> Daemon::movedWall(const std::string& output,
+                                                 const std::string& camera) {
+  DriftRuntime::Output& o = drift_rt_.outputs[output];
+  if (!rig_.surface.plane) return std::nullopt;
+  const auto viewOf = [&](const std::string& name) -> std::optional<drift::WallView> {
+    const rig::RigCamera* cam = rig_.camera(name);
+    auto v = o.views.find(name);
+    // Both checks against this rig model (their maps are its).
+    if (!cam || !cam->pose_known || v == o.views.end() || !v->second.last || !v->second.reference ||
+        v->second.reference->rig_generation != rig_generation_ || v->second.last->too_plain) {
+      return std::nullopt;
+    }
+    return drift::WallView{&cam->model, &*v->second.last, &v->second.reference->map,
+                           v->second.reference->grid};
+  };
+  const auto here = viewOf(camera);
+  if (!here) return std::nullopt;
+  for (const std::string& name : o.cameras) {
+    if (name == camera) continue;
+    const auto there = viewOf(name);
+    if (!there || there->drift->rms_px <= config_.drift.threshold_px) continue;
+    auto seen = drift::wallFromTwoViews(*here, *there, *rig_.surface.plane);
+    if (!seen) {
+      logInfo("drift: output '" + output + "': the wall from cameras '" + camera + "' and '" +
+              name + "': " + seen.error().message);
+      continue;
+    }
+    logInfo("drift: output '" + output + "': cameras '" + camera + "' and '" + name + "' see " +
+            std::to_string(seen->points) + " content points " +
+            std::to_string(1e3 * seen->offset_m) + " mm from the rig's wall (standard error " +
+            std::to_string(1e3 * seen->offset_se_m) + " mm), turned " +
+            std::to_string(seen->tilt_deg) +
+            " deg: " + (drift::wallMoved(*seen) ? "the wall moved" : "the wall stands"));
+    if (drift::wallMoved(*seen)) return *seen;
+    return std::nullopt;
+  }
+  return std::nullopt;
+}
+
+void Daemon::correctSurface(const std::string& output, const std::string& camera,
+                            const drift::Misregistration& m, const drift::WallSeen& wall) {
+  DriftRuntime::Output& o = drift_rt_.outputs[output];
+  const double held = heldFor(o);
+  const auto giveUp = [&](const std::string& why) {
+    unresolveDrift(output, camera, "surface", why + "; the rig model stays as it was", m);
+  };
+  // Every projector on the wall keeps its pose; those that kept a collineation with the
+  // old plane get theirs from the pose and the new plane.
+  rig::RigModel update;
+  update.surface.plane = wall.plane;
+  update.surface.plane_rms_m = wall.rms_m;
+  for (const rig::RigProjector& p : rig_.projectors) {
+    if (!p.plane_homography) continue;
+    if (!p.pose_known || !p.intrinsics_known || !p.scale_known) {
+      return giveUp("projector '" + p.name +
+                    "' is known only by its collineation with the old wall, which the moved "
+                    "wall does not carry");
+    }
+    update.projectors.push_back(p);
+    update.projectors.back().plane_homography.reset();
+  }
+  if (!o.before) o.before.emplace();
+  if (!o.before->surface.plane) {
+    o.before->surface.plane = rig_.surface.plane;
+    o.before->surface.plane_rms_m = rig_.surface.plane_rms_m;
+  }
+  for (const rig::RigProjector& p : update.projectors) {
+    if (const rig::RigProjector* was = rig_.projector(p.name)) keepBefore(o, *was, nullptr);
+  }
+  const json why = {{"misregistration_px", m.rms_px},
+                    {"held_s", held},
+                    {"threshold_px", config_.drift.threshold_px},
+                    {"wall_offset_mm", 1e3 * wall.offset_m},
+                    {"wall_offset_se_mm", 1e3 * wall.offset_se_m},
+                    {"wall_turned_deg", wall.tilt_deg}};
+  logInfo("drift: output '" + output + "': the wall moved " + std::to_string(1e3 * wall.offset_m) +
+          " mm (turned " + std::to_string(wall.tilt_deg) +
+          " deg); the rig's plane measured again "
+          "from " +
+          std::to_string(wall.points) + " content points two cameras see");
+  writeDriftCorrection(output, std::move(update),
+                       {{"output", output},
+                        {"step", "surface"},
+                        {"why", why},
+                        {"points", wall.points},
+                        {"plane_rms_mm", 1e3 * wall.rms_m}},
+                       "corrected-surface");
 }
 
 void Daemon::unresolveDrift(const std::string& output, const std::string& camera, const char* step,
@@ -308,30 +431,6 @@ void Daemon::unresolveDrift(const std::string& output, const std::string& camera
                       {"why", why},
                       {"check", misregistrationJson(m)}});
 }
-
-namespace {
-
-// `camera` (world -> camera) rigidly mounted on a projector that moved from `from` to `to`
-// (world -> projector): the camera-from-projector pose stays.
-// Keeps `projector` (or, given, `camera`) as it was before the first of the corrections
-// since the output was last registered: restored when they do not converge.
-void keepBefore(DriftRuntime::Output& o, const rig::RigProjector& projector,
-                const rig::RigCamera* camera) {
-  if (!o.before) o.before.emplace();
-  rig::RigModel& b = *o.before;
-  if (camera) {
-    if (!b.camera(camera->name)) b.cameras.push_back(*camera);
-  } else if (!b.projector(projector.name)) {
-    b.projectors.push_back(projector);
-  }
-}
-
-geom::Pose carried(const geom::Pose& camera, const geom::Pose& from, const geom::Pose& to) {
-  const geom::Pose rel = camera.relativeTo(from);
-  return {rel.R * to.R, rel.R * to.t + rel.t};
-}
-
-}  // namespace
 
 void Daemon::correctDrift(const std::string& output, const std::string& camera,
                           const drift::Misregistration& m) {

@@ -6,26 +6,6 @@
 #include "pose_refit.hpp"
 
 namespace procam::drift {
-namespace {
-
-// The map's camera pixel at a work-grid point (bilinear; nullopt off the camera's view).
-std::optional<Vec2> cameraPixelAt(const cv::Mat& map, const Vec2& w) {
-  const int x0 = static_cast<int>(std::floor(w.x())), y0 = static_cast<int>(std::floor(w.y()));
-  if (x0 < 0 || y0 < 0 || x0 + 1 >= map.cols || y0 + 1 >= map.rows) return std::nullopt;
-  const double fx = w.x() - x0, fy = w.y() - y0;
-  Vec2 sum = Vec2::Zero();
-  for (int dy = 0; dy < 2; ++dy) {
-    for (int dx = 0; dx < 2; ++dx) {
-      const cv::Vec2f c = map.at<cv::Vec2f>(y0 + dy, x0 + dx);
-      if (c[0] < 0) return std::nullopt;
-      sum += (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy) * Vec2(c[0], c[1]);
-    }
-  }
-  return sum;
-}
-
-}  // namespace
-
 Result<CameraCorrection> correctCamera(const rig::RigCamera& before,
                                        const geom::PlaneHomography& tile,
                                        const Misregistration& drift, const cv::Mat& map,
@@ -46,7 +26,7 @@ Result<CameraCorrection> correctCamera(const rig::RigCamera& before,
     const Vec3 ab = tile.H * Vec3(t.drawn.x(), t.drawn.y(), 1.0);
     if (!(std::abs(ab.z()) > 1e-12)) continue;
     const Vec3 X = tile.basis.toWorld({ab.x() / ab.z(), ab.y() / ab.z()});
-    auto px = cameraPixelAt(map, grid.toWork(t.seen_at));
+    auto px = mappedCameraPixel(map, grid.toWork(t.seen_at));
     if (!px) continue;
     world.push_back(X);
     pixels.push_back(*px);

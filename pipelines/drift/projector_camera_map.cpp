@@ -41,4 +41,19 @@ Result<cv::Mat> projectorCameraMap(const geom::PlaneHomography& projector_to_pla
   return map;
 }
 
+std::optional<Vec2> mappedCameraPixel(const cv::Mat& map, const Vec2& w) {
+  const int x0 = static_cast<int>(std::floor(w.x())), y0 = static_cast<int>(std::floor(w.y()));
+  if (x0 < 0 || y0 < 0 || x0 + 1 >= map.cols || y0 + 1 >= map.rows) return std::nullopt;
+  const double fx = w.x() - x0, fy = w.y() - y0;
+  Vec2 sum = Vec2::Zero();
+  for (int dy = 0; dy < 2; ++dy) {
+    for (int dx = 0; dx < 2; ++dx) {
+      const cv::Vec2f c = map.at<cv::Vec2f>(y0 + dy, x0 + dx);
+      if (c[0] < 0) return std::nullopt;
+      sum += (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy) * Vec2(c[0], c[1]);
+    }
+  }
+  return sum;
+}
+
 }  // namespace procam::drift

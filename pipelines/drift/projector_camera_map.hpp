@@ -3,6 +3,7 @@
 // projector's collineation with the display plane ([Raskar02] §4.2.1) and the camera's
 // calibration. The drift check compares what the camera sees there with the frame shown.
 #include <opencv2/core.hpp>
+#include <optional>
 
 #include "core/error.hpp"
 #include "geometry/camera_model.hpp"
@@ -31,5 +32,8 @@ struct WorkGrid {
 // for a factor outside 1..8, an empty framebuffer or a non-finite mapping.
 Result<cv::Mat> projectorCameraMap(const geom::PlaneHomography& projector_to_plane,
                                    const geom::CameraModel& camera, const WorkGrid& grid);
+
+// The map's camera pixel at a work-grid point (bilinear); nullopt off the camera's view.
+std::optional<Vec2> mappedCameraPixel(const cv::Mat& map, const Vec2& work);
 
 }  // namespace procam::drift

@@ -19,6 +19,7 @@
 #include "rig/rig_model.hpp"
 #include "sim/scene_library.hpp"
 #include "truth_rig_file.hpp"
+#include "unit/drift/second_camera.hpp"
 #include "unit/drift/textured_content.hpp"
 
 namespace procam::itest {
@@ -354,25 +355,6 @@ TEST(SimDrift, ACameraUnpluggedAfterDriftWasSeenLeavesTheRigUntilItIsBack) {
   EXPECT_LE(rig_px, 0.5);
 }
 
-// A second fixed camera looking at the projector's image from the other side.
-const char* kSecondCamera = R"([[cameras]]
-name = "cam2"
-resolution = [1280, 960]
-intrinsics = { fx = 1000.0, fy = 1000.0, cx = 639.1, cy = 481.0 }
-distortion = { k1 = -0.05, k2 = 0.01, p1 = 0.0, p2 = 0.0, k3 = 0.0 }
-pose = { position = [0.9, -0.6, 1.2], look_at = [-0.4, 3.0, 1.4] }
-exposure = 1.0
-gain = 1.0
-bit_depth = 8
-response_gamma = 1.0
-read_noise_dn = 0.8
-full_well_e = 12000.0
-channels = 1
-psf_sigma_px = 0.8
-supersamples = 4
-
-)";
-
 // The `drift` event of the correction `state` (none of `wrong`, none unresolved), then
 // whether a check found the output registered after it (within 25 s).
 std::optional<json> awaitCorrection(Connection& watcher, const std::string& state,
@@ -391,24 +373,39 @@ std::optional<json> awaitCorrection(Connection& watcher, const std::string& stat
   return corrected;
 }
 
+// procamd with recalibrate = "on-drift" on wall_oblique with a second camera and
+// `events`, a watcher on its events and textured content shown.
+struct TwoCameraRig {
+  TwoCameraRig(const TempDir& dir, const std::string& events)
+      : scene_file(sceneWithEvents(dir, std::string(drift::kSecondCamera) + events)),
+        scene(sim::resolveScene(scene_file)),
+        d(dir, driftDaemon(dir, "on-drift", scene_file)),
+        c(d.socketPath()),
+        watcher(d.socketPath()) {}
+  // Fatal failures of the set-up; call first.
+  void start(const TempDir& dir) {
+    ASSERT_TRUE(scene) << scene.error().message;
+    ASSERT_TRUE(d.started()) << d.log();
+    ASSERT_TRUE(watcher.call({{"cmd", "watch"}}));
+    ASSERT_NO_FATAL_FAILURE(showContent(c, texturedContent(dir)));
+  }
+  std::string scene_file;
+  Result<sim::Scene> scene;
+  DaemonProcess d;
+  Connection c, watcher;
+};
+
 // Two fixed cameras, one of them bumped: the other still sees the content where the rig
 // puts it, so the bumped camera is re-registered and the projector left as it is; then the
 // projector bumped, which both cameras see.
 TEST(SimDrift, ABumpedCameraIsReregisteredAndTheProjectorLeftAlone) {
   TempDir dir;
-  const std::string scene_file = sceneWithEvents(
-      dir, std::string(kSecondCamera) + "[[events]]\nt = " + atText(6.0) +
-               "\ntarget = \"cam\"\nrotate_deg = [0.3, 0.0, 0.0]\n\n"
-               "[[events]]\nt = " +
-               atText(16.0) + "\ntarget = \"proj\"\nrotate_deg = [0.5, 0.0, 0.0]\n");
-  auto scene = sim::resolveScene(scene_file);
-  ASSERT_TRUE(scene) << scene.error().message;
-  DaemonProcess d(dir, driftDaemon(dir, "on-drift", scene_file));
-  ASSERT_TRUE(d.started()) << d.log();
-  Connection c(d.socketPath());
-  Connection watcher(d.socketPath());
-  ASSERT_TRUE(watcher.call({{"cmd", "watch"}}));
-  ASSERT_NO_FATAL_FAILURE(showContent(c, texturedContent(dir)));
+  TwoCameraRig r(dir, "[[events]]\nt = " + atText(6.0) +
+                          "\ntarget = \"cam\"\nrotate_deg = [0.3, 0.0, 0.0]\n\n"
+                          "[[events]]\nt = " +
+                          atText(16.0) + "\ntarget = \"proj\"\nrotate_deg = [0.5, 0.0, 0.0]\n");
+  ASSERT_NO_FATAL_FAILURE(r.start(dir));
+  auto [scene, d, c, watcher] = std::tie(r.scene, r.d, r.c, r.watcher);
   const auto projectorOf = [&] {
     auto rig = rig::rigFromText(rigText(dir), "rig.json");
     return rig ? rig::rigToJson(*rig)["projectors"] : json(nullptr);
@@ -473,6 +470,64 @@ TEST(SimDrift, ABumpedCameraIsReregisteredAndTheProjectorLeftAlone) {
       "corrected, the rig against the true projector %.3f px\n",
       rig_px);
   EXPECT_LE(rig_px, 0.5);
+}
+
+// Two fixed cameras, the wall moved 1 cm back: both see the content drift, and where
+// they both found it their rays meet 1 cm behind the rig's wall, so the wall is measured
+// again from the content and the projector left as it is.
+TEST(SimDrift, AMovedWallIsMeasuredAgainFromTheContentAndTheProjectorLeftAlone) {
+  TempDir dir;
+  TwoCameraRig r(
+      dir, "[[events]]\nt = " + atText(6.0) + "\ntarget = \"wall\"\nmove_m = [0.0, 0.01, 0.0]\n");
+  ASSERT_NO_FATAL_FAILURE(r.start(dir));
+  auto [scene, d, c, watcher] = std::tie(r.scene, r.d, r.c, r.watcher);
+  auto before = rig::rigFromText(rigText(dir), "rig.json");
+  ASSERT_TRUE(before) << before.error().message;
+  bool registered = false;
+  const std::optional<json> corrected =
+      awaitCorrection(watcher, "corrected-surface", "corrected-pose", registered);
+  ASSERT_TRUE(corrected) << outputDrift(c).dump() << d.log();
+  EXPECT_EQ((*corrected)["step"], "surface");
+  EXPECT_TRUE(registered) << outputDrift(c).dump();
+  auto after = rig::rigFromText(rigText(dir), "rig.json");
+  ASSERT_TRUE(after && after->surface.plane) << rigText(dir);
+  EXPECT_EQ(rig::rigToJson(*before)["projectors"], rig::rigToJson(*after)["projectors"]);
+  EXPECT_EQ(rig::rigToJson(*before)["cameras"], rig::rigToJson(*after)["cameras"]);
+  // The measured wall against the true one (the plane y = 3.01).
+  const geom::Plane& plane = *after->surface.plane;
+  const double turned = std::acos(std::min(1.0, std::abs(plane.n.dot(Vec3::UnitY())))) * 180 / M_PI;
+  const double off_mm = 1e3 * std::abs(plane.signedDistance(Vec3(0.0, 3.01, 1.5)));
+  // Where the content lands on the true wall against where the rig puts it, in the
+  // projector's pixels there.
+  const geom::CameraModel projector = scene->at(at(7.0)).projectors.at(0).model;
+  const geom::Plane wall{Vec3(0, -1, 0), 3.01};
+  double worst_px = 0;
+  for (int y = 0; y < projector.height; y += 60) {
+    for (int x = 0; x < projector.width; x += 60) {
+      auto ray = projector.backproject({x, y});
+      auto next = projector.backproject({x + 1, y});
+      auto on_true = geom::intersectPlane(*ray, wall);
+      auto next_true = geom::intersectPlane(*next, wall);
+      auto on_rig = geom::intersectPlane(*ray, plane);
+      ASSERT_TRUE(on_true && next_true && on_rig);
+      const double pixel = (next_true->point - on_true->point).norm();
+      worst_px = std::max(worst_px, (on_rig->point - on_true->point).norm() / pixel);
+    }
+  }
+  const json dr = outputDrift(c);
+  const json& why = (*corrected)["why"];
+  std::printf(
+      "[ figures  ] wall moved 1 cm back: seen at %.2f px, triangulated %.2f mm off the rig's "
+      "wall (standard error %.3f) from %d content points; the wall measured again %.3f mm and "
+      "%.4f deg from the true one, the content on it %.3f projector px from where the rig puts "
+      "it; now %.3f px; projector and cameras unchanged\n",
+      why["misregistration_px"].get<double>(), why["wall_offset_mm"].get<double>(),
+      why["wall_offset_se_mm"].get<double>(), (*corrected)["points"].get<int>(), off_mm, turned,
+      worst_px, dr.value("misregistration_px", -1.0));
+  EXPECT_LE(off_mm, 1.0);
+  EXPECT_LE(turned, 0.1);
+  EXPECT_LE(worst_px, 0.5);
+  EXPECT_LE(dr.value("misregistration_px", 1e9), 0.5);
 }
 
 }  // namespace
