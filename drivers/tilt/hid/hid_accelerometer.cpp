@@ -54,24 +54,55 @@ Result<void> HidAccelerometer::open() {
   auto fields = findAccelerometer(*desc);
   if (!fields) return tl::unexpected(fields.error());
   fields_ = *fields;
+  gyro_.reset();
+  if (auto gyro = findGyrometer(*desc)) {
+    gyro_ = *gyro;
+  } else if (gyro.error().code != ErrorCode::kNotFound) {
+    return tl::unexpected(gyro.error());
+  }
+  last_rate_.reset();
   uses_report_ids_ = desc->uses_report_ids;
   open_ = true;
   return {};
 }
 
+Result<void> HidAccelerometer::readGyro(std::span<const std::uint8_t> data, std::uint64_t now_ns) {
+  Vec3 rate;
+  for (int a = 0; a < 3; ++a) {
+    const HidField& f = gyro_->axis[a];
+    auto v = f.extract(data);
+    if (!v) return fail(ErrorCode::kIo, "hid: gyrometer report too short");
+    if (*v < f.logical_min || *v > f.logical_max)
+      return fail(ErrorCode::kInvalidInput, "hid: angular velocity outside the logical range");
+    rate(a) = double(*v) * gyro_->scale;
+  }
+  last_rate_ = rate;
+  last_rate_ns_ = now_ns;
+  return {};
+}
+
 Result<TiltSample> HidAccelerometer::read() {
   if (!open_) return fail(ErrorCode::kIo, "hid: not open");
-  // A sensor hub interleaves reports of several sensors: skip the others.
+  // A sensor hub interleaves reports of several sensors: the gyrometer's are kept for
+  // the next accelerometer sample, the others skipped.
   for (int attempt = 0; attempt < 16; ++attempt) {
     auto report = transport_->readReport(timeout_ms_);
     if (!report) return tl::unexpected(report.error());
     std::span<const std::uint8_t> data(*report);
+    const std::uint64_t now = monotonicNs();
+    const std::uint8_t id = uses_report_ids_ && !data.empty() ? data[0] : 0;
     if (uses_report_ids_) {
-      if (data.empty() || data[0] != fields_.axis[0].report_id) continue;
+      if (data.empty()) continue;
       data = data.subspan(1);
     }
+    if (gyro_ && id == gyro_->axis[0].report_id) {
+      if (auto ok = readGyro(data, now); !ok) return tl::unexpected(ok.error());
+      if (id != fields_.axis[0].report_id) continue;
+    }
+    if (id != fields_.axis[0].report_id) continue;
     TiltSample s;
-    s.timestamp_ns = monotonicNs();
+    s.timestamp_ns = now;
+    if (last_rate_ && now - last_rate_ns_ <= kGyroFreshNs) s.angular_velocity = last_rate_;
     for (int a = 0; a < 3; ++a) {
       const HidField& f = fields_.axis[a];
       auto v = f.extract(data);

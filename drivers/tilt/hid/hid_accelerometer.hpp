@@ -1,9 +1,12 @@
 #pragma once
 // HID sensor accelerometers (usage page 0x20, usage 0x73) through hidraw: the report
 // descriptor names the X/Y/Z fields, their unit exponent and logical range; input
-// reports are decoded with them. The transport is an interface so stored descriptors
-// and reports drive the tests.
+// reports are decoded with them. A sensor hub's gyrometer (usage 0x76) on the same node
+// is read too: each accelerometer sample carries its latest angular velocity. The transport is an
+// interface so stored descriptors and reports drive the tests.
 #include <memory>
+#include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -52,13 +55,24 @@ class HidAccelerometer final : public TiltSensor {
   int pollFd() const override { return transport_->pollFd(); }
 
   const HidAccelFields& fields() const { return fields_; }
+  bool hasGyroscope() const { return gyro_.has_value(); }
+
+  // A gyrometer report older than this when an accelerometer sample comes is not
+  // given with it (the hub stopped reporting it).
+  static constexpr std::uint64_t kGyroFreshNs = 100'000'000;
 
  private:
+  // The gyrometer's reading in `data` (the report without its ID byte) into last_rate_.
+  Result<void> readGyro(std::span<const std::uint8_t> data, std::uint64_t now_ns);
+
   std::unique_ptr<HidTransport> transport_;
   int timeout_ms_;
   bool open_ = false;
   bool uses_report_ids_ = false;
   HidAccelFields fields_;
+  std::optional<HidGyroFields> gyro_;
+  std::optional<Vec3> last_rate_;  // rad/s, sensor axes
+  std::uint64_t last_rate_ns_ = 0;
 };
 
 }  // namespace procam::tilt

@@ -1,7 +1,10 @@
 #include "tilt/hid/hid_descriptor.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
+#include <string>
 
 #include "core/units.hpp"
 
@@ -10,7 +13,9 @@ namespace {
 
 constexpr std::uint16_t kSensorPage = 0x20;
 constexpr std::uint16_t kAccelerometer3D = 0x73;
-constexpr std::uint16_t kAxisUsage[3] = {0x453, 0x454, 0x455};
+constexpr std::uint16_t kAccelAxes[3] = {0x453, 0x454, 0x455};
+constexpr std::uint16_t kGyrometer3D = 0x76;
+constexpr std::uint16_t kAngularVelocityAxes[3] = {0x457, 0x458, 0x459};
 
 struct Globals {
   std::uint16_t usage_page = 0;
@@ -161,24 +166,40 @@ Result<HidDescriptor> parseHidDescriptor(std::span<const std::uint8_t> bytes) {
   return out;
 }
 
-Result<HidAccelFields> findAccelerometer(const HidDescriptor& d) {
-  HidAccelFields out;
+namespace {
+
+// The X/Y/Z fields of the first `collection` of the sensor page, all in one report with
+// one unit and exponent; `what` names the sensor in messages.
+Result<std::array<HidField, 3>> motionAxes(const HidDescriptor& d, std::uint16_t collection,
+                                           const std::uint16_t (&usages)[3], const char* what) {
+  std::array<HidField, 3> axis;
   bool found[3] = {false, false, false};
   for (const HidField& f : d.inputs) {
-    if (f.collection_page != kSensorPage || f.collection_usage != kAccelerometer3D) continue;
+    if (f.collection_page != kSensorPage || f.collection_usage != collection) continue;
     if (f.usage_page != kSensorPage) continue;
     for (int a = 0; a < 3; ++a)
-      if (f.usage == kAxisUsage[a] && !found[a]) {
-        out.axis[a] = f;
+      if (f.usage == usages[a] && !found[a]) {
+        axis[a] = f;
         found[a] = true;
       }
   }
   if (!found[0] || !found[1] || !found[2])
-    return fail(ErrorCode::kNotFound, "no Accelerometer 3D X/Y/Z input fields");
+    return fail(ErrorCode::kNotFound, std::string("no ") + what + " X/Y/Z input fields");
+  for (const HidField& f : axis)
+    if (f.unit != axis[0].unit || f.unit_exponent != axis[0].unit_exponent ||
+        f.report_id != axis[0].report_id)
+      return fail(ErrorCode::kInvalidInput, std::string(what) + " axes differ in unit or report");
+  return axis;
+}
+
+}  // namespace
+
+Result<HidAccelFields> findAccelerometer(const HidDescriptor& d) {
+  auto axis = motionAxes(d, kAccelerometer3D, kAccelAxes, "Accelerometer 3D");
+  if (!axis) return tl::unexpected(axis.error());
+  HidAccelFields out;
+  std::copy(axis->begin(), axis->end(), out.axis);
   const HidField& x = out.axis[0];
-  for (const HidField& f : out.axis)
-    if (f.unit != x.unit || f.unit_exponent != x.unit_exponent || f.report_id != x.report_id)
-      return fail(ErrorCode::kInvalidInput, "acceleration axes differ in unit or report");
   double unit_scale = 0;
   if (x.unit == 0 || x.unit == 0x1A)
     unit_scale = kStandardGravity;  // default unit: g
@@ -186,6 +207,25 @@ Result<HidAccelFields> findAccelerometer(const HidDescriptor& d) {
     unit_scale = 1;  // "m/s^2" of the HID sensor usage tables
   else
     return fail(ErrorCode::kInvalidInput, "unsupported acceleration unit");
+  out.scale = unit_scale * std::pow(10.0, x.unit_exponent);
+  return out;
+}
+
+Result<HidGyroFields> findGyrometer(const HidDescriptor& d) {
+  auto axis = motionAxes(d, kGyrometer3D, kAngularVelocityAxes, "Gyrometer 3D");
+  if (!axis) return tl::unexpected(axis.error());
+  HidGyroFields out;
+  std::copy(axis->begin(), axis->end(), out.axis);
+  const HidField& x = out.axis[0];
+  double unit_scale = 0;
+  // Degrees per second: the default, the usage tables' code and the one Linux's HID
+  // sensor drivers name (0x15); radians per second.
+  if (x.unit == 0 || x.unit == 0xF014 || x.unit == 0x15)
+    unit_scale = degToRad(1.0);
+  else if (x.unit == 0xF012)
+    unit_scale = 1;
+  else
+    return fail(ErrorCode::kInvalidInput, "unsupported angular velocity unit");
   out.scale = unit_scale * std::pow(10.0, x.unit_exponent);
   return out;
 }

@@ -1,6 +1,7 @@
 #pragma once
-// HID report descriptor parsing (HID 1.11 §6.2.2) for sensor accelerometers (HID Sensor
-// Usages: page 0x20, Accelerometer 3D 0x73, Acceleration Axis X/Y/Z 0x453..0x455).
+// HID report descriptor parsing (HID 1.11 §6.2.2) for sensor accelerometers and
+// gyrometers (HID Sensor Usages: page 0x20, Accelerometer 3D 0x73 with Acceleration Axis
+// X/Y/Z 0x453..0x455, Gyrometer 3D 0x76 with Angular Velocity X/Y/Z 0x457..0x459).
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -43,5 +44,15 @@ struct HidAccelFields {
 // The X/Y/Z acceleration input fields of the first Accelerometer 3D collection.
 // kNotFound when absent; kInvalidInput for an unsupported unit.
 Result<HidAccelFields> findAccelerometer(const HidDescriptor& d);
+
+struct HidGyroFields {
+  HidField axis[3];
+  double scale = 0;  // rad/s per logical unit (unit and unit exponent applied)
+};
+
+// The X/Y/Z angular velocity input fields of the first Gyrometer 3D collection (the
+// default unit is degrees per second). kNotFound when absent; kInvalidInput for an
+// unsupported unit.
+Result<HidGyroFields> findGyrometer(const HidDescriptor& d);
 
 }  // namespace procam::tilt

@@ -1,4 +1,5 @@
-// The "hid" tilt driver: HID sensor accelerometers on /dev/hidrawN behind the plugin ABI.
+// The "hid" tilt driver: HID sensor accelerometers (with a sensor hub's gyrometer when the
+// node has one) on /dev/hidrawN behind the plugin ABI.
 #include <cstring>
 #include <exception>
 
@@ -67,7 +68,7 @@ int createHidOn(std::unique_ptr<HidTransport> transport, const procam_config* co
 const procam_driver_factory kHidFactory = {
     PROCAM_FAMILY_TILT,
     "hid",
-    "HID sensor accelerometer (usage 0x20/0x73) on /dev/hidrawN",
+    "HID sensor accelerometer (usage 0x20/0x73) and gyrometer (0x20/0x76) on /dev/hidrawN",
     &probe,
     &create,
     nullptr};

@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <cmath>
 #include <deque>
+#include <thread>
 
 #include "fake_hid.hpp"
 #include "tilt/hid/hid_accelerometer.hpp"
@@ -60,6 +63,67 @@ TEST(HidAccelerometer, SiUnitWithOtherExponent) {
   auto s = sensor.read();
   ASSERT_TRUE(s);
   EXPECT_NEAR((s->specific_force - Vec3(9.807, 0, -4.903)).norm(), 0, 1e-12);
+}
+
+TEST(HidDescriptor, GyrometerFieldsAndUnits) {
+  auto d = parseHidDescriptor(hubDescriptor(0x0E, false, true));
+  ASSERT_TRUE(d) << d.error().message;
+  auto g = findGyrometer(*d);
+  ASSERT_TRUE(g) << g.error().message;
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(g->axis[i].report_id, 4);
+    EXPECT_EQ(g->axis[i].usage, 0x457 + i);
+    EXPECT_EQ(g->axis[i].bit_offset, std::uint32_t(16 * i));
+    EXPECT_EQ(g->axis[i].logical_min, -32767);
+  }
+  // Degrees per second (the default unit) times 10^-2.
+  EXPECT_NEAR(g->scale, 0.01 * M_PI / 180, 1e-15);
+  // Radians per second; the usage tables' and Linux's codes for degrees per second.
+  for (auto [unit, scale] : {std::pair<std::uint16_t, double>{0xF012, 0.01},
+                             {0xF014, 0.01 * M_PI / 180},
+                             {0x0015, 0.01 * M_PI / 180}}) {
+    auto u = parseHidDescriptor(hubDescriptor(0x0E, false, true, unit));
+    ASSERT_TRUE(u);
+    auto f = findGyrometer(*u);
+    ASSERT_TRUE(f) << unit;
+    EXPECT_NEAR(f->scale, scale, 1e-15) << unit;
+  }
+  auto odd = parseHidDescriptor(hubDescriptor(0x0E, false, true, 0x1A));  // g: not a rate
+  ASSERT_TRUE(odd);
+  EXPECT_EQ(findGyrometer(*odd).error().code, ErrorCode::kInvalidInput);
+  // The accelerometer alone (the mouse below has neither).
+  const std::vector<std::uint8_t> mouse = {0x05, 0x01, 0x09, 0x02, 0xA1, 0x01, 0xC0};
+  EXPECT_EQ(findGyrometer(*parseHidDescriptor(mouse)).error().code, ErrorCode::kNotFound);
+}
+
+TEST(HidAccelerometer, ASensorHubsGyrometerComesWithEachSample) {
+  auto t = std::make_unique<ScriptedHid>();
+  ScriptedHid& hub = *t;
+  t->descriptor = hubDescriptor(0x0E, false, true);
+  t->reports.push_back(accelReport(0, 0, 100));  // before any gyrometer report: no rate
+  t->reports.push_back(gyroReport(1000, -2000, 50));
+  t->reports.push_back(accelReport(0, 0, 100));
+  HidAccelerometer sensor(std::move(t));
+  ASSERT_TRUE(sensor.open());
+  EXPECT_TRUE(sensor.hasGyroscope());
+  auto first = sensor.read();
+  ASSERT_TRUE(first) << first.error().message;
+  EXPECT_FALSE(first->angular_velocity);
+  auto s = sensor.read();
+  ASSERT_TRUE(s) << s.error().message;
+  ASSERT_TRUE(s->angular_velocity);
+  const double k = 0.01 * M_PI / 180;  // rad/s per unit
+  EXPECT_NEAR((*s->angular_velocity - Vec3(10, -20, 0.5) * 100 * k).norm(), 0, 1e-12);
+  // A gyrometer gone quiet for longer than kGyroFreshNs: samples come without a rate.
+  std::this_thread::sleep_for(std::chrono::nanoseconds(HidAccelerometer::kGyroFreshNs) +
+                              std::chrono::milliseconds(20));
+  hub.reports.push_back(accelReport(0, 0, 100));
+  auto stale = sensor.read();
+  ASSERT_TRUE(stale);
+  EXPECT_FALSE(stale->angular_velocity);
+  // Out of its range: refused, as the accelerometer's.
+  hub.reports.push_back(gyroReport(-32768, 0, 0));
+  EXPECT_EQ(sensor.read().error().code, ErrorCode::kInvalidInput);
 }
 
 TEST(HidDescriptor, MalformedAndForeignDescriptors) {
