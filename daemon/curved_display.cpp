@@ -30,6 +30,7 @@ struct CurvedInput {
   std::shared_ptr<const void> surface;  // holds `intersector`
   const geom::MeshIntersector* intersector = nullptr;
   Daemon::RigResponse response;
+  bool own_mesh = false;  // the projector's own measured mesh, not the unified one
 };
 
 // What a display is made for: the content's size, the eye, every output's projector,
@@ -64,7 +65,7 @@ const KeystoneRuntime::Curved* Daemon::curvedDisplay(cv::Size content, const Vie
     if (!surface) continue;
     const geom::CameraModel model = p->model();
     inputs.push_back({e.name, model, model.projectionMatrix(), *mode, surface,
-                      &surface->intersector, rigResponse(*p)});
+                      &surface->intersector, rigResponse(*p), rig_surfaces_.count(p->name) > 0});
   }
   if (inputs.size() < 2 || content.width < 1 || content.height < 1) {
     k.curved.reset();
@@ -89,7 +90,8 @@ const KeystoneRuntime::Curved* Daemon::curvedDisplay(cv::Size content, const Vie
         for (const auto& in : inputs) {
           // The pinhole draws what the projector's pixels lit through the post-rendering
           // warp ([Raskar02] §4.1.3): measured from the mesh's pixels, or its lens.
-          auto warp = render::projectorPostRenderWarp(in.intersector->mesh(), in.model);
+          auto warp = render::projectorPostRenderWarp(
+              in.model, in.own_mesh ? &in.intersector->mesh() : nullptr);
           if (!warp) {
             error = in.output + "'s post-rendering warp: " + warp.error().message;
             break;

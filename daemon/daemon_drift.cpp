@@ -249,6 +249,7 @@ void Daemon::onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, Calibr
   ++o.checks;
   const drift::Misregistration& m = r->misregistration;
   v.last = m;
+  v.last_generation = key.rig_generation;
   const double threshold = config_.drift.threshold_px;
   if (m.too_plain || m.rms_px <= threshold) {
     v.above.reset();
@@ -338,6 +339,7 @@ std::optional<drift::WallSeen> Daemon::movedWall(const std::string& output,
     auto v = o.views.find(name);
     // Both checks against this rig model (their maps are its).
     if (!cam || !cam->pose_known || v == o.views.end() || !v->second.last || !v->second.reference ||
+        v->second.last_generation != rig_generation_ ||
         v->second.reference->rig_generation != rig_generation_ || v->second.last->too_plain) {
       return std::nullopt;
     }
@@ -345,11 +347,16 @@ std::optional<drift::WallSeen> Daemon::movedWall(const std::string& output,
                            v->second.reference->grid};
   };
   const auto here = viewOf(camera);
-  if (!here) return std::nullopt;
+  const auto& above = o.views[camera].above;
+  if (!here || !above) return std::nullopt;
   for (const std::string& name : o.cameras) {
     if (name == camera) continue;
+    // Another camera that saw the drift too, checked since this one first saw it.
     const auto there = viewOf(name);
-    if (!there || there->drift->rms_px <= config_.drift.threshold_px) continue;
+    if (!there || there->drift->rms_px <= config_.drift.threshold_px ||
+        o.views[name].checked_at <= *above) {
+      continue;
+    }
     auto seen = drift::wallFromTwoViews(*here, *there, *rig_.surface.plane);
     if (!seen) {
       logInfo("drift: output '" + output + "': the wall from cameras '" + camera + "' and '" +
@@ -390,14 +397,9 @@ void Daemon::correctSurface(const std::string& output, const std::string& camera
     update.projectors.push_back(p);
     update.projectors.back().plane_homography.reset();
   }
-  if (!o.before) o.before.emplace();
-  if (!o.before->surface.plane) {
-    o.before->surface.plane = rig_.surface.plane;
-    o.before->surface.plane_rms_m = rig_.surface.plane_rms_m;
-  }
-  for (const rig::RigProjector& p : update.projectors) {
-    if (const rig::RigProjector* was = rig_.projector(p.name)) keepBefore(o, *was, nullptr);
-  }
+  // The wall is measured, not fitted by passes: what was kept to restore after
+  // corrections that do not converge belonged to the old wall and cannot come back.
+  o.before.reset();
   const json why = {{"misregistration_px", m.rms_px},
                     {"held_s", held},
                     {"threshold_px", config_.drift.threshold_px},

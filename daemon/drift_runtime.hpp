@@ -32,6 +32,7 @@ struct DriftRuntime {
   struct View {
     std::shared_ptr<const DriftReference> reference;
     std::optional<drift::Misregistration> last;
+    uint64_t last_generation = 0;  // the rig model `last` was measured against
     Clock::time_point checked_at;
     std::optional<Clock::time_point> above;  // drift seen by this camera since
     nlohmann::json timing =

@@ -23,6 +23,7 @@ Result<json> renderCurved(const CurvedRenderInput& in) {
   const fs::path dir = in.rig_file.parent_path();
   std::vector<const rig::RigProjector*> chosen;
   std::vector<geom::MeshIntersector> surfaces;
+  std::vector<bool> own_mesh;  // the projector's own measured mesh, not the unified one
   std::vector<std::string> skipped;
   surfaces.reserve(rig.projectors.size());
   for (const rig::RigProjector& p : rig.projectors) {
@@ -52,6 +53,7 @@ Result<json> renderCurved(const CurvedRenderInput& in) {
     auto intersector = geom::MeshIntersector::build(std::move(mesh->mesh));
     if (!intersector) return tl::unexpected(intersector.error());
     surfaces.push_back(std::move(*intersector));
+    own_mesh.push_back(mesh_it != rig.surface.meshes.end());
     chosen.push_back(&p);
   }
   if (chosen.empty()) {
@@ -72,7 +74,7 @@ Result<json> renderCurved(const CurvedRenderInput& in) {
   for (std::size_t t = 0; t < chosen.size(); ++t) {
     // The pinhole's image moved to the pixels that lit the surface ([Raskar02] §4.1.3).
     const geom::CameraModel model = chosen[t]->model();
-    auto warp = render::projectorPostRenderWarp(surfaces[t].mesh(), model);
+    auto warp = render::projectorPostRenderWarp(model, own_mesh[t] ? &surfaces[t].mesh() : nullptr);
     if (!warp) {
       return fail(warp.error().code,
                   chosen[t]->name + "'s post-rendering warp: " + warp.error().message);

@@ -65,9 +65,9 @@ Result<CurvedDisplay> solveCurvedDisplay(std::span<const SurfaceProjector> proje
     for (std::size_t m = 0; m < projectors.size(); ++m) {
       const auto hit = projectors[m].surface->intersect(ray);
       if (!hit) continue;
-      const Vec3 x = projectors[m].projector * hit->point.homogeneous();
-      if (!(x.z() > 0)) continue;
-      const Vec2 u = x.hnormalized();
+      const auto pixel = rays[m].framebufferPixelOf(hit->point);
+      if (!pixel) continue;
+      const Vec2 u = *pixel;
       const cv::Size s = projectors[m].size;
       if (u.x() >= -0.5 && u.y() >= -0.5 && u.x() <= s.width - 0.5 && u.y() <= s.height - 0.5)
         return true;
@@ -95,17 +95,8 @@ Result<CurvedDisplay> solveCurvedDisplay(std::span<const SurfaceProjector> proje
     for (std::size_t m = 0; m < projectors.size(); ++m) {
       const auto hit = projectors[m].surface->intersect(ray);
       if (!hit) continue;
-      const Vec3 u = projectors[m].projector * hit->point.homogeneous();
-      if (!(u.z() > 0)) continue;
-      // The framebuffer pixel whose post-rendering warp lands on the pinhole's pixel.
-      const Vec2 pinhole = u.hnormalized();
-      Vec2 pixel = pinhole;
-      for (int it = 0; it < 3 && projectors[m].post_warp; ++it) {
-        const auto to = render::gridSource(*projectors[m].post_warp, pixel);
-        if (!to) break;
-        pixel -= *to - pinhole;
-      }
-      if (render::gridSource(d.lookup[m], pixel)) return true;
+      const auto pixel = rays[m].framebufferPixelOf(hit->point);
+      if (pixel && render::gridSource(d.lookup[m], *pixel)) return true;
     }
     return false;
   };

@@ -30,9 +30,9 @@ struct Lit {
 // Where projector `n` shows the surface point X, when it does: X inside its frame and
 // its own ray through that pixel meeting its surface there.
 std::optional<Vec2> pixelLighting(const Lit& n, const Vec3& X, double same_point_m) {
-  const Vec3 x = n.p->projector * X.homogeneous();
-  if (!(x.z() > 0)) return std::nullopt;
-  const Vec2 u = x.hnormalized();
+  const auto pixel = n.rays.framebufferPixelOf(X);
+  if (!pixel) return std::nullopt;
+  const Vec2 u = *pixel;
   if (!(u.x() >= -0.5 && u.y() >= -0.5 && u.x() <= n.p->size.width - 0.5 &&
         u.y() <= n.p->size.height - 0.5))
     return std::nullopt;

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <vector>
 
+#include "core/units.hpp"
 #include "geometry/triangulate.hpp"
 
 namespace procam::drift {
@@ -22,7 +23,8 @@ std::optional<Vec2> foundAt(const WallView& v, const TileShift& tile) {
 
 bool wallMoved(const WallSeen& seen, double min_offset_m, double min_tilt_deg) {
   const double off = std::abs(seen.offset_m);
-  return (off > min_offset_m && off > 6 * seen.offset_se_m) || seen.tilt_deg > min_tilt_deg;
+  return (off > min_offset_m && off > 6 * seen.offset_se_m) ||
+         (seen.tilt_deg > min_tilt_deg && seen.tilt_deg > 6 * seen.tilt_se_deg);
 }
 
 Result<WallSeen> wallFromTwoViews(const WallView& a, const WallView& b,
@@ -40,8 +42,11 @@ Result<WallSeen> wallFromTwoViews(const WallView& a, const WallView& b,
       auto ra = a.camera->backproject(*pa);
       auto rb = b.camera->backproject(*pb);
       if (!ra || !rb) break;
+      // Rays that pass apart saw different points (the content moved between the checks).
       auto x = geom::triangulateRays(*ra, *rb);
-      if (x && x->t1 > 0 && x->t2 > 0 && x->point.allFinite()) points.push_back(x->point);
+      if (x && x->t1 > 0 && x->t2 > 0 && x->point.allFinite() && x->gap <= kMaxRayGapM) {
+        points.push_back(x->point);
+      }
       break;
     }
   }
@@ -67,7 +72,16 @@ Result<WallSeen> wallFromTwoViews(const WallView& a, const WallView& b,
   const double var = std::max(0.0, sq / n - out.offset_m * out.offset_m);
   out.offset_se_m = std::sqrt(var / (n - 1));
   const double c = std::min(1.0, std::abs(out.plane.n.dot(rig_plane.n)));
-  out.tilt_deg = std::acos(c) * 180.0 / 3.14159265358979323846;
+  out.tilt_deg = radToDeg(std::acos(c));
+  // The fitted normal's standard error: the points' scatter over their spread about
+  // their centroid, in n points.
+  Vec3 centroid = Vec3::Zero();
+  for (const Vec3& x : points) centroid += x;
+  centroid /= n;
+  double spread = 0;
+  for (const Vec3& x : points) spread += (x - centroid).squaredNorm();
+  spread = std::sqrt(spread / n);
+  out.tilt_se_deg = spread > 0 ? radToDeg(out.rms_m / (spread * std::sqrt(n))) : 90.0;
   return out;
 }
 

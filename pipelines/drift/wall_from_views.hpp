@@ -33,15 +33,20 @@ struct WallSeen {
   double offset_m = 0;     // the points' mean signed distance from the rig's plane
   double offset_se_m = 0;  // its standard error
   double tilt_deg = 0;     // between the fitted plane and the rig's
+  double tilt_se_deg = 0;  // the fitted normal's standard error
 };
 
+// Rays of the two cameras that pass further apart than this saw different points.
+inline constexpr double kMaxRayGapM = 0.005;
+
 // Moved: the points stand off the rig's plane by more than `min_offset_m` and by more
-// than six standard errors, or the plane turned by more than `min_tilt_deg`.
+// than six standard errors, or the plane turned by more than `min_tilt_deg` and by more
+// than six of its standard errors.
 bool wallMoved(const WallSeen& seen, double min_offset_m = 0.002, double min_tilt_deg = 0.3);
 
 // kTooFewPoints under 8 content points both cameras registered (inlier tiles of the same
-// framebuffer point); kInvalidInput for a missing or mismatched view or a camera without
-// a pose; fitPlane's errors.
+// framebuffer point whose rays meet within kMaxRayGapM); kInvalidInput for a missing or
+// mismatched view; fitPlane's errors.
 Result<WallSeen> wallFromTwoViews(const WallView& a, const WallView& b,
                                   const geom::Plane& rig_plane);
 

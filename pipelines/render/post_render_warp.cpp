@@ -81,13 +81,25 @@ Result<PostRenderWarp> measuredPostRenderWarp(const geom::TriangleMesh& mesh, co
     ++out.points;
   }
   if (out.points > 0) out.rms_px = std::sqrt(sum / out.points);
+  // A lens and a unified surface move a projector's pixels by a few; far more means the
+  // vertices' u v are not this projector's pixels.
+  if (out.rms_px > kMaxMeasuredShiftPx) {
+    return fail(ErrorCode::kDegenerate,
+                "post-rendering warp: the mesh's pixels lie " + std::to_string(out.rms_px) +
+                    " px RMS from where the projector's matrix puts its vertices: not its "
+                    "pixels");
+  }
 
   // Every node inside a triangle (in projector space) takes the triangle's linear
   // interpolation of its corners' shifts.
   out.grid = framebufferGrid(size, step);
   WarpGrid& g = out.grid;
   std::vector<Vec2> shift(g.source.size(), none);
+  const int n = static_cast<int>(mesh.vertices.size());
   for (const auto& f : mesh.faces) {
+    if (f.minCoeff() < 0 || f.maxCoeff() >= n) {
+      return fail(ErrorCode::kInvalidInput, "post-rendering warp: a face's vertex is out of range");
+    }
     const Vec2 &a = mesh.uv[f[0]], &b = mesh.uv[f[1]], &c = mesh.uv[f[2]];
     const Vec2 &sa = moved[f[0]], &sb = moved[f[1]], &sc = moved[f[2]];
     if (!sa.allFinite() || !sb.allFinite() || !sc.allFinite()) continue;
@@ -95,10 +107,15 @@ Result<PostRenderWarp> measuredPostRenderWarp(const geom::TriangleMesh& mesh, co
     if (!(std::abs(area) > 1e-9)) continue;
     const double lo_x = std::min({a.x(), b.x(), c.x()}), hi_x = std::max({a.x(), b.x(), c.x()});
     const double lo_y = std::min({a.y(), b.y(), c.y()}), hi_y = std::max({a.y(), b.y(), c.y()});
-    const int i0 = std::max(0, static_cast<int>(std::ceil(lo_x / g.step.x())));
-    const int i1 = std::min(g.cols - 1, static_cast<int>(std::floor(hi_x / g.step.x())));
-    const int j0 = std::max(0, static_cast<int>(std::ceil(lo_y / g.step.y())));
-    const int j1 = std::min(g.rows - 1, static_cast<int>(std::floor(hi_y / g.step.y())));
+    // Node range, clamped in double before the cast (a pixel far off the frame).
+    const auto first = [](double v, int count) {
+      return std::max(0, static_cast<int>(std::clamp(std::ceil(v), -1.0, double(count))));
+    };
+    const auto last = [](double v, int count) {
+      return std::min(count - 1, static_cast<int>(std::clamp(std::floor(v), -1.0, double(count))));
+    };
+    const int i0 = first(lo_x / g.step.x(), g.cols), i1 = last(hi_x / g.step.x(), g.cols);
+    const int j0 = first(lo_y / g.step.y(), g.rows), j1 = last(hi_y / g.step.y(), g.rows);
     for (int j = j0; j <= j1; ++j) {
       for (int i = i0; i <= i1; ++i) {
         const Vec2 p = g.node(i, j);
@@ -151,14 +168,14 @@ Result<PostRenderWarp> lensPostRenderWarp(const geom::CameraModel& projector, in
 }
 
 Result<std::shared_ptr<const PostRenderWarp>> projectorPostRenderWarp(
-    const geom::TriangleMesh& surface, const geom::CameraModel& projector, int step) {
+    const geom::CameraModel& projector, const geom::TriangleMesh* own_mesh, int step) {
   const auto shared =
       [](Result<PostRenderWarp> w) -> Result<std::shared_ptr<const PostRenderWarp>> {
     if (!w) return tl::unexpected(w.error());
     return std::make_shared<const PostRenderWarp>(std::move(*w));
   };
-  if (!surface.uv.empty()) {
-    return shared(measuredPostRenderWarp(surface, projector.projectionMatrix(),
+  if (own_mesh && !own_mesh->uv.empty()) {
+    return shared(measuredPostRenderWarp(*own_mesh, projector.projectionMatrix(),
                                          cv::Size(projector.width, projector.height), step));
   }
   if (!projector.dist.isZero()) return shared(lensPostRenderWarp(projector, step));

@@ -28,10 +28,14 @@ struct PostRenderWarp {
   int points = 0;  // measured vertices used; 0 for the lens model
 };
 
+// Pixels moved further than this (RMS) are not a lens's or a unified surface's doing.
+inline constexpr double kMaxMeasuredShiftPx = 50;
+
 // `mesh`: its vertices (world) with `uv`, the projector pixel that lit each. Nodes every
 // `step` framebuffer pixels (render::framebufferGrid); a node no triangle covers takes the
-// value of the nearest covered one. kInvalidInput without uv for every vertex, for a bad
-// size or step or a non-finite P; kTooFewPoints when no triangle lies in front of P.
+// value of the nearest covered one. kInvalidInput without uv for every vertex, for a face
+// out of range, a bad size or step or a non-finite P; kTooFewPoints when no triangle lies
+// in front of P; kDegenerate when the pixels move more than kMaxMeasuredShiftPx RMS.
 Result<PostRenderWarp> measuredPostRenderWarp(const geom::TriangleMesh& mesh, const Mat34& P,
                                               cv::Size size, int step = 8);
 
@@ -40,9 +44,10 @@ Result<PostRenderWarp> measuredPostRenderWarp(const geom::TriangleMesh& mesh, co
 Result<PostRenderWarp> lensPostRenderWarp(const geom::CameraModel& projector, int step = 8);
 
 // A projector's warp for drawing through `projector`'s pinhole matrix: measured when
-// `surface` carries the pixels that lit its vertices, else from the lens model when it
-// has distortion; nullptr when neither (the pinhole is the projector). Errors as above.
+// `own_mesh` (the projector's own measured mesh, not one shared by several) carries the
+// pixels that lit its vertices, else from the lens model when it has distortion; nullptr
+// when neither (the pinhole is the projector). Errors as above.
 Result<std::shared_ptr<const PostRenderWarp>> projectorPostRenderWarp(
-    const geom::TriangleMesh& surface, const geom::CameraModel& projector, int step = 8);
+    const geom::CameraModel& projector, const geom::TriangleMesh* own_mesh, int step = 8);
 
 }  // namespace procam::render

@@ -15,7 +15,29 @@ Result<PixelRays> pixelRays(const Mat34& P, std::shared_ptr<const WarpGrid> post
     return fail(ErrorCode::kInvalidInput, "viewer view: singular projector matrix");
   }
   const Mat3 Minv = M.inverse();
-  return PixelRays{Minv, -Minv * P.col(3), std::move(post_warp)};
+  return PixelRays{Minv, -Minv * P.col(3), std::move(post_warp), M};
+}
+
+Vec2 PixelRays::toPinhole(const Vec2& pixel) const {
+  if (!post_warp || post_warp->cols < 2 || post_warp->rows < 2) return pixel;
+  const WarpGrid& g = *post_warp;
+  const Vec2 last = g.node(g.cols - 1, g.rows - 1);
+  const Vec2 at = pixel.cwiseMax(g.origin).cwiseMin(last);
+  const auto to = gridSource(g, at);
+  return to ? Vec2(pixel + (*to - at)) : pixel;
+}
+
+Vec2 PixelRays::toFramebuffer(const Vec2& pinhole) const {
+  if (!post_warp) return pinhole;
+  Vec2 pixel = pinhole;
+  for (int it = 0; it < 4; ++it) pixel -= toPinhole(pixel) - pinhole;
+  return pixel;
+}
+
+std::optional<Vec2> PixelRays::framebufferPixelOf(const Vec3& X) const {
+  const Vec3 x = M * (X - centre);
+  if (!(x.z() > 0)) return std::nullopt;
+  return toFramebuffer(x.hnormalized());
 }
 
 Result<Mat3> uprightEyeRotation(const Vec3& forward) {

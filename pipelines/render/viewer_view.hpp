@@ -9,6 +9,7 @@
 // grid (§4.1.5).
 #include <memory>
 #include <opencv2/core.hpp>
+#include <optional>
 
 #include "core/error.hpp"
 #include "core/types.hpp"
@@ -25,11 +26,18 @@ struct PixelRays {
   // Framebuffer pixel -> pixel of the matrix's pinhole image ([Raskar02] §4.1.3,
   // render/post_render_warp.hpp); null: the matrix is the projector.
   std::shared_ptr<const WarpGrid> post_warp;
+  Mat3 M = Mat3::Identity();  // the matrix's left 3x3
+
+  // The pinhole pixel a framebuffer pixel shows (past the warp's grid, the shift at its
+  // nearest edge).
+  Vec2 toPinhole(const Vec2& pixel) const;
+  // The framebuffer pixel that shows a pinhole pixel (the warp inverted by fixed-point
+  // steps: it moves pixels by a smooth field of a few pixels).
+  Vec2 toFramebuffer(const Vec2& pinhole) const;
+  // The framebuffer pixel whose ray passes through X; nullopt behind the projector.
+  std::optional<Vec2> framebufferPixelOf(const Vec3& X) const;
   geom::Ray through(double x, double y) const {
-    Vec2 m(x, y);
-    if (post_warp) {
-      if (auto s = gridSource(*post_warp, m)) m = *s;
-    }
+    const Vec2 m = toPinhole(Vec2(x, y));
     return {centre, (Minv * m.homogeneous()).normalized()};
   }
 };

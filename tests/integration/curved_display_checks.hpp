@@ -101,7 +101,7 @@ inline void readCalibrated(const std::string& state_dir, const std::vector<std::
   }
   for (std::size_t t = 0; t < outputs.size(); ++t) {
     const rig::RigProjector* p = out.rig.projectorForOutput(outputs[t]);
-    auto warp = render::projectorPostRenderWarp(out.surfaces[t].mesh(), p->model());
+    auto warp = render::projectorPostRenderWarp(p->model(), &out.surfaces[t].mesh());
     ASSERT_TRUE(warp) << warp.error().message;
     out.warps.push_back(*warp);
     std::shared_ptr<const render::WarpGrid> grid;

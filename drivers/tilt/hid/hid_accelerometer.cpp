@@ -54,31 +54,30 @@ Result<void> HidAccelerometer::open() {
   auto fields = findAccelerometer(*desc);
   if (!fields) return tl::unexpected(fields.error());
   fields_ = *fields;
+  // A gyrometer this driver cannot read (another unit, axes split over reports) leaves
+  // the accelerometer as it is, without a rate.
   gyro_.reset();
-  if (auto gyro = findGyrometer(*desc)) {
-    gyro_ = *gyro;
-  } else if (gyro.error().code != ErrorCode::kNotFound) {
-    return tl::unexpected(gyro.error());
-  }
+  if (auto gyro = findGyrometer(*desc)) gyro_ = *gyro;
   last_rate_.reset();
   uses_report_ids_ = desc->uses_report_ids;
   open_ = true;
   return {};
 }
 
-Result<void> HidAccelerometer::readGyro(std::span<const std::uint8_t> data, std::uint64_t now_ns) {
+void HidAccelerometer::readGyro(std::span<const std::uint8_t> data, std::uint64_t now_ns) {
   Vec3 rate;
   for (int a = 0; a < 3; ++a) {
     const HidField& f = gyro_->axis[a];
     auto v = f.extract(data);
-    if (!v) return fail(ErrorCode::kIo, "hid: gyrometer report too short");
-    if (*v < f.logical_min || *v > f.logical_max)
-      return fail(ErrorCode::kInvalidInput, "hid: angular velocity outside the logical range");
+    // A short or out-of-range report says nothing about the rate: none until a good one.
+    if (!v || *v < f.logical_min || *v > f.logical_max) {
+      last_rate_.reset();
+      return;
+    }
     rate(a) = double(*v) * gyro_->scale;
   }
   last_rate_ = rate;
   last_rate_ns_ = now_ns;
-  return {};
 }
 
 Result<TiltSample> HidAccelerometer::read() {
@@ -96,7 +95,7 @@ Result<TiltSample> HidAccelerometer::read() {
       data = data.subspan(1);
     }
     if (gyro_ && id == gyro_->axis[0].report_id) {
-      if (auto ok = readGyro(data, now); !ok) return tl::unexpected(ok.error());
+      readGyro(data, now);
       if (id != fields_.axis[0].report_id) continue;
     }
     if (id != fields_.axis[0].report_id) continue;

@@ -62,8 +62,9 @@ class HidAccelerometer final : public TiltSensor {
   static constexpr std::uint64_t kGyroFreshNs = 100'000'000;
 
  private:
-  // The gyrometer's reading in `data` (the report without its ID byte) into last_rate_.
-  Result<void> readGyro(std::span<const std::uint8_t> data, std::uint64_t now_ns);
+  // The gyrometer's reading in `data` (the report without its ID byte) into last_rate_;
+  // a bad report clears it.
+  void readGyro(std::span<const std::uint8_t> data, std::uint64_t now_ns);
 
   std::unique_ptr<HidTransport> transport_;
   int timeout_ms_;

@@ -109,6 +109,24 @@ TEST(WallFromViews, AMovedWallIsToldFromAMovedProjector) {
   }
 }
 
+TEST(WallFromViews, AMoveOrTurnCountsOnlyAboveItsNoise) {
+  WallSeen seen;
+  seen.offset_m = 0.003;
+  seen.offset_se_m = 0.0001;
+  EXPECT_TRUE(wallMoved(seen));
+  seen.offset_se_m = 0.001;  // three standard errors: noise
+  EXPECT_FALSE(wallMoved(seen));
+  seen = {};
+  seen.tilt_deg = 0.5;
+  seen.tilt_se_deg = 0.2;  // a small patch of noisy points
+  EXPECT_FALSE(wallMoved(seen));
+  seen.tilt_se_deg = 0.05;
+  EXPECT_TRUE(wallMoved(seen));
+  seen.tilt_deg = 0.2;  // significant, but under the bound
+  seen.tilt_se_deg = 0.01;
+  EXPECT_FALSE(wallMoved(seen));
+}
+
 TEST(WallFromViews, TooFewCommonTilesAndBadViewsAreRefused) {
   Misregistration none;
   const cv::Mat map(540, 960, CV_32FC2, cv::Scalar(-1, -1));

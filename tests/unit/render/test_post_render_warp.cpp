@@ -86,7 +86,8 @@ TEST(PostRenderWarp, MeasuredWarpSendsEveryPixelToThePinholePixelOfWhatItLit) {
 
 TEST(PostRenderWarp, RaysThroughTheWarpMeetTheWallWhereTheLensSendsThem) {
   const geom::CameraModel m = lensProjector();
-  auto warp = projectorPostRenderWarp(measuredWall(m, 16), m);
+  const geom::TriangleMesh wall = measuredWall(m, 16);
+  auto warp = projectorPostRenderWarp(m, &wall);
   ASSERT_TRUE(warp && *warp);
   auto plain = pixelRays(m.projectionMatrix());
   auto warped =
@@ -124,11 +125,11 @@ TEST(PostRenderWarp, LensWarpIsTheIdealPixelAndNoneIsNeededWithoutALens) {
   // The mesh's pixels win over the lens; with neither there is nothing to warp.
   geom::TriangleMesh bare = measuredWall(m, 32);
   bare.uv.clear();
-  auto from_lens = projectorPostRenderWarp(bare, m);
+  auto from_lens = projectorPostRenderWarp(m, &bare);
   ASSERT_TRUE(from_lens && *from_lens);
   EXPECT_EQ((*from_lens)->source, PostRenderWarp::Source::kLens);
   m.dist = {};
-  auto none = projectorPostRenderWarp(bare, m);
+  auto none = projectorPostRenderWarp(m, &bare);
   ASSERT_TRUE(none);
   EXPECT_FALSE(*none);
 }
@@ -149,6 +150,18 @@ TEST(PostRenderWarp, BadInputIsRefused) {
   geom::TriangleMesh behind = wall;
   for (auto& v : behind.vertices) v.z() = -v.z();
   EXPECT_EQ(measuredPostRenderWarp(behind, P, {1280, 800}).error().code, ErrorCode::kTooFewPoints);
+  // A face out of range; u v that are not the projector's pixels (texture coordinates).
+  geom::TriangleMesh bad_face = wall;
+  bad_face.faces.emplace_back(0, 1, static_cast<int>(wall.vertices.size()));
+  EXPECT_EQ(measuredPostRenderWarp(bad_face, P, {1280, 800}).error().code,
+            ErrorCode::kInvalidInput);
+  geom::TriangleMesh texture = wall;
+  for (auto& t : texture.uv) t = Vec2(t.x() / 1279, t.y() / 799);
+  EXPECT_EQ(measuredPostRenderWarp(texture, P, {1280, 800}).error().code, ErrorCode::kDegenerate);
+  // A pixel far off the frame: refused, nothing cast out of range.
+  geom::TriangleMesh far = wall;
+  far.uv[0] = Vec2(-1e30, 1e30);
+  EXPECT_FALSE(measuredPostRenderWarp(far, P, {1280, 800}).has_value());
   // No NaN or Inf leaves it.
   auto ok = measuredPostRenderWarp(wall, P, {1280, 800});
   ASSERT_TRUE(ok);

@@ -121,9 +121,30 @@ TEST(HidAccelerometer, ASensorHubsGyrometerComesWithEachSample) {
   auto stale = sensor.read();
   ASSERT_TRUE(stale);
   EXPECT_FALSE(stale->angular_velocity);
-  // Out of its range: refused, as the accelerometer's.
+  // Out of its range: the rate is dropped, the accelerometer's sample kept.
+  hub.reports.push_back(gyroReport(1000, 0, 0));
+  hub.reports.push_back(accelReport(0, 0, 100));
+  auto fresh = sensor.read();
+  ASSERT_TRUE(fresh && fresh->angular_velocity);
   hub.reports.push_back(gyroReport(-32768, 0, 0));
-  EXPECT_EQ(sensor.read().error().code, ErrorCode::kInvalidInput);
+  hub.reports.push_back(accelReport(0, 0, 100));
+  auto dropped = sensor.read();
+  ASSERT_TRUE(dropped) << dropped.error().message;
+  EXPECT_FALSE(dropped->angular_velocity);
+}
+
+TEST(HidAccelerometer, AGyrometerItCannotReadLeavesTheAccelerometer) {
+  auto t = std::make_unique<ScriptedHid>();
+  t->descriptor = hubDescriptor(0x0E, false, true, 0x1A);  // a rate in g: not one
+  t->reports.push_back(gyroReport(1000, 0, 0));
+  t->reports.push_back(accelReport(0, 0, 100));
+  HidAccelerometer sensor(std::move(t));
+  ASSERT_TRUE(sensor.open());
+  EXPECT_FALSE(sensor.hasGyroscope());
+  auto s = sensor.read();
+  ASSERT_TRUE(s) << s.error().message;
+  EXPECT_FALSE(s->angular_velocity);
+  EXPECT_NEAR(s->specific_force.z(), kStandardGravity, 1e-12);
 }
 
 TEST(HidDescriptor, MalformedAndForeignDescriptors) {
