@@ -24,8 +24,7 @@ namespace {
 
 struct CurvedInput {
   std::string output;
-  geom::CameraModel model;  // the rig's: its lens gives the post-rendering warp without pixels
-  Mat34 projector;
+  geom::CameraModel model;  // the rig's projector: its pinhole, and its lens for the warp
   cv::Size size;
   std::shared_ptr<const void> surface;  // holds `intersector`
   const geom::MeshIntersector* intersector = nullptr;
@@ -42,7 +41,8 @@ std::string curvedKey(cv::Size content, const Vec3& eye, const std::vector<Curve
   for (const auto& in : inputs) {
     key << ' ' << in.output << ' ' << in.size.width << 'x' << in.size.height << ' '
         << in.surface.get();
-    for (int i = 0; i < 12; ++i) key << ' ' << in.projector(i / 4, i % 4);
+    const Mat34 P = in.model.projectionMatrix();
+    for (int i = 0; i < 12; ++i) key << ' ' << P(i / 4, i % 4);
     const geom::Distortion& d = in.model.dist;
     key << " lens " << d.k1 << ' ' << d.k2 << ' ' << d.p1 << ' ' << d.p2 << ' ' << d.k3;
     key << in.response.key;
@@ -63,9 +63,8 @@ const KeystoneRuntime::Curved* Daemon::curvedDisplay(cv::Size content, const Vie
     if (!mode || mode->width != p->width || mode->height != p->height) continue;
     auto surface = rigSurfaceFor(p->name);
     if (!surface) continue;
-    const geom::CameraModel model = p->model();
-    inputs.push_back({e.name, model, model.projectionMatrix(), *mode, surface,
-                      &surface->intersector, rigResponse(*p), rig_surfaces_.count(p->name) > 0});
+    inputs.push_back({e.name, p->model(), *mode, surface, &surface->intersector, rigResponse(*p),
+                      rig_surfaces_.count(p->name) > 0});
   }
   if (inputs.size() < 2 || content.width < 1 || content.height < 1) {
     k.curved.reset();
@@ -98,7 +97,7 @@ const KeystoneRuntime::Curved* Daemon::curvedDisplay(cv::Size content, const Vie
           }
           std::shared_ptr<const render::WarpGrid> grid;
           if (*warp) grid = std::shared_ptr<const render::WarpGrid>(*warp, &(*warp)->grid);
-          projectors.push_back({in.intersector, in.projector, in.size, grid});
+          projectors.push_back({in.intersector, in.model.projectionMatrix(), in.size, grid});
           responses.push_back(in.response.response);
           made->outputs.push_back(in.output);
           made->surfaces.push_back(in.surface);

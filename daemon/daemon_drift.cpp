@@ -337,10 +337,10 @@ std::optional<drift::WallSeen> Daemon::movedWall(const std::string& output,
   const auto viewOf = [&](const std::string& name) -> std::optional<drift::WallView> {
     const rig::RigCamera* cam = rig_.camera(name);
     auto v = o.views.find(name);
-    // Both checks against this rig model (their maps are its).
+    // Both checks against this rig model; so then is the reference, which a check sets
+    // before its result may be dropped and so is never older than `last`.
     if (!cam || !cam->pose_known || v == o.views.end() || !v->second.last || !v->second.reference ||
-        v->second.last_generation != rig_generation_ ||
-        v->second.reference->rig_generation != rig_generation_ || v->second.last->too_plain) {
+        v->second.last_generation != rig_generation_ || v->second.last->too_plain) {
       return std::nullopt;
     }
     return drift::WallView{&cam->model, &*v->second.last, &v->second.reference->map,

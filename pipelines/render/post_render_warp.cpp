@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <deque>
 #include <limits>
+#include <opencv2/imgproc.hpp>
 #include <vector>
 
 namespace procam::render {
@@ -14,38 +14,25 @@ bool goodGrid(cv::Size size, int step) {
          step >= 1;
 }
 
-// Nodes without a value take their nearest valued neighbour's (breadth first over the
-// lattice): the warp stays smooth past the measured region's edge. False when no node has
-// a value.
+// Nodes without a value take their nearest valued node's (OpenCV's distance transform
+// labels each node with its nearest valued one): the warp stays smooth past the measured
+// region's edge. False when no node has a value.
 bool fillFromNearest(WarpGrid& g, std::vector<Vec2>& shift) {
-  std::vector<char> known(shift.size(), 0);
-  std::deque<std::size_t> queue;
+  cv::Mat unknown(g.rows, g.cols, CV_8UC1);
+  for (std::size_t k = 0; k < shift.size(); ++k) unknown.data[k] = shift[k].allFinite() ? 0 : 255;
+  if (cv::countNonZero(unknown) == static_cast<int>(shift.size())) return false;
+  cv::Mat distance, labels;
+  cv::distanceTransform(unknown, distance, labels, cv::DIST_L2, cv::DIST_MASK_5,
+                        cv::DIST_LABEL_PIXEL);
+  std::vector<std::size_t> node_of(shift.size() + 1);  // label -> its valued node
+  const int* label = labels.ptr<int>();
   for (std::size_t k = 0; k < shift.size(); ++k) {
-    if (shift[k].allFinite()) {
-      known[k] = 1;
-      queue.push_back(k);
-    }
-  }
-  if (queue.empty()) return false;
-  while (!queue.empty()) {
-    const std::size_t k = queue.front();
-    queue.pop_front();
-    const int i = static_cast<int>(k % g.cols), j = static_cast<int>(k / g.cols);
-    const int di[] = {1, -1, 0, 0}, dj[] = {0, 0, 1, -1};
-    for (int n = 0; n < 4; ++n) {
-      const int a = i + di[n], b = j + dj[n];
-      if (a < 0 || b < 0 || a >= g.cols || b >= g.rows) continue;
-      const std::size_t q = static_cast<std::size_t>(b) * g.cols + a;
-      if (known[q]) continue;
-      known[q] = 1;
-      shift[q] = shift[k];
-      queue.push_back(q);
-    }
+    if (!unknown.data[k]) node_of[static_cast<std::size_t>(label[k])] = k;
   }
   for (int j = 0; j < g.rows; ++j) {
     for (int i = 0; i < g.cols; ++i) {
       const std::size_t k = static_cast<std::size_t>(j) * g.cols + i;
-      g.source[k] = g.node(i, j) + shift[k];
+      g.source[k] = g.node(i, j) + shift[node_of[static_cast<std::size_t>(label[k])]];
     }
   }
   return true;

@@ -94,10 +94,7 @@ Result<TiltSample> HidAccelerometer::read() {
       if (data.empty()) continue;
       data = data.subspan(1);
     }
-    if (gyro_ && id == gyro_->axis[0].report_id) {
-      readGyro(data, now);
-      if (id != fields_.axis[0].report_id) continue;
-    }
+    if (gyro_ && id == gyro_->axis[0].report_id) readGyro(data, now);
     if (id != fields_.axis[0].report_id) continue;
     TiltSample s;
     s.timestamp_ns = now;
