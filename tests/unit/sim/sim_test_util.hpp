@@ -21,7 +21,7 @@ inline std::filesystem::path scenePath(const std::string& name) {
 // The shipped scenes (tests/scenes), each a case of [Raskar02]'s rendering-path table.
 inline const char* const kShippedScenes[] = {"wall_oblique",  "wall_oblique_board", "tiled_wall",
                                              "corner_stereo", "handheld",           "dome3",
-                                             "object_box",    "wall_views"};
+                                             "object_box",    "wall_views",         "object_vase"};
 
 // A wall y = 2 facing a projector at the origin (1 m high) that looks straight at
 // it, and a camera beside the projector with a parallel optical axis. `camera`

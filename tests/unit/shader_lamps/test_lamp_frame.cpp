@@ -1,0 +1,158 @@
+// A projector's frame for shader lamps: the radiance correction of [Raskar02] eq. 5.4
+// through the projector's response, the white level every projector can give, and the
+// appearance (texture, virtual light, view-dependent highlight).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "lamp_rig.hpp"
+#include "shader_lamps/lamp_frame.hpp"
+#include "shader_lamps/lamp_view.hpp"
+
+namespace procam::lamps {
+namespace {
+
+struct Lit {
+  ObjectModel plate;
+  geom::CameraModel p;
+  LampView view;
+  cv::Mat weight;
+};
+
+// A projector 2 m in front of a plate, 30 deg to its side, all its hits weighted one.
+Lit lit() {
+  auto plate = ObjectModel::build(test::plate(2.0, 2.0, 4));
+  EXPECT_TRUE(plate);
+  Lit r{std::move(*plate), test::projectorAt(Vec3(-1.1547, 0, 0), Vec3(0, 2, 0)), {}, {}};
+  r.view = *castLampView(r.p, r.plate);
+  r.weight = cv::Mat(r.view.size, CV_32FC1, cv::Scalar(0));
+  r.weight.setTo(1.f, r.view.face >= 0);
+  return r;
+}
+
+TEST(ShaderLampFrame, IntensityIsRadianceTimesDistanceSquaredOverCosine) {
+  const Lit r = lit();
+  LampFrameInput in{&r.view, &r.weight, {}};
+  in.photometry.gamma = 2.2;
+  in.photometry.gain_rgb = Vec3(2.0, 2.5, 3.0);
+  Material grey;
+  grey.albedo_rgb = Vec3(0.5, 0.4, 0.3);
+  auto level = lampWhiteLevel(std::span<const LampFrameInput>(&in, 1));
+  ASSERT_TRUE(level);
+  const double white = 0.9 * *level;
+  LampFrameStats stats;
+  auto frame = lampFrame(in, grey, white, std::nullopt, &stats);
+  ASSERT_TRUE(frame) << frame.error().message;
+  ASSERT_EQ(frame->type(), CV_8UC3);
+  int checked = 0;
+  for (int y = 0; y < 300; y += 5) {
+    for (int x = 0; x < 400; x += 5) {
+      const cv::Vec3b c = frame->at<cv::Vec3b>(y, x);
+      if (r.view.face.at<int>(y, x) < 0) {
+        EXPECT_EQ(c, cv::Vec3b(0, 0, 0));  // off the object: no light
+        continue;
+      }
+      const double d = r.view.distance.at<float>(y, x), cs = r.view.cosine.at<float>(y, x);
+      for (int k = 0; k < 3; ++k) {
+        const double want = white * grey.albedo_rgb[k] * d * d / (in.photometry.gain_rgb[k] * cs);
+        // The code value that emits it, rounded (the view's floats add under 1e-4 code).
+        EXPECT_NEAR(c[2 - k], 255 * std::pow(want, 1 / 2.2), 0.5 + 1e-4)
+            << x << "," << y << " channel " << k;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 3000);
+  EXPECT_EQ(stats.clipped_pixels, 0);
+  EXPECT_GT(stats.lit_pixels, 50000);
+}
+
+TEST(ShaderLampFrame, WhiteLevelIsWhatTheDimmestPointAllows) {
+  const Lit r = lit();
+  LampFrameInput in{&r.view, &r.weight, {}};
+  in.photometry.gain_rgb = Vec3(2.0, 2.5, 3.0);
+  auto white = lampWhiteLevel(std::span<const LampFrameInput>(&in, 1));
+  ASSERT_TRUE(white);
+  double want = 1e300;
+  for (int y = 0; y < 300; ++y)
+    for (int x = 0; x < 400; ++x)
+      if (r.view.face.at<int>(y, x) >= 0) {
+        const double d = r.view.distance.at<float>(y, x);
+        want = std::min(want, 2.0 * r.view.cosine.at<float>(y, x) / (d * d));
+      }
+  EXPECT_NEAR(*white, want, 1e-9 * want);
+  // At that level a white object needs full light somewhere and never more.
+  Material white_material;
+  LampFrameStats stats;
+  auto frame = lampFrame(in, white_material, *white, std::nullopt, &stats);
+  ASSERT_TRUE(frame);
+  double hi = 0;
+  cv::minMaxLoc(frame->reshape(1), nullptr, &hi);
+  EXPECT_EQ(hi, 255);
+  EXPECT_EQ(stats.clipped_pixels, 0);
+  // Twice as bright cannot be given everywhere: the pixels that would need it are counted.
+  ASSERT_TRUE(lampFrame(in, white_material, 2 * *white, std::nullopt, &stats));
+  EXPECT_GT(stats.clipped_pixels, 0);
+}
+
+TEST(ShaderLampFrame, AppearanceTexturesLightsAndHighlights) {
+  Material m;
+  m.texture = cv::Mat(2, 2, CV_32FC3);
+  m.texture.at<cv::Vec3f>(0, 0) = {1, 0, 0};  // top left: v = 1, u = 0
+  m.texture.at<cv::Vec3f>(0, 1) = {0, 1, 0};
+  m.texture.at<cv::Vec3f>(1, 0) = {0, 0, 1};
+  m.texture.at<cv::Vec3f>(1, 1) = {1, 1, 1};
+  EXPECT_TRUE(textureAt(m.texture, Vec2(0.25, 0.75)).isApprox(Vec3(1, 0, 0)));
+  EXPECT_TRUE(textureAt(m.texture, Vec2(0.75, 0.25)).isApprox(Vec3(1, 1, 1)));
+  EXPECT_TRUE(textureAt(m.texture, Vec2(0.5, 0.75)).isApprox(Vec3(0.5, 0.5, 0)));
+  // A virtual light at 60 deg from the normal: ambient plus half the rest.
+  Material lambert;
+  lambert.light_dir = Vec3(std::sqrt(3.0), 0, 1);
+  lambert.ambient = 0.2;
+  const Vec3 up = Vec3::UnitZ();
+  EXPECT_TRUE(desiredRadiance(lambert, Vec3::Zero(), up, Vec2::Zero(), std::nullopt)
+                  .isApprox(Vec3::Constant(0.2 + 0.8 * 0.5)));
+  // Blinn-Phong: the full highlight for the eye in the mirror direction, less elsewhere,
+  // none without an eye.
+  Material glossy;
+  glossy.albedo_rgb = Vec3::Zero();
+  glossy.specular_rgb = Vec3::Constant(0.5);
+  glossy.light_dir = Vec3(1, 0, 1);
+  const Vec3 mirror(-3, 0, 3), aside(3, 0, 3);
+  EXPECT_NEAR(desiredRadiance(glossy, Vec3::Zero(), up, {}, mirror).x(), 0.5, 1e-12);
+  EXPECT_LT(desiredRadiance(glossy, Vec3::Zero(), up, {}, aside).x(), 0.05);
+  EXPECT_EQ(desiredRadiance(glossy, Vec3::Zero(), up, {}, std::nullopt).x(), 0.0);
+}
+
+TEST(ShaderLampFrame, BadInputIsRefused) {
+  const Lit r = lit();
+  LampFrameInput in{&r.view, &r.weight, {}};
+  Material ok;
+  EXPECT_TRUE(lampFrame(in, ok, 0.1, std::nullopt));
+  EXPECT_EQ(lampFrame(in, ok, 0.0, std::nullopt).error().code, ErrorCode::kInvalidInput);
+  EXPECT_EQ(lampFrame(in, ok, std::nan(""), std::nullopt).error().code, ErrorCode::kInvalidInput);
+  LampFrameInput bad = in;
+  bad.photometry.gamma = 0.5;
+  EXPECT_EQ(lampFrame(bad, ok, 0.1, std::nullopt).error().code, ErrorCode::kInvalidInput);
+  bad = in;
+  bad.photometry.gain_rgb = Vec3(1, 0, 1);
+  EXPECT_EQ(lampFrame(bad, ok, 0.1, std::nullopt).error().code, ErrorCode::kInvalidInput);
+  const cv::Mat small(10, 10, CV_32FC1, cv::Scalar(1));
+  bad = in;
+  bad.weight = &small;
+  EXPECT_EQ(lampFrame(bad, ok, 0.1, std::nullopt).error().code, ErrorCode::kInvalidInput);
+  Material m;
+  m.shininess = 0;
+  EXPECT_EQ(lampFrame(in, m, 0.1, std::nullopt).error().code, ErrorCode::kInvalidInput);
+  m = {};
+  m.texture = cv::Mat(4, 4, CV_8UC3, cv::Scalar::all(0));
+  EXPECT_EQ(lampFrame(in, m, 0.1, std::nullopt).error().code, ErrorCode::kInvalidInput);
+  m = {};
+  m.light_dir = Vec3::Zero();
+  EXPECT_EQ(lampFrame(in, m, 0.1, std::nullopt).error().code, ErrorCode::kInvalidInput);
+  const LampFrameInput none{};
+  EXPECT_EQ(lampFrame(none, ok, 0.1, std::nullopt).error().code, ErrorCode::kInvalidInput);
+}
+
+}  // namespace
+}  // namespace procam::lamps

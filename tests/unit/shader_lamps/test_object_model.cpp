@@ -1,0 +1,122 @@
+// The object model: shading normals smooth across a tessellated curve and across the
+// seams of its texture, sharp at a box's edges; texture coordinates interpolated.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "core/units.hpp"
+#include "lamp_rig.hpp"
+#include "shader_lamps/object_model.hpp"
+
+namespace procam::lamps {
+namespace {
+
+// A unit sphere in latitude-longitude quads whose seam column repeats its vertices (as a
+// textured mesh does), u = longitude / 2pi.
+struct SeamedSphere {
+  geom::TriangleMesh mesh;
+  std::vector<Vec2> uv;
+};
+
+SeamedSphere seamedSphere(int segments) {
+  SeamedSphere s;
+  const double pi = std::numbers::pi;
+  const int rings = segments / 2;
+  for (int j = 0; j <= rings; ++j) {
+    for (int i = 0; i <= segments; ++i) {
+      const double theta = pi * j / rings, phi = 2 * pi * i / segments;
+      s.mesh.vertices.emplace_back(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                                   std::cos(theta));
+      s.uv.emplace_back(static_cast<double>(i) / segments, 1 - static_cast<double>(j) / rings);
+    }
+  }
+  const auto at = [&](int i, int j) { return j * (segments + 1) + i; };
+  for (int j = 0; j < rings; ++j) {
+    for (int i = 0; i < segments; ++i) {
+      if (j > 0) s.mesh.faces.emplace_back(at(i, j), at(i + 1, j + 1), at(i + 1, j));
+      if (j + 1 < rings) s.mesh.faces.emplace_back(at(i, j), at(i, j + 1), at(i + 1, j + 1));
+    }
+  }
+  return s;
+}
+
+double angleDeg(const Vec3& a, const Vec3& b) {
+  return radToDeg(std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)));
+}
+
+TEST(ShaderLampObject, NormalsOfATessellatedSphereAreRadialAcrossItsSeam) {
+  SeamedSphere s = seamedSphere(32);
+  auto model = ObjectModel::build(s.mesh, s.uv);
+  ASSERT_TRUE(model) << model.error().message;
+  // Rays at the sphere from outside, at every longitude, through the seam at phi = 0.
+  double worst = 0, worst_seam = 0;
+  for (int k = 0; k < 720; ++k) {
+    const double phi = 2 * std::numbers::pi * (k + 0.5) / 720 - 0.05, z = 0.3;
+    const Vec3 aim(std::cos(phi), std::sin(phi), z);
+    const geom::Ray ray{3 * aim, -aim.normalized()};
+    const auto hit = model->intersect(ray);
+    ASSERT_TRUE(hit);
+    const double err = angleDeg(hit->normal, hit->point);
+    worst = std::max(worst, err);
+    if (std::abs(phi) < 0.05) worst_seam = std::max(worst_seam, err);
+  }
+  // Interpolated vertex normals of a 32-gon: a small fraction of its 11.25 deg facets.
+  EXPECT_LT(worst, 0.5);
+  EXPECT_LT(worst_seam, 0.5);
+  // Without welding the seam, its two columns would average over one side only: the
+  // normals there would lean by about half a facet.
+  std::printf("sphere normals: worst %.3f deg, at the seam %.3f deg\n", worst, worst_seam);
+}
+
+TEST(ShaderLampObject, ABoxKeepsItsEdges) {
+  // A unit cube from 8 shared vertices: every corner is shared by three faces at 90 deg.
+  geom::TriangleMesh cube;
+  for (int k = 0; k < 8; ++k) cube.vertices.emplace_back(k & 1, (k >> 1) & 1, (k >> 2) & 1);
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : quads) {
+    cube.faces.emplace_back(q[0], q[1], q[2]);
+    cube.faces.emplace_back(q[0], q[2], q[3]);
+  }
+  auto model = ObjectModel::build(cube);
+  ASSERT_TRUE(model);
+  // Near a corner of the top face (z = 1), the normal is still straight up.
+  const auto hit = model->intersect({Vec3(0.97, 0.02, 2), Vec3(0, 0, -1)});
+  ASSERT_TRUE(hit);
+  EXPECT_LT(angleDeg(hit->normal, Vec3::UnitZ()), 1e-9);
+  // With no crease at all every corner is averaged over its three faces.
+  auto smooth = ObjectModel::build(cube, {}, 180);
+  ASSERT_TRUE(smooth);
+  const auto corner = smooth->intersect({Vec3(0.999, 0.001, 2), Vec3(0, 0, -1)});
+  ASSERT_TRUE(corner);
+  EXPECT_GT(angleDeg(corner->normal, Vec3::UnitZ()), 30);
+}
+
+TEST(ShaderLampObject, TextureCoordinatesAreInterpolated) {
+  geom::TriangleMesh m = test::plate(1.0, 0.5, 1);  // 4 vertices: (i, j) at x, z
+  std::vector<Vec2> uv;
+  for (const Vec3& v : m.vertices) uv.emplace_back(v.x() + 0.5, v.z() + 0.5);
+  auto model = ObjectModel::build(m, uv);
+  ASSERT_TRUE(model);
+  EXPECT_TRUE(model->textured());
+  const auto hit = model->intersect({Vec3(0.1, 0, -0.2), Vec3(0, 1, 0)});
+  ASSERT_TRUE(hit);
+  EXPECT_NEAR(hit->texcoord.x(), 0.6, 1e-12);
+  EXPECT_NEAR(hit->texcoord.y(), 0.3, 1e-12);
+  EXPECT_LT(angleDeg(hit->normal, -Vec3::UnitY()), 1e-9);  // facing the ray
+}
+
+TEST(ShaderLampObject, BadModelsAreRefused) {
+  EXPECT_EQ(ObjectModel::build({}).error().code, ErrorCode::kInvalidInput);
+  geom::TriangleMesh m = test::plate(1.0, 0.5, 1);
+  EXPECT_EQ(ObjectModel::build(m, {Vec2(0, 0)}).error().code, ErrorCode::kInvalidInput);
+  EXPECT_EQ(ObjectModel::build(m, {}, 200).error().code, ErrorCode::kInvalidInput);
+  std::vector<Vec2> bad(m.vertices.size(), Vec2(std::nan(""), 0));
+  EXPECT_EQ(ObjectModel::build(m, bad).error().code, ErrorCode::kInvalidInput);
+  m.faces.emplace_back(0, 0, 1);  // no area
+  EXPECT_EQ(ObjectModel::build(m).error().code, ErrorCode::kDegenerate);
+}
+
+}  // namespace
+}  // namespace procam::lamps
