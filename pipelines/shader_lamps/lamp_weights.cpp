@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -15,13 +16,26 @@ Vec3 toVec(const cv::Vec3f& v) {
   return {v[0], v[1], v[2]};
 }
 
+// The dark margin inside a silhouette and around a depth discontinuity, in this
+// projector's pixels: the option's, plus the object's position error at its nearest.
+int marginPx(const LampView& v, const geom::CameraModel& m, const LampWeightOptions& o) {
+  if (!(o.position_error_m > 0)) return o.silhouette_margin_px;
+  double nearest = 0;
+  cv::Mat hit_distance = v.distance.clone();
+  hit_distance.setTo(std::numeric_limits<float>::max(), v.face < 0);
+  cv::minMaxLoc(hit_distance, &nearest);
+  if (!(nearest > 0) || nearest == std::numeric_limits<float>::max()) return o.silhouette_margin_px;
+  const double px = o.position_error_m * std::max(m.K.fx, m.K.fy) / nearest;
+  return o.silhouette_margin_px + static_cast<int>(std::min(std::ceil(px), 32.0));
+}
+
 // Pixels that light the object: a hit, not grazing, not within the margin of a miss.
-cv::Mat usablePixels(const LampView& v, const LampWeightOptions& o) {
+cv::Mat usablePixels(const LampView& v, const LampWeightOptions& o, int margin) {
   const float min_cos = static_cast<float>(std::cos(degToRad(o.max_incidence_deg)));
   cv::Mat hit = v.face >= 0;  // 255 / 0
   cv::Mat usable = hit & (v.cosine >= min_cos);
-  if (o.silhouette_margin_px > 0) {
-    const int k = 2 * o.silhouette_margin_px + 1;
+  if (margin > 0) {
+    const int k = 2 * margin + 1;
     cv::Mat inner;
     cv::erode(hit, inner, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(k, k)),
               cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(255));
@@ -112,6 +126,8 @@ Result<LampWeights> lampWeights(std::span<const Lamp> lamps, const LampWeightOpt
                 "the depth discontinuity angle must lie between the cut-off and 90 degrees");
   if (o.silhouette_margin_px < 0 || o.silhouette_margin_px > 16)
     return fail(ErrorCode::kInvalidInput, "the silhouette margin must lie in [0, 16] pixels");
+  if (!(o.position_error_m >= 0 && o.position_error_m <= 0.1))
+    return fail(ErrorCode::kInvalidInput, "the position error must lie in [0, 0.1] m");
   if (!(o.smoothing_px >= 0 && o.smoothing_px <= 16))
     return fail(ErrorCode::kInvalidInput, "the weight smoothing must lie in [0, 16] pixels");
   for (const Lamp& l : lamps) {
@@ -123,14 +139,15 @@ Result<LampWeights> lampWeights(std::span<const Lamp> lamps, const LampWeightOpt
   }
   LampWeights out;
   for (const Lamp& l : lamps) {
+    const int margin = marginPx(*l.view, *l.model, o);
     cv::Mat edges = depthEdges(*l.view, l.model->K.fx, o.discontinuity_deg);
-    if (o.silhouette_margin_px > 0) {
+    if (margin > 0) {
       // The same margin on both sides of a discontinuity: light meant for the near part
       // spreads onto the far one there, and the far part's onto the near one.
-      const int k = 2 * o.silhouette_margin_px + 1;
+      const int k = 2 * margin + 1;
       cv::dilate(edges, edges, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(k, k)));
     }
-    out.reach.push_back(edgeDistance(usablePixels(*l.view, o) & ~edges));
+    out.reach.push_back(edgeDistance(usablePixels(*l.view, o, margin) & ~edges));
   }
   // Feathering strength: the square of the reach, so a weight leaves zero with zero slope
   // instead of a kink; times how squarely the projector faces the point (0 at the cut-off,

@@ -34,6 +34,10 @@ struct LampWeightOptions {
   // the lens blur), so the last pixel whose centre meets the object would put light past
   // the edge, or onto the part behind it.
   int silhouette_margin_px = 1;
+  // How far the object's model may stand from the object (its placement's largest
+  // residual, or the calibration's): the margin grows by as many pixels as that is at the
+  // object's nearest point to the projector, so no light misses the object.
+  double position_error_m = 0;
   // Gaussian sigma, in pixels, smoothing each projector's feathering strength.
   double smoothing_px = 1.5;
 };
@@ -57,7 +61,7 @@ struct LampWeights {
 
 // kInvalidInput for no projectors, a missing model or view, a view whose size is not its
 // model's, or options out of range (cut-off in (0, 90), discontinuity in (cut-off, 90),
-// margin and smoothing in [0, 16]).
+// margin and smoothing in [0, 16], a position error outside [0, 0.1] m).
 Result<LampWeights> lampWeights(std::span<const Lamp> lamps, const LampWeightOptions& options = {});
 
 // Which projectors see a world point on the side its unit normal faces (the point is the

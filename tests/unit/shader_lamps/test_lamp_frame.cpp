@@ -7,6 +7,7 @@
 
 #include "lamp_rig.hpp"
 #include "shader_lamps/lamp_frame.hpp"
+#include "shader_lamps/lamp_gain.hpp"
 #include "shader_lamps/lamp_view.hpp"
 
 namespace procam::lamps {
@@ -152,6 +153,60 @@ TEST(ShaderLampFrame, BadInputIsRefused) {
   EXPECT_EQ(lampFrame(in, m, 0.1, std::nullopt).error().code, ErrorCode::kInvalidInput);
   const LampFrameInput none{};
   EXPECT_EQ(lampFrame(none, ok, 0.1, std::nullopt).error().code, ErrorCode::kInvalidInput);
+}
+
+}  // namespace
+}  // namespace procam::lamps
+
+namespace procam::lamps {
+namespace {
+
+// k·B from a camera's white and black captures of the plate: the camera's codes are
+// black + k·B cos θ / d² wherever the projector lights the plate.
+TEST(ShaderLampGain, WhiteMinusBlackTimesDistanceSquaredOverCosine) {
+  auto plate = ObjectModel::build(test::plate(2.0, 2.0, 4));
+  ASSERT_TRUE(plate);
+  const geom::CameraModel projector = test::projectorAt(Vec3(-0.5, 0, 0.1), Vec3(0, 2, 0));
+  const geom::CameraModel camera = test::projectorAt(Vec3(0.4, 0.2, -0.1), Vec3(0, 2, 0));
+  auto view = castLampView(projector, *plate);
+  ASSERT_TRUE(view);
+  const Lamp lamps[] = {{&projector, &*view, true}};
+  auto weights = lampWeights(lamps);
+  ASSERT_TRUE(weights);
+  const Vec3 gain(9000, 11000, 13000);  // R, G, B
+  cv::Mat white(camera.height, camera.width, CV_16UC3, cv::Scalar::all(100));
+  const cv::Mat black = white.clone();
+  for (int y = 0; y < camera.height; ++y) {
+    for (int x = 0; x < camera.width; ++x) {
+      const auto ray = camera.backproject(Vec2(x, y));
+      const auto s = plate->intersect(*ray);
+      if (!s) continue;
+      const auto q = projector.project(s->point);
+      if (!q || !projector.inImage(*q)) continue;
+      const Vec3 to = projector.pose.center() - s->point;
+      const Vec3 v = gain * s->normal.dot(to.normalized()) / to.squaredNorm();
+      white.at<cv::Vec3w>(y, x) += cv::Vec3w(static_cast<std::uint16_t>(std::lround(v.z())),
+                                             static_cast<std::uint16_t>(std::lround(v.y())),
+                                             static_cast<std::uint16_t>(std::lround(v.x())));
+    }
+  }
+  const GainCapture capture{&camera, white, black, 65535, 2};
+  auto m = measureLampGain(lamps, *weights, 0, *plate, capture);
+  ASSERT_TRUE(m) << m.error().message;
+  EXPECT_GT(m->samples, 5000);
+  // Codes rounded to one in about 2500: the median is within a few in 10^4.
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(m->gain_rgb[c], gain[c], 1e-3 * gain[c]);
+  EXPECT_LT(m->spread, 1e-3);
+  // No light: nothing to measure. Wrong images or index: refused.
+  EXPECT_EQ(
+      measureLampGain(lamps, *weights, 0, *plate, {&camera, black, black, 65535, 2}).error().code,
+      ErrorCode::kTooFewPoints);
+  EXPECT_EQ(measureLampGain(lamps, *weights, 1, *plate, capture).error().code,
+            ErrorCode::kInvalidInput);
+  const cv::Mat small(10, 10, CV_16UC3, cv::Scalar::all(0));
+  EXPECT_EQ(
+      measureLampGain(lamps, *weights, 0, *plate, {&camera, small, small, 65535, 2}).error().code,
+      ErrorCode::kInvalidInput);
 }
 
 }  // namespace

@@ -158,6 +158,28 @@ TEST(ShaderLampWeights, DepthDiscontinuitiesAreEdges) {
   }
 }
 
+TEST(ShaderLampWeights, APositionErrorWidensTheDarkMargin) {
+  auto plate = ObjectModel::build(test::plate(2.0, 0.5, 2));
+  ASSERT_TRUE(plate);
+  const geom::CameraModel p = test::projectorAt(Vec3::Zero(), Vec3(0, 2, 0));
+  auto view = castLampView(p, *plate);
+  ASSERT_TRUE(view);
+  const Lamp lamps[] = {{&p, &*view, true}};
+  // The plate's edge |x| = 0.5 at 2 m: between pixels 99 and 100 (199.5 - 100).
+  LampWeightOptions o;
+  auto exact = lampWeights(lamps, o);
+  o.position_error_m = 0.01;  // 2 pixels at 2 m with f = 400
+  auto loose = lampWeights(lamps, o);
+  ASSERT_TRUE(exact && loose);
+  const int y = 150;
+  EXPECT_EQ(exact->reach[0].at<float>(y, 100), 0.f);  // the one-pixel margin
+  EXPECT_GT(exact->reach[0].at<float>(y, 101), 0.f);
+  for (int x = 100; x <= 102; ++x) EXPECT_EQ(loose->reach[0].at<float>(y, x), 0.f) << x;
+  EXPECT_GT(loose->reach[0].at<float>(y, 103), 0.f);
+  o.position_error_m = 1;
+  EXPECT_EQ(lampWeights(lamps, o).error().code, ErrorCode::kInvalidInput);
+}
+
 TEST(ShaderLampWeights, ASwitchedOffProjectorLeavesAReportedHole) {
   const TwoLamps r = twoLamps();
   const Lamp both[] = {{&r.a, &r.va, true}, {&r.b, &r.vb, true}};

@@ -8,6 +8,7 @@
 #include "core/units.hpp"
 #include "lamp_rig.hpp"
 #include "shader_lamps/object_model.hpp"
+#include "shader_lamps/object_placement.hpp"
 
 namespace procam::lamps {
 namespace {
@@ -116,6 +117,43 @@ TEST(ShaderLampObject, BadModelsAreRefused) {
   EXPECT_EQ(ObjectModel::build(m, bad).error().code, ErrorCode::kInvalidInput);
   m.faces.emplace_back(0, 0, 1);  // no area
   EXPECT_EQ(ObjectModel::build(m).error().code, ErrorCode::kDegenerate);
+}
+
+}  // namespace
+}  // namespace procam::lamps
+
+namespace procam::lamps {
+namespace {
+
+TEST(ShaderLampPlacement, FourOrMorePointsPlaceTheModel) {
+  const Mat3 R = (Eigen::AngleAxisd(0.4, Vec3(1, 2, 3).normalized())).toRotationMatrix();
+  const Vec3 t(0.3, 1.2, -0.4);
+  const std::vector<Vec3> model = {
+      {0, 0, 0}, {0.3, 0, 0}, {0, 0.2, 0}, {0, 0, 0.25}, {0.3, 0.2, 0.25}};
+  std::vector<Vec3> world;
+  for (const Vec3& p : model) world.push_back(R * p + t);
+  world[4].x() += 0.002;  // one point picked 2 mm off
+  auto placement = placeObject(model, world);
+  ASSERT_TRUE(placement) << placement.error().message;
+  EXPECT_LT((placement->R - R).norm(), 0.02);
+  EXPECT_LT((placement->t - t).norm(), 0.002);
+  EXPECT_GT(placement->max_m, 0.001);  // the mis-picked point shows in the residual
+  EXPECT_LT(placement->max_m, 0.002);
+  geom::TriangleMesh mesh;
+  mesh.vertices = model;
+  mesh.faces.emplace_back(0, 1, 2);
+  const geom::TriangleMesh placed = placedMesh(mesh, *placement);
+  EXPECT_LT((placed.vertices[3] - (R * model[3] + t)).norm(), 0.002);
+
+  const std::vector<Vec3> three(model.begin(), model.begin() + 3);
+  EXPECT_EQ(placeObject(three, std::vector<Vec3>(world.begin(), world.begin() + 3)).error().code,
+            ErrorCode::kTooFewPoints);
+  EXPECT_EQ(placeObject(model, three).error().code, ErrorCode::kInvalidInput);
+  const std::vector<Vec3> line = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 0, 0}};
+  EXPECT_EQ(placeObject(line, line).error().code, ErrorCode::kDegenerate);
+  std::vector<Vec3> bad = model;
+  bad[0].x() = std::nan("");
+  EXPECT_EQ(placeObject(bad, world).error().code, ErrorCode::kInvalidInput);
 }
 
 }  // namespace
