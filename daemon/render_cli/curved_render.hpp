@@ -27,9 +27,9 @@ struct CurvedRenderInput {
 };
 
 // Draws every share (with `out`), writes the MPCDI package (with `mpcdi`) and returns
-// display.json's document (without the rig and content entries the caller adds). kNotFound without a viewer or a projector with a pose and a
-// mesh; kInvalidInput for a mesh named outside the rig file's folder; errors of reading
-// the meshes and of blend::makeCurvedBlend.
+// display.json's document (without the rig and content entries the caller adds). kNotFound without
+// a viewer or a projector with a pose and a mesh; kInvalidInput for a mesh named outside the rig
+// file's folder; errors of reading the meshes and of blend::makeCurvedBlend.
 Result<nlohmann::json> renderCurved(const CurvedRenderInput& in);
 
 }  // namespace procam::render_cli

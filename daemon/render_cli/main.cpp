@@ -37,7 +37,15 @@ static int run(int argc, char** argv) {
   const auto& display = (*done)["display"];
   const char* sep = parsed->out.empty() ? "" : ", ";
   const std::string json_file = parsed->out.empty() ? "" : (parsed->out / "display.json").string();
-  if (display.value("surface", "") == "mesh") {
+  if (display.value("surface", "") == "object") {
+    const auto& c = display["coverage"];
+    std::printf(
+        "object: white %.6g (%s); lit %.4f m2, unlit %.4f m2 (projectors off), no "
+        "projector reaches %.4f m2%s%s\n",
+        display["white"].get<double>(), display["units"].get<std::string>().c_str(),
+        c["lit_m2"].get<double>(), c["unlit_m2"].get<double>(), c["never_lit_m2"].get<double>(),
+        sep, json_file.c_str());
+  } else if (display.value("surface", "") == "mesh") {
     // A curved display: its field of view as the viewer sees it (the rectangle on the
     // eye's plane z = 1, possibly off its axis).
     const auto& rect = display["rect_tan"];

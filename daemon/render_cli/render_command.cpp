@@ -14,6 +14,7 @@
 #include "curved_render.hpp"
 #include "json_matrix.hpp"
 #include "mpcdi_zip.hpp"
+#include "object_render.hpp"
 #include "replace_file.hpp"
 #include "rig/rig_model.hpp"
 
@@ -100,9 +101,19 @@ Result<RenderArgs> parseRenderArgs(const std::vector<std::string>& args) {
   RenderArgs a;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& opt = args[i];
-    const bool takes_value = opt == "--rig" || opt == "--content" || opt == "--out" ||
-                             opt == "--rect" || opt == "--bit-depth" || opt == "--projector" ||
-                             opt == "--mpcdi" || opt == "--viewer";
+    const bool takes_value =
+        opt == "--rig" || opt == "--content" || opt == "--out" || opt == "--rect" ||
+        opt == "--bit-depth" || opt == "--projector" || opt == "--mpcdi" || opt == "--viewer" ||
+        opt == "--object" || opt == "--texture" || opt == "--off" || opt == "--light" ||
+        opt == "--specular" || opt == "--shininess" || opt == "--max-incidence" || opt == "--white";
+    const auto number = [&](double lo, double hi) -> Result<double> {
+      auto v = numberList(args[++i], 1, opt);
+      if (!v) return tl::unexpected(v.error());
+      if (!((*v)[0] >= lo && (*v)[0] <= hi))
+        return fail(ErrorCode::kInvalidInput,
+                    opt + " must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+      return (*v)[0];
+    };
     if (takes_value && i + 1 >= args.size())
       return fail(ErrorCode::kInvalidInput, opt + " needs a value");
     if (opt == "--rig") {
@@ -131,10 +142,48 @@ Result<RenderArgs> parseRenderArgs(const std::vector<std::string>& args) {
       a.projectors.push_back(args[++i]);
     } else if (opt == "--mpcdi") {
       a.mpcdi = args[++i];
+    } else if (opt == "--object") {
+      a.object = args[++i];
+    } else if (opt == "--texture") {
+      a.texture = args[++i];
+    } else if (opt == "--off") {
+      a.off.push_back(args[++i]);
+    } else if (opt == "--light") {
+      auto v = numberList(args[++i], 3, "--light");
+      if (!v) return tl::unexpected(v.error());
+      a.light = Vec3((*v)[0], (*v)[1], (*v)[2]);
+      if (!(a.light->norm() > 0))
+        return fail(ErrorCode::kInvalidInput, "--light must be a non-zero direction");
+    } else if (opt == "--specular") {
+      auto v = number(0, 1);
+      if (!v) return tl::unexpected(v.error());
+      a.specular = *v;
+    } else if (opt == "--shininess") {
+      auto v = number(1, 10000);
+      if (!v) return tl::unexpected(v.error());
+      a.shininess = *v;
+    } else if (opt == "--max-incidence") {
+      auto v = number(1, 89);
+      if (!v) return tl::unexpected(v.error());
+      a.max_incidence_deg = *v;
+    } else if (opt == "--white") {
+      auto v = number(1e-12, 1e12);
+      if (!v) return tl::unexpected(v.error());
+      a.white = *v;
     } else {
       return fail(ErrorCode::kInvalidInput, "unknown option '" + opt + "'");
     }
   }
+  if (!a.object.empty()) {
+    if (a.rig.empty() || a.out.empty())
+      return fail(ErrorCode::kInvalidInput, "--object needs --rig and --out");
+    if (!a.content.empty() || !a.mpcdi.empty() || a.rect || a.geometry_only)
+      return fail(ErrorCode::kInvalidInput,
+                  "--object takes --texture, not --content, --mpcdi, --rect or --geometry-only");
+    return a;
+  }
+  if (!a.texture.empty() || !a.off.empty() || a.light || a.white)
+    return fail(ErrorCode::kInvalidInput, "--texture, --off, --light and --white are for --object");
   if (a.rig.empty() || a.content.empty() || (a.out.empty() && a.mpcdi.empty()))
     return fail(ErrorCode::kInvalidInput, "--rig, --content and --out or --mpcdi are required");
   return a;
@@ -176,6 +225,35 @@ Result<json> runCurved(const RenderArgs& args, const rig::RigModel& rig) {
   return doc;
 }
 
+Result<json> runObject(const RenderArgs& args, const rig::RigModel& rig) {
+  ObjectRenderInput in;
+  in.rig = &rig;
+  in.object = args.object;
+  if (!args.texture.empty()) {
+    auto texture = readContent(args.texture);
+    if (!texture) return tl::unexpected(texture.error());
+    in.texture = *texture;
+  }
+  in.projectors = args.projectors;
+  in.off = args.off;
+  in.viewer = args.viewer;
+  in.light = args.light;
+  in.specular = args.specular;
+  in.shininess = args.shininess;
+  in.max_incidence_deg = args.max_incidence_deg;
+  in.white = args.white;
+  in.out = args.out;
+  in.bit_depth = args.bit_depth;
+  auto doc = renderObject(in);
+  if (!doc) return tl::unexpected(doc.error());
+  (*doc)["rig"] = args.rig.string();
+  if (!args.texture.empty()) (*doc)["object"]["texture"] = args.texture.string();
+  (*doc)["bit_depth"] = args.bit_depth;
+  if (auto ok = replaceFileWith(args.out / "display.json", doc->dump(2) + "\n"); !ok)
+    return tl::unexpected(ok.error());
+  return doc;
+}
+
 }  // namespace
 
 Result<json> runRender(const RenderArgs& args) {
@@ -183,6 +261,7 @@ Result<json> runRender(const RenderArgs& args) {
   if (!text) return tl::unexpected(text.error());
   auto rig = rig::rigFromText(*text, args.rig.string());
   if (!rig) return tl::unexpected(rig.error());
+  if (!args.object.empty()) return runObject(args, *rig);
 
   // The projectors of the display, in rig order.
   std::vector<const rig::RigProjector*> chosen;

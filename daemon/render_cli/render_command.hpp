@@ -41,6 +41,23 @@ inline constexpr const char* kUsage =
     "                     the content image gives the buffer's size (a curved display's\n"
     "                     warps hold the viewer's image: right for that viewer)\n"
     "  --help             this text\n"
+    "object (shader lamps, [Raskar02] 5.2): procam-render --rig RIG.json --object MESH\n"
+    "    [--texture IMAGE] --out DIR [options]\n"
+    "  Paints a neutral object: MESH (PLY with vertex u v texture coordinates, or OBJ) in\n"
+    "  the rig's world; IMAGE (sRGB) its look (white without one). Each posed projector's\n"
+    "  frame is the look corrected for distance and angle (I = L d^2 / (k cos theta)),\n"
+    "  feathered across projectors (frame edges, silhouette, grazing cut-off, depth\n"
+    "  discontinuities), through its measured response; k is from its measured\n"
+    "  brightness (rig.json photometric) or taken equal. display.json gives the white\n"
+    "  level, its units and the coverage: the area lit, the area left unlit by projectors\n"
+    "  switched off, the area no projector reaches.\n"
+    "  --off NAME         a projector switched off (repeatable): the others take over\n"
+    "  --viewer X,Y,Z     the eye the highlight is shaded for\n"
+    "  --specular S       grey Blinn-Phong highlight, 0..1 (default 0)\n"
+    "  --shininess N      its exponent (default 32)\n"
+    "  --light X,Y,Z      direction towards a virtual light (default: evenly lit)\n"
+    "  --max-incidence D  grazing cut-off in degrees (default 60)\n"
+    "  --white L          the white level (default: the brightest every projector gives)\n"
     "Exit status: 0 success, 1 failure, 2 bad command line.\n";
 
 struct RenderArgs {
@@ -51,6 +68,12 @@ struct RenderArgs {
   std::vector<std::string> projectors;
   std::filesystem::path mpcdi;  // empty: no MPCDI export
   std::optional<Vec3> viewer;   // a curved display's eye
+  // An object to paint (shader lamps) instead of a display.
+  std::filesystem::path object, texture;
+  std::vector<std::string> off;
+  std::optional<Vec3> light;
+  double specular = 0, shininess = 32, max_incidence_deg = 60;
+  std::optional<double> white;
 };
 
 // kInvalidInput (with the reason) for a bad command line.

@@ -43,14 +43,17 @@ Result<double> lampWhiteLevel(std::span<const LampFrameInput> lamps) {
 }
 
 Result<cv::Mat> lampFrame(const LampFrameInput& l, const Material& material, double white,
-                          const std::optional<Vec3>& eye, LampFrameStats* stats) {
+                          const std::optional<Vec3>& eye, LampFrameStats* stats, int bit_depth) {
+  if (bit_depth != 8 && bit_depth != 16)
+    return fail(ErrorCode::kInvalidInput, "frames are 8 or 16 bits deep");
   if (auto ok = checkInput(l); !ok) return tl::unexpected(ok.error());
   if (auto ok = checkMaterial(material); !ok) return tl::unexpected(ok.error());
   if (!(std::isfinite(white) && white > 0))
     return fail(ErrorCode::kInvalidInput, "the white level must be finite and positive");
   if (eye && !eye->allFinite()) return fail(ErrorCode::kInvalidInput, "the eye is not finite");
   const LampView& v = *l.view;
-  cv::Mat frame(v.size, CV_8UC3, cv::Scalar::all(0));
+  cv::Mat frame(v.size, bit_depth == 8 ? CV_8UC3 : CV_16UC3, cv::Scalar::all(0));
+  const double top = bit_depth == 8 ? 255 : 65535;
   const double inv_gamma = 1 / l.photometry.gamma;
   const Vec3 gain = l.photometry.gain_rgb;
   std::atomic<long> lit{0}, clipped{0};
@@ -70,10 +73,12 @@ Result<cv::Mat> lampFrame(const LampFrameInput& l, const Material& material, dou
         const Vec3 I = (w * d * d / c) * L.cwiseQuotient(gain);
         ++row_lit;
         row_clipped += I.maxCoeff() > 1 + 1e-6;
-        cv::Vec3b& out = frame.at<cv::Vec3b>(y, x);
         for (int k = 0; k < 3; ++k) {
-          const double code = 255 * std::pow(std::clamp(I[k], 0.0, 1.0), inv_gamma);
-          out[2 - k] = static_cast<std::uint8_t>(std::lround(code));  // BGR
+          const double code = top * std::pow(std::clamp(I[k], 0.0, 1.0), inv_gamma);
+          if (bit_depth == 8)
+            frame.at<cv::Vec3b>(y, x)[2 - k] = static_cast<std::uint8_t>(std::lround(code));
+          else
+            frame.at<cv::Vec3w>(y, x)[2 - k] = static_cast<std::uint16_t>(std::lround(code));
         }
       }
     }

@@ -38,11 +38,13 @@ struct LampFrameInput {
 // lit pixels and channels. kNotFound when no pixel lights the object.
 Result<double> lampWhiteLevel(std::span<const LampFrameInput> lamps);
 
-// The frame, CV_8UC3 (BGR), the view's size. `white`: the radiance of L = 1 (> 0);
-// `eye`: the viewer, for the view-dependent (specular) part. kInvalidInput for a
-// missing view or weight, mismatched sizes, a white level or gain that is not finite and
-// positive, a gamma outside [1, 4] or a bad material.
+// The frame, BGR, the view's size: CV_8UC3, or CV_16UC3 with `bit_depth` 16. `white`:
+// the radiance of L = 1 (> 0); `eye`: the viewer, for the view-dependent (specular)
+// part. kInvalidInput for a missing view or weight, mismatched sizes, a white level or
+// gain that is not finite and positive, a gamma outside [1, 4], a bit depth other than 8
+// or 16 or a bad material.
 Result<cv::Mat> lampFrame(const LampFrameInput& lamp, const Material& material, double white,
-                          const std::optional<Vec3>& eye, LampFrameStats* stats = nullptr);
+                          const std::optional<Vec3>& eye, LampFrameStats* stats = nullptr,
+                          int bit_depth = 8);
 
 }  // namespace procam::lamps

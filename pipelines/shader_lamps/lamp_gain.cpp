@@ -85,4 +85,33 @@ Result<GainMeasurement> measureLampGain(std::span<const Lamp> lamps, const LampW
   return out;
 }
 
+Result<GainMeasurement> gainFromBrightness(const LampView& view, const cv::Mat& reach,
+                                           const std::function<double(const Vec2&)>& brightness,
+                                           double inside_px) {
+  if (reach.size() != view.size || reach.type() != CV_32FC1)
+    return fail(ErrorCode::kInvalidInput, "the reach does not match the projector's view");
+  std::vector<double> gains;
+  // Every other pixel: the map's nodes are tens of pixels apart.
+  for (int y = 0; y < view.size.height; y += 2) {
+    for (int x = 0; x < view.size.width; x += 2) {
+      if (reach.at<float>(y, x) < inside_px) continue;
+      const double d = view.distance.at<float>(y, x), c = view.cosine.at<float>(y, x);
+      const double b = brightness(Vec2(x, y));
+      if (!(c > 0) || !(b > 0) || !std::isfinite(b)) continue;
+      gains.push_back(b * d * d / c);
+    }
+  }
+  if (static_cast<long>(gains.size()) < kMinSamples)
+    return fail(ErrorCode::kTooFewPoints, "the projector lights the object at only " +
+                                              std::to_string(gains.size()) +
+                                              " pixels with a brightness");
+  GainMeasurement out;
+  out.samples = static_cast<long>(gains.size());
+  const double g = median(gains);
+  out.gain_rgb = Vec3::Constant(g);
+  for (double& v : gains) v = std::abs(v - g);
+  out.spread = median(gains) / g;
+  return out;
+}
+
 }  // namespace procam::lamps

@@ -7,6 +7,7 @@
 // white level and the appearance are then in the same units. The camera must be linear
 // (response gamma 1) and its captures unsaturated where they count; the rig's geometry
 // (camera pose, projector pose, object) comes from the rig model.
+#include <functional>
 #include <opencv2/core.hpp>
 #include <span>
 
@@ -37,5 +38,16 @@ struct GainCapture {
 Result<GainMeasurement> measureLampGain(std::span<const Lamp> lamps, const LampWeights& weights,
                                         std::size_t index, const ObjectModel& object,
                                         const GainCapture& capture);
+
+// The same from a projector's brightness across its frame as a rig's calibration keeps it
+// (white minus black seen by a camera at each framebuffer pixel, in that camera's units,
+// one channel): the median of brightness · d² / cos θ_P over the pixels that light the
+// object at least `inside_px` inside their reach (the map is interpolated between nodes
+// that may straddle the object's edge; the median keeps to the object's own). Grey: the
+// object's colour is not in it. kTooFewPoints under 50 such pixels; kInvalidInput for a
+// reach of another size.
+Result<GainMeasurement> gainFromBrightness(const LampView& view, const cv::Mat& reach,
+                                           const std::function<double(const Vec2&)>& brightness,
+                                           double inside_px = 3);
 
 }  // namespace procam::lamps

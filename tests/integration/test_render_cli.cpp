@@ -54,17 +54,7 @@ Rig trueTiledWall(const TempDir& dir) {
   Rig r{*scene, scene->at(0), ""};
   auto rig = sim::truthRig(r.scene, 0.0);
   EXPECT_TRUE(rig);
-  for (auto& p : rig->projectors) {
-    for (std::size_t i = 0; i < r.state.projectors.size(); ++i) {
-      const auto& s = r.state.projectors[i];
-      if (s.spec.name != p.name) continue;
-      p.photometric = {{"response_gamma", s.spec.gamma},
-                       {"black", 0.0},
-                       {"white", s.spec.brightness},
-                       {"brightness", blend::brightnessToJson(trueBrightness(r.scene, r.state, i))},
-                       {"camera", "truth"}};
-    }
-  }
+  addTruePhotometry(r.scene, r.state, *rig);
   dir.write("rig.json", rig::rigToJson(*rig).dump(2) + "\n");
   r.file = dir.file("rig.json");
   return r;

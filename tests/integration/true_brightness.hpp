@@ -7,6 +7,7 @@
 
 #include "blend/brightness_map.hpp"
 #include "render/viewer_view.hpp"
+#include "rig/rig_model.hpp"
 #include "sim/scene.hpp"
 
 namespace procam::itest {
@@ -38,6 +39,24 @@ inline blend::BrightnessMap trueBrightness(const sim::Scene& scene, const sim::S
     }
   }
   return map;
+}
+
+// Each projector of `rig` (the scene's true rig) with its true response and brightness
+// across its frame as its photometric record: black 0, white its brightness, what a
+// linear camera ("truth") would measure.
+inline void addTruePhotometry(const sim::Scene& scene, const sim::SceneState& state,
+                              rig::RigModel& rig) {
+  for (auto& p : rig.projectors) {
+    for (std::size_t i = 0; i < state.projectors.size(); ++i) {
+      const auto& s = state.projectors[i];
+      if (s.spec.name != p.name) continue;
+      p.photometric = {{"response_gamma", s.spec.gamma},
+                       {"black", 0.0},
+                       {"white", s.spec.brightness},
+                       {"brightness", blend::brightnessToJson(trueBrightness(scene, state, i))},
+                       {"camera", "truth"}};
+    }
+  }
 }
 
 }  // namespace procam::itest

@@ -211,3 +211,52 @@ TEST(ShaderLampGain, WhiteMinusBlackTimesDistanceSquaredOverCosine) {
 
 }  // namespace
 }  // namespace procam::lamps
+
+namespace procam::lamps {
+namespace {
+
+// k·B from a brightness map: brightness = k·B cos θ / d² wherever the projector lights
+// the plate gives k·B back, grey.
+TEST(ShaderLampGain, FromABrightnessMap) {
+  const Lit r = lit();
+  const Lamp lamps[] = {{&r.p, &r.view, true}};
+  auto weights = lampWeights(lamps);
+  ASSERT_TRUE(weights);
+  const auto brightness = [&](const Vec2& px) {
+    const int x = static_cast<int>(px.x()), y = static_cast<int>(px.y());
+    const double d = r.view.distance.at<float>(y, x);
+    return 250.0 * r.view.cosine.at<float>(y, x) / (d * d);
+  };
+  auto gain = gainFromBrightness(r.view, weights->reach[0], brightness);
+  ASSERT_TRUE(gain) << gain.error().message;
+  EXPECT_NEAR(gain->gain_rgb.x(), 250, 1e-6 * 250);
+  EXPECT_EQ(gain->gain_rgb.x(), gain->gain_rgb.z());
+  const auto none = [](const Vec2&) { return 0.0; };
+  EXPECT_EQ(gainFromBrightness(r.view, weights->reach[0], none).error().code,
+            ErrorCode::kTooFewPoints);
+}
+
+TEST(ShaderLampFrame, SixteenBitFramesKeepTheFinerCodes) {
+  const Lit r = lit();
+  LampFrameInput in{&r.view, &r.weight, {}};
+  auto level = lampWhiteLevel(std::span<const LampFrameInput>(&in, 1));
+  ASSERT_TRUE(level);
+  Material grey;
+  grey.albedo_rgb = Vec3::Constant(0.3);
+  auto frame = lampFrame(in, grey, *level, std::nullopt, nullptr, 16);
+  ASSERT_TRUE(frame);
+  ASSERT_EQ(frame->type(), CV_16UC3);
+  for (int y = 0; y < 300; y += 11) {
+    for (int x = 0; x < 400; x += 11) {
+      if (r.view.face.at<int>(y, x) < 0) continue;
+      const double d = r.view.distance.at<float>(y, x), c = r.view.cosine.at<float>(y, x);
+      const double want = *level * 0.3 * d * d / c;
+      EXPECT_NEAR(frame->at<cv::Vec3w>(y, x)[1], 65535 * std::pow(want, 1 / 2.2), 0.5 + 0.05);
+    }
+  }
+  EXPECT_EQ(lampFrame(in, grey, *level, std::nullopt, nullptr, 12).error().code,
+            ErrorCode::kInvalidInput);
+}
+
+}  // namespace
+}  // namespace procam::lamps

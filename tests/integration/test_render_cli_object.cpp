@@ -1,0 +1,219 @@
+// procam-render --object on the virtual rig's object_box (two projectors, shader lamps,
+// [Raskar02] §5.2), from the scene's true rig handed over explicitly with each
+// projector's true response and brightness across its frame as its photometric record
+// (grey: the brightness map holds the surface's mean albedo, so colour is judged as
+// luminance), and the box's model as a PLY with texture coordinates:
+//  - the frames lighting the scene, seen from the scene's viewer in linear light, give
+//    the texture at the white level display.json reports;
+//  - a projector switched off: its frame dark, the part only it lit reported unlit;
+//  - bad input: clear errors.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "blend/brightness_map.hpp"
+#include "daemon_harness.hpp"
+#include "object_meshes.hpp"
+#include "object_render.hpp"
+#include "render_command.hpp"
+#include "rig/rig_model.hpp"
+#include "shader_lamps/appearance.hpp"
+#include "shader_lamps/object_model.hpp"
+#include "sim/renderer.hpp"
+#include "sim/scene_library.hpp"
+#include "sim/truth_rig.hpp"
+#include "true_brightness.hpp"
+
+namespace procam::itest {
+namespace {
+
+using nlohmann::json;
+
+const Vec3 kBoxCentre(0.1, 1.5, 0.875), kBoxSize(0.3, 0.2, 0.25);
+
+struct BoxRig {
+  sim::Scene scene;
+  sim::SceneState state;
+  std::string rig, mesh, texture;
+};
+
+double luma(const Vec3& rgb) {
+  return 0.2126 * rgb.x() + 0.7152 * rgb.y() + 0.0722 * rgb.z();
+}
+
+BoxRig boxRig(const TempDir& dir) {
+  auto scene = sim::resolveScene("object_box");
+  EXPECT_TRUE(scene);
+  BoxRig r{*scene, scene->at(0), "", "", ""};
+  auto rig = sim::truthRig(r.scene, 0.0);
+  EXPECT_TRUE(rig);
+  addTruePhotometry(r.scene, r.state, *rig);
+  dir.write("rig.json", rig::rigToJson(*rig).dump(2) + "\n");
+  r.rig = dir.file("rig.json");
+  // The box's model with its texture atlas, as an ASCII PLY.
+  const ObjectMesh box = boxMesh(kBoxCentre, kBoxSize, 0.01);
+  std::ostringstream ply;
+  ply << "ply\nformat ascii 1.0\nelement vertex " << box.mesh.vertices.size()
+      << "\nproperty double x\nproperty double y\nproperty double z\nproperty double u\n"
+         "property double v\nelement face "
+      << box.mesh.faces.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
+  ply.precision(17);
+  for (std::size_t v = 0; v < box.mesh.vertices.size(); ++v) {
+    const Vec3& x = box.mesh.vertices[v];
+    ply << x.x() << ' ' << x.y() << ' ' << x.z() << ' ' << box.uv[v].x() << ' ' << box.uv[v].y()
+        << '\n';
+  }
+  for (const auto& f : box.mesh.faces) ply << "3 " << f[0] << ' ' << f[1] << ' ' << f[2] << '\n';
+  dir.write("box.ply", ply.str());
+  r.mesh = dir.file("box.ply");
+  // A smooth texture, sRGB-encoded.
+  cv::Mat texture(256, 256, CV_8UC3);
+  const double pi = std::numbers::pi;
+  for (int y = 0; y < 256; ++y) {
+    for (int x = 0; x < 256; ++x) {
+      const double u = (x + 0.5) / 256, v = 1 - (y + 0.5) / 256;
+      const double rgb[3] = {0.55 + 0.3 * std::sin(2 * pi * (2 * u + v)),
+                             0.5 + 0.3 * std::cos(2 * pi * (u - 2 * v)),
+                             0.45 + 0.25 * std::sin(6 * pi * v)};
+      for (int c = 0; c < 3; ++c) {
+        const double l = rgb[c];
+        const double e = l <= 0.0031308 ? 12.92 * l : 1.055 * std::pow(l, 1 / 2.4) - 0.055;
+        texture.at<cv::Vec3b>(y, x)[2 - c] = static_cast<std::uint8_t>(std::lround(255 * e));
+      }
+    }
+  }
+  EXPECT_TRUE(cv::imwrite(dir.file("look.png"), texture));
+  r.texture = dir.file("look.png");
+  return r;
+}
+
+Result<json> run(const std::vector<std::string>& args) {
+  auto parsed = render_cli::parseRenderArgs(args);
+  if (!parsed) return tl::unexpected(parsed.error());
+  return render_cli::runRender(*parsed);
+}
+
+// What the viewer sees of the box lit by the frames in DIR against white · texture, as
+// luminance: the mean relative error over box pixels two in from its outline on one face.
+double appearanceError(const BoxRig& r, const std::string& dir, double white, long* judged) {
+  sim::Framebuffers frames;
+  for (const auto& p : r.state.projectors)
+    frames[p.spec.name] = cv::imread(dir + "/" + p.spec.name + ".png", cv::IMREAD_UNCHANGED);
+  auto lit = sim::Renderer::create(r.scene, r.state, frames);
+  auto dark = sim::Renderer::create(r.scene, r.state, {});
+  EXPECT_TRUE(lit && dark);
+  if (!lit || !dark) return 1;
+  const cv::Mat seen = lit->renderViewer(4) - dark->renderViewer(4);
+  const ObjectMesh box = boxMesh(kBoxCentre, kBoxSize, 0.01);
+  auto model = lamps::ObjectModel::build(box.mesh, box.uv);
+  EXPECT_TRUE(model);
+  const cv::Mat texture = render_cli::linearTexture(cv::imread(r.texture, cv::IMREAD_UNCHANGED));
+  const geom::CameraModel& eye = r.state.viewer;
+  cv::Mat group(eye.height, eye.width, CV_32SC1, cv::Scalar(-1));
+  std::vector<double> target(static_cast<std::size_t>(eye.width * eye.height), 0);
+  for (int y = 0; y < eye.height; ++y) {
+    for (int x = 0; x < eye.width; ++x) {
+      const sim::PixelTruth t = lit->truthAt(eye, Vec2(x, y));
+      if (!t.hit || r.scene.world().surfaces()[static_cast<std::size_t>(t.surface)].name != "box")
+        continue;
+      const auto s = model->intersect(*eye.backproject(Vec2(x, y)));
+      if (!s) continue;
+      // Face by its normal: one group per side of the box.
+      const Vec3 n = t.normal;
+      group.at<int>(y, x) = n.x() > 0.5    ? 0
+                            : n.x() < -0.5 ? 1
+                            : n.y() > 0.5  ? 2
+                            : n.y() < -0.5 ? 3
+                            : n.z() > 0.5  ? 4
+                                           : 5;
+      target[static_cast<std::size_t>(y * eye.width + x)] =
+          white * luma(lamps::textureAt(texture, s->texcoord));
+    }
+  }
+  double sum = 0;
+  *judged = 0;
+  for (int y = 2; y + 2 < eye.height; ++y) {
+    for (int x = 2; x + 2 < eye.width; ++x) {
+      const int g = group.at<int>(y, x);
+      if (g < 0) continue;
+      bool one_face = true;
+      for (int dy = -2; dy <= 2 && one_face; ++dy)
+        for (int dx = -2; dx <= 2; ++dx) one_face &= group.at<int>(y + dy, x + dx) == g;
+      if (!one_face) continue;
+      const cv::Vec3f bgr = seen.at<cv::Vec3f>(y, x);
+      const double want = target[static_cast<std::size_t>(y * eye.width + x)];
+      sum += std::abs(luma(Vec3(bgr[2], bgr[1], bgr[0])) - want) / want;
+      ++*judged;
+    }
+  }
+  return *judged ? sum / *judged : 1;
+}
+
+TEST(RenderCliObject, FramesPaintTheBoxWithItsTexture) {
+  TempDir dir;
+  const BoxRig r = boxRig(dir);
+  auto doc = run(
+      {"--rig", r.rig, "--object", r.mesh, "--texture", r.texture, "--out", dir.file("frames")});
+  ASSERT_TRUE(doc) << doc.error().message;
+  const json& display = (*doc)["display"];
+  EXPECT_EQ(display["surface"], "object");
+  EXPECT_EQ(display["units"], "camera 'truth' units");
+  EXPECT_EQ(display["coverage"]["unlit_m2"].get<double>(), 0.0);
+  ASSERT_EQ((*doc)["projectors"].size(), 2u);
+  for (const auto& p : (*doc)["projectors"]) {
+    EXPECT_EQ(p["gain_source"], "brightness map");
+    EXPECT_GT(p["lit_pixels"].get<long>(), 10000);
+  }
+  long judged = 0;
+  const double error =
+      appearanceError(r, dir.file("frames"), display["white"].get<double>(), &judged);
+  std::printf(
+      "procam-render --object: white %.4f, %ld viewer pixels, mean relative luminance "
+      "error %.2f %%\n",
+      display["white"].get<double>(), judged, 100 * error);
+  EXPECT_GT(judged, 20000);
+  EXPECT_LT(error, 0.03);
+}
+
+TEST(RenderCliObject, AProjectorSwitchedOffIsDarkAndItsPartReported) {
+  TempDir dir;
+  const BoxRig r = boxRig(dir);
+  auto doc = run({"--rig", r.rig, "--object", r.mesh, "--texture", r.texture, "--off", "proj_right",
+                  "--out", dir.file("frames")});
+  ASSERT_TRUE(doc) << doc.error().message;
+  EXPECT_GT((*doc)["display"]["coverage"]["unlit_m2"].get<double>(), 0.001);
+  EXPECT_GT((*doc)["display"]["coverage"]["unlit_faces"].get<long>(), 0);
+  const cv::Mat off = cv::imread(dir.file("frames/proj_right.png"), cv::IMREAD_UNCHANGED);
+  ASSERT_FALSE(off.empty());
+  EXPECT_EQ(cv::countNonZero(off.reshape(1)), 0);
+}
+
+TEST(RenderCliObject, BadInputIsNamed) {
+  TempDir dir;
+  const BoxRig r = boxRig(dir);
+  const auto code = [&](const std::vector<std::string>& args) {
+    auto doc = run(args);
+    return doc ? std::optional<ErrorCode>() : doc.error().code;
+  };
+  EXPECT_EQ(
+      code({"--rig", r.rig, "--object", r.mesh, "--content", r.texture, "--out", dir.file("x")}),
+      ErrorCode::kInvalidInput);
+  EXPECT_EQ(code({"--rig", r.rig, "--content", r.texture, "--off", "proj", "--out", dir.file("x")}),
+            ErrorCode::kInvalidInput);
+  EXPECT_EQ(code({"--rig", r.rig, "--object", dir.file("none.ply"), "--out", dir.file("x")}),
+            ErrorCode::kIo);
+  EXPECT_EQ(code({"--rig", r.rig, "--object", r.mesh, "--off", "nobody", "--out", dir.file("x")}),
+            ErrorCode::kNotFound);
+  EXPECT_EQ(code({"--rig", r.rig, "--object", r.mesh, "--specular", "2", "--out", dir.file("x")}),
+            ErrorCode::kInvalidInput);
+  EXPECT_EQ(code({"--rig", r.rig, "--object", r.mesh, "--off", "proj", "--off", "proj_right",
+                  "--out", dir.file("x")}),
+            ErrorCode::kInvalidInput);
+}
+
+}  // namespace
+}  // namespace procam::itest
