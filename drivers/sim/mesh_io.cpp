@@ -7,8 +7,10 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <sstream>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace procam::sim {
@@ -37,20 +39,77 @@ Result<geom::TriangleMesh> checked(geom::TriangleMesh mesh, const std::string& o
   return mesh;
 }
 
-// Resolves an OBJ index token ("7", "7/1/3", "-1//2") to a 0-based vertex index.
-bool objIndex(const std::string& token, int vertex_count, int& out) {
-  const std::string head = token.substr(0, token.find('/'));
-  int value = 0;
-  const auto [ptr, ec] = std::from_chars(head.data(), head.data() + head.size(), value);
-  if (ec != std::errc() || ptr != head.data() + head.size() || value == 0) return false;
-  out = value > 0 ? value - 1 : vertex_count + value;
-  return true;
-}
-
 tl::unexpected<Error> tooLarge(const std::string& origin, const std::string& what,
                                std::size_t limit) {
   return fail(ErrorCode::kTooLarge,
               origin + ": more than " + std::to_string(limit) + " " + what + " (the limit)");
+}
+
+// Resolves one OBJ index (1-based, or negative from the end) to a 0-based index.
+bool objNumber(std::string_view text, int count, int& out) {
+  int value = 0;
+  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (ec != std::errc() || ptr != text.data() + text.size() || value == 0) return false;
+  out = value > 0 ? value - 1 : count + value;
+  return true;
+}
+
+constexpr int kNoTexcoord = std::numeric_limits<int>::min();
+
+// Resolves an OBJ face token ("7", "7/1/3", "-1//2") to a 0-based vertex index and
+// texture-coordinate index (kNoTexcoord when the token has none).
+bool objIndex(const std::string& token, int vertex_count, int texcoord_count, int& vertex,
+              int& texcoord) {
+  const std::size_t slash = token.find('/');
+  if (!objNumber(std::string_view(token).substr(0, slash), vertex_count, vertex)) return false;
+  texcoord = kNoTexcoord;
+  if (slash == std::string::npos) return true;
+  const std::size_t next = token.find('/', slash + 1);
+  const std::string_view vt = std::string_view(token).substr(
+      slash + 1, next == std::string::npos ? std::string::npos : next - slash - 1);
+  return vt.empty() || objNumber(vt, texcoord_count, texcoord);
+}
+
+// An OBJ's texture coordinates belong to face corners, a mesh's to vertices: when every
+// corner has one, each distinct (vertex, texture coordinate) pair becomes a vertex of
+// its own (a vertex on a texture seam is repeated, once per side).
+Result<geom::TriangleMesh> splitByTexcoord(geom::TriangleMesh mesh,
+                                           const std::vector<Eigen::Vector3i>& corner_uv,
+                                           const std::vector<Vec2>& texcoords,
+                                           const std::string& origin, const MeshLimits& limits) {
+  bool every = true;
+  for (const auto& c : corner_uv) {
+    for (int k = 0; k < 3; ++k) {
+      if (c[k] == kNoTexcoord) {
+        every = false;
+      } else if (c[k] < 0 || c[k] >= static_cast<int>(texcoords.size())) {
+        return fail(ErrorCode::kParse, origin + ": texture coordinate index out of range");
+      }
+    }
+  }
+  if (!every) return mesh;  // not every corner has one: the geometry alone
+  std::unordered_map<std::uint64_t, int> index;
+  geom::TriangleMesh out;
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    Eigen::Vector3i face;
+    for (int k = 0; k < 3; ++k) {
+      const int v = mesh.faces[f][k], t = corner_uv[f][k];
+      if (v < 0 || v >= static_cast<int>(mesh.vertices.size()))
+        return fail(ErrorCode::kParse, origin + ": face index out of range");
+      const std::uint64_t key =
+          (static_cast<std::uint64_t>(v) << 32) | static_cast<std::uint32_t>(t);
+      auto [it, added] = index.emplace(key, static_cast<int>(out.vertices.size()));
+      if (added) {
+        if (out.vertices.size() >= limits.vertices)
+          return tooLarge(origin, "vertices", limits.vertices);
+        out.vertices.push_back(mesh.vertices[static_cast<std::size_t>(v)]);
+        out.uv.push_back(texcoords[static_cast<std::size_t>(t)]);
+      }
+      face[k] = it->second;
+    }
+    out.faces.push_back(face);
+  }
+  return out;
 }
 
 }  // namespace
@@ -58,6 +117,8 @@ tl::unexpected<Error> tooLarge(const std::string& origin, const std::string& wha
 Result<geom::TriangleMesh> parseObj(std::string_view text, const std::string& origin,
                                     const MeshLimits& limits) {
   geom::TriangleMesh mesh;
+  std::vector<Vec2> texcoords;             // vt records
+  std::vector<Eigen::Vector3i> corner_uv;  // per triangle, its corners' vt
   std::istringstream in{std::string(text)};
   std::string line;
   std::size_t line_no = 0;
@@ -72,25 +133,41 @@ Result<geom::TriangleMesh> parseObj(std::string_view text, const std::string& or
       if (mesh.vertices.size() >= limits.vertices)
         return tooLarge(origin, "vertices", limits.vertices);
       mesh.vertices.push_back(v);
+    } else if (tag == "vt") {
+      Vec2 t;
+      if (!(fields >> t.x() >> t.y()) || !t.allFinite())
+        return parseError(origin, line_no, "bad texture coordinate");
+      if (texcoords.size() >= limits.vertices)
+        return tooLarge(origin, "texture coordinates", limits.vertices);
+      texcoords.push_back(t);
     } else if (tag == "f") {
-      std::vector<int> idx;
+      std::vector<int> idx, uv;
       std::string token;
       while (fields >> token) {
-        int i = 0;
-        if (!objIndex(token, static_cast<int>(mesh.vertices.size()), i))
+        int i = 0, t = kNoTexcoord;
+        if (!objIndex(token, static_cast<int>(mesh.vertices.size()),
+                      static_cast<int>(texcoords.size()), i, t))
           return parseError(origin, line_no, "bad face index '" + token + "'");
         if (idx.size() >= limits.face_indices)
           return tooLarge(origin + ":" + std::to_string(line_no), "vertices in one face",
                           limits.face_indices);
         idx.push_back(i);
+        uv.push_back(t);
       }
       if (idx.size() < 3) return parseError(origin, line_no, "face with fewer than 3 vertices");
       if (mesh.faces.size() + idx.size() - 2 > limits.faces)
         return tooLarge(origin, "triangles", limits.faces);
-      for (std::size_t k = 1; k + 1 < idx.size(); ++k)
+      for (std::size_t k = 1; k + 1 < idx.size(); ++k) {
         mesh.faces.emplace_back(idx[0], idx[k], idx[k + 1]);
+        corner_uv.emplace_back(uv[0], uv[k], uv[k + 1]);
+      }
     }
-    // vt, vn, o, g, s, usemtl, mtllib: not needed for geometry.
+    // vn, o, g, s, usemtl, mtllib: not needed.
+  }
+  if (!texcoords.empty()) {
+    auto split = splitByTexcoord(std::move(mesh), corner_uv, texcoords, origin, limits);
+    if (!split) return tl::unexpected(split.error());
+    return checked(std::move(*split), origin);
   }
   return checked(std::move(mesh), origin);
 }

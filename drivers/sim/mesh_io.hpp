@@ -1,7 +1,9 @@
 #pragma once
-// Triangle meshes for scene surfaces: Wavefront OBJ (v/f records, polygons fanned
-// into triangles, negative indices) and PLY (ascii or binary_little_endian, vertex
-// x/y/z and a face vertex-index list; other elements and properties are skipped).
+// Triangle meshes for scene surfaces: Wavefront OBJ (v/vt/f records, polygons fanned
+// into triangles, negative indices; when every face corner has a texture coordinate,
+// each distinct vertex and texture coordinate pair is a vertex with its `uv`) and PLY
+// (ascii or binary_little_endian, vertex x/y/z and optional u/v, a face vertex-index
+// list; other elements and properties are skipped).
 #include <filesystem>
 
 #include "core/error.hpp"

@@ -117,5 +117,38 @@ TEST(SimMesh, MeshTransformAndErrors) {
   EXPECT_NE(scene.error().message.find("surfaces[0].file"), std::string::npos);
 }
 
+// OBJ texture coordinates belong to face corners: a vertex on a texture seam has one per
+// side and becomes two vertices; without them, or with some corners lacking one, the
+// vertices stay as they are and carry none.
+TEST(SimMesh, ObjTextureCoordinatesSplitVerticesOnSeams) {
+  const char* seam =
+      "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+      "vt 0 0\nvt 0.5 0\nvt 0.5 1\nvt 0 1\nvt 1 0\nvt 1 1\n"
+      "f 1/1 2/2 3/3\nf 1/1 3/3 4/4\nf 2/5/1 3/6/1 1/1/1\n";
+  auto mesh = parseObj(seam, "seam.obj");
+  ASSERT_TRUE(mesh) << mesh.error().message;
+  ASSERT_EQ(mesh->faces.size(), 3u);
+  // Vertices 2 and 3 appear with two texture coordinates each: 4 + 2 vertices.
+  ASSERT_EQ(mesh->vertices.size(), 6u);
+  ASSERT_EQ(mesh->uv.size(), 6u);
+  for (const auto& f : mesh->faces) {
+    for (int k = 0; k < 3; ++k) {
+      const Vec3& v = mesh->vertices[f[k]];
+      const Vec2& t = mesh->uv[f[k]];
+      if (&f == &mesh->faces[2])
+        EXPECT_EQ(t.x(), v.x() == 0 ? 0.0 : 1.0);  // the third face's own atlas
+      else
+        EXPECT_EQ(t.x(), 0.5 * v.x());
+      EXPECT_EQ(t.y(), v.y());
+    }
+  }
+  auto plain = parseObj("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2 3\n", "partial.obj");
+  ASSERT_TRUE(plain);
+  EXPECT_EQ(plain->vertices.size(), 3u);
+  EXPECT_TRUE(plain->uv.empty());
+  EXPECT_FALSE(parseObj("v 0 0 0\nvt 0 x\nf 1 1 1\n", "bad.obj"));
+  EXPECT_FALSE(parseObj("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/2 2/1 3/1\n", "bad.obj"));
+}
+
 }  // namespace
 }  // namespace procam::sim
