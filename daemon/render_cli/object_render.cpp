@@ -43,7 +43,11 @@ cv::Mat linearTexture(const cv::Mat& image) {
 Result<json> renderObject(const ObjectRenderInput& in) {
   auto loaded = content::loadMeshContent(in.object);
   if (!loaded) return tl::unexpected(loaded.error());
-  std::vector<Vec2> uv = loaded->mesh.uv;
+  std::vector<Vec2> uv = loaded->mesh.texcoord;
+  if (!in.texture.empty() && uv.empty())
+    return fail(
+        ErrorCode::kInvalidInput,
+        in.object.string() + " has no texture coordinates (OBJ vt, PLY s t) for the texture");
   const bool textured = !uv.empty() && !in.texture.empty();
   auto object = lamps::ObjectModel::build(loaded->mesh, textured ? uv : std::vector<Vec2>{});
   if (!object) return tl::unexpected(object.error());
@@ -89,44 +93,64 @@ Result<json> renderObject(const ObjectRenderInput& in) {
   const lamps::Coverage coverage = lamps::lampCoverage(set, *weights, *object);
 
   // Each projector's response and k·B: from its measured brightness across the frame
-  // (grey, in its camera's units) when the rig has one, else equal for all.
+  // (grey, in its camera's units) when every projector that is on has one from the same
+  // camera; taken equal for all when none has one; refused otherwise (gains in camera
+  // units beside assumed ones, or two cameras' units, do not compare).
   std::vector<lamps::LampFrameInput> inputs;
   json projectors = json::array();
+  std::vector<std::optional<lamps::GainMeasurement>> gains(chosen.size());
+  std::vector<std::string> measured_by(chosen.size()), unmeasured;
+  for (std::size_t i = 0; i < chosen.size(); ++i) {
+    const auto response = blend::projectorResponse(*chosen[i].p);
+    if (!response || !response->brightness) {
+      if (chosen[i].on) unmeasured.push_back(chosen[i].p->name);
+      continue;
+    }
+    const blend::BrightnessMap& map = *response->brightness;
+    auto gain = lamps::gainFromBrightness(chosen[i].view, weights->reach[i], [&](const Vec2& px) {
+      return blend::brightnessAt(map, px);
+    });
+    if (!gain) {
+      if (chosen[i].on) unmeasured.push_back(chosen[i].p->name + " (" + gain.error().message + ")");
+      continue;
+    }
+    gains[i] = *gain;
+    measured_by[i] = response->camera;
+  }
   std::string units;
+  for (std::size_t i = 0; i < chosen.size(); ++i) {
+    if (!chosen[i].on || !gains[i]) continue;
+    if (!unmeasured.empty()) {
+      std::string names;
+      for (const auto& n : unmeasured) names += (names.empty() ? "" : ", ") + n;
+      return fail(ErrorCode::kInvalidInput,
+                  "some projectors' brightness was measured and not that of " + names +
+                      ": their gains do not compare (measure them all, or none)");
+    }
+    const std::string camera = "camera '" + measured_by[i] + "' units";
+    if (!units.empty() && units != camera)
+      return fail(ErrorCode::kInvalidInput,
+                  "the projectors' brightness was measured by different cameras: their gains "
+                  "do not compare");
+    units = camera;
+  }
   for (std::size_t i = 0; i < chosen.size(); ++i) {
     lamps::LampFrameInput input{&chosen[i].view, &weights->weight[i], {}};
     const auto response = blend::projectorResponse(*chosen[i].p);
-    std::string gain_source = "assumed equal";
     if (response) input.photometry.gamma = response->gamma;
-    if (response && response->brightness) {
-      const blend::BrightnessMap& map = *response->brightness;
-      auto gain = lamps::gainFromBrightness(chosen[i].view, weights->reach[i], [&](const Vec2& px) {
-        return blend::brightnessAt(map, px);
-      });
-      if (gain) {
-        input.photometry.gain_rgb = gain->gain_rgb;
-        gain_source = "brightness map";
-        const std::string camera = "camera '" + response->camera + "' units";
-        if (!units.empty() && units != camera)
-          units = "mixed";  // not comparable
-        else if (units.empty())
-          units = camera;
-      }
-    }
+    const bool measured = !units.empty() && gains[i];
+    if (measured) input.photometry.gain_rgb = gains[i]->gain_rgb;
     json p = {{"name", chosen[i].p->name},
               {"output", chosen[i].p->output},
               {"on", chosen[i].on},
               {"response_gamma", input.photometry.gamma},
               {"response", response ? "measured" : "assumed gamma 2.2"},
               {"gain", daemon::vectorJson(input.photometry.gain_rgb)},
-              {"gain_source", gain_source}};
+              {"gain_source", measured ? "brightness map" : "assumed equal"}};
+    if (measured) p["gain_spread"] = gains[i]->spread;
     projectors.push_back(p);
     if (chosen[i].on) inputs.push_back(input);
   }
-  if (units == "mixed")
-    return fail(ErrorCode::kInvalidInput,
-                "the projectors' brightness was measured by different cameras: their gains "
-                "do not compare");
   if (inputs.empty()) return fail(ErrorCode::kInvalidInput, "every projector is off");
   double white = 0;
   if (in.white) {

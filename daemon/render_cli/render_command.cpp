@@ -99,6 +99,7 @@ std::string utcNow() {
 
 Result<RenderArgs> parseRenderArgs(const std::vector<std::string>& args) {
   RenderArgs a;
+  bool object_only = false;  // an option only --object takes was given
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& opt = args[i];
     const bool takes_value =
@@ -116,6 +117,9 @@ Result<RenderArgs> parseRenderArgs(const std::vector<std::string>& args) {
     };
     if (takes_value && i + 1 >= args.size())
       return fail(ErrorCode::kInvalidInput, opt + " needs a value");
+    object_only = object_only || opt == "--texture" || opt == "--off" || opt == "--light" ||
+                  opt == "--specular" || opt == "--shininess" || opt == "--max-incidence" ||
+                  opt == "--white";
     if (opt == "--rig") {
       a.rig = args[++i];
     } else if (opt == "--content") {
@@ -182,8 +186,10 @@ Result<RenderArgs> parseRenderArgs(const std::vector<std::string>& args) {
                   "--object takes --texture, not --content, --mpcdi, --rect or --geometry-only");
     return a;
   }
-  if (!a.texture.empty() || !a.off.empty() || a.light || a.white)
-    return fail(ErrorCode::kInvalidInput, "--texture, --off, --light and --white are for --object");
+  if (object_only)
+    return fail(ErrorCode::kInvalidInput,
+                "--texture, --off, --light, --specular, --shininess, --max-incidence and --white "
+                "are for --object");
   if (a.rig.empty() || a.content.empty() || (a.out.empty() && a.mpcdi.empty()))
     return fail(ErrorCode::kInvalidInput, "--rig, --content and --out or --mpcdi are required");
   return a;

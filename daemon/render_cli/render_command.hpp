@@ -43,7 +43,7 @@ inline constexpr const char* kUsage =
     "  --help             this text\n"
     "object (shader lamps, [Raskar02] 5.2): procam-render --rig RIG.json --object MESH\n"
     "    [--texture IMAGE] --out DIR [options]\n"
-    "  Paints a neutral object: MESH (PLY with vertex u v, or OBJ with vt: texture\n"
+    "  Paints a neutral object: MESH (PLY with vertex s t, or OBJ with vt: texture\n"
     "  coordinates) in the rig's world; IMAGE (sRGB) its look (white without one). Each\n"
     "  posed projector's\n"
     "  frame is the look corrected for distance and angle (I = L d^2 / (k cos theta)),\n"

@@ -36,6 +36,10 @@ Result<geom::TriangleMesh> checked(geom::TriangleMesh mesh, const std::string& o
   for (const auto& t : mesh.uv) {
     if (!t.allFinite()) return fail(ErrorCode::kParse, origin + ": non-finite vertex u v");
   }
+  if (mesh.texcoord.size() != mesh.vertices.size()) mesh.texcoord.clear();
+  for (const auto& t : mesh.texcoord) {
+    if (!t.allFinite()) return fail(ErrorCode::kParse, origin + ": non-finite texture coordinate");
+  }
   return mesh;
 }
 
@@ -103,7 +107,7 @@ Result<geom::TriangleMesh> splitByTexcoord(geom::TriangleMesh mesh,
         if (out.vertices.size() >= limits.vertices)
           return tooLarge(origin, "vertices", limits.vertices);
         out.vertices.push_back(mesh.vertices[static_cast<std::size_t>(v)]);
-        out.uv.push_back(texcoords[static_cast<std::size_t>(t)]);
+        out.texcoord.push_back(texcoords[static_cast<std::size_t>(t)]);
       }
       face[k] = it->second;
     }
@@ -355,9 +359,13 @@ Result<geom::TriangleMesh> parsePly(std::string_view bytes, const std::string& o
                          [name](const PlyProperty& p) { return !p.is_list && p.name == name; });
     };
     const bool with_uv = e.name == "vertex" && has("u") && has("v");
+    // Texture coordinates: s t, or texture_u texture_v.
+    const char* tex_s = has("s") && has("t") ? "s" : "texture_u";
+    const char* tex_t = has("s") && has("t") ? "t" : "texture_v";
+    const bool with_tex = e.name == "vertex" && has(tex_s) && has(tex_t);
     for (std::size_t i = 0; i < e.count; ++i) {
       Vec3 v = Vec3::Zero();
-      Vec2 uv = Vec2::Zero();
+      Vec2 uv = Vec2::Zero(), tex = Vec2::Zero();
       for (const auto& p : e.props) {
         if (p.is_list) {
           double count = 0;
@@ -388,6 +396,8 @@ Result<geom::TriangleMesh> parsePly(std::string_view bytes, const std::string& o
           if (e.name == "vertex" && p.name.size() == 1 && p.name[0] >= 'x' && p.name[0] <= 'z')
             v[p.name[0] - 'x'] = value;
           if (with_uv && (p.name == "u" || p.name == "v")) uv[p.name == "u" ? 0 : 1] = value;
+          if (with_tex && (p.name == tex_s || p.name == tex_t))
+            tex[p.name == tex_s ? 0 : 1] = value;
         }
       }
       if (e.name == "vertex") {
@@ -395,6 +405,7 @@ Result<geom::TriangleMesh> parsePly(std::string_view bytes, const std::string& o
           return tooLarge(origin, "vertices", limits.vertices);
         mesh.vertices.push_back(v);
         if (with_uv) mesh.uv.push_back(uv);
+        if (with_tex) mesh.texcoord.push_back(tex);
       }
     }
   }

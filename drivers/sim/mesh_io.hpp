@@ -1,9 +1,10 @@
 #pragma once
 // Triangle meshes for scene surfaces: Wavefront OBJ (v/vt/f records, polygons fanned
 // into triangles, negative indices; when every face corner has a texture coordinate,
-// each distinct vertex and texture coordinate pair is a vertex with its `uv`) and PLY
-// (ascii or binary_little_endian, vertex x/y/z and optional u/v, a face vertex-index
-// list; other elements and properties are skipped).
+// each distinct vertex and texture coordinate pair is a vertex with its `texcoord`) and
+// PLY (ascii or binary_little_endian, vertex x/y/z, optional u/v — a measured surface's
+// projector pixels — and s/t or texture_u/texture_v texture coordinates, a face
+// vertex-index list; other elements and properties are skipped).
 #include <filesystem>
 
 #include "core/error.hpp"

@@ -77,6 +77,9 @@ struct TriangleMesh {
   // Per vertex, when the file gives them (PLY u v): a measured display surface's
   // projector pixel that lit the vertex. Empty otherwise.
   std::vector<Vec2> uv;
+  // Per vertex, when the file gives them (OBJ vt, PLY s t): texture coordinates, u right,
+  // v up. Empty otherwise.
+  std::vector<Vec2> texcoord;
 };
 
 // Mesh intersector: brute force for small meshes, a BVH (SAH-binned) above

@@ -10,12 +10,8 @@ Result<void> checkMaterial(const Material& m) {
       (m.texture.type() != CV_32FC3 || m.texture.cols > 16384 || m.texture.rows > 16384))
     return fail(ErrorCode::kInvalidInput,
                 "a texture must be linear RGB floats, at most 16384 a side");
-  if (!m.texture.empty()) {
-    double lo = 0, hi = 0;
-    cv::minMaxLoc(m.texture.reshape(1), &lo, &hi);
-    if (!(lo >= 0) || !std::isfinite(hi))
-      return fail(ErrorCode::kInvalidInput, "a texture has negative or non-finite colours");
-  }
+  if (!m.texture.empty() && !cv::checkRange(m.texture, true, nullptr, 0, 1e30))
+    return fail(ErrorCode::kInvalidInput, "a texture has negative or non-finite colours");
   if (!m.albedo_rgb.allFinite() || (m.albedo_rgb.array() < 0).any() ||
       !m.specular_rgb.allFinite() || (m.specular_rgb.array() < 0).any())
     return fail(ErrorCode::kInvalidInput, "albedo and specular colours must be finite and >= 0");
@@ -30,7 +26,10 @@ Result<void> checkMaterial(const Material& m) {
 
 Vec3 textureAt(const cv::Mat& texture, const Vec2& uv) {
   if (texture.empty()) return Vec3::Ones();
-  const double x = uv.x() * texture.cols - 0.5, y = (1 - uv.y()) * texture.rows - 0.5;
+  // Clamped to the texture's edge (and a coordinate that is not a number to its corner).
+  const double u = std::isfinite(uv.x()) ? std::clamp(uv.x(), 0.0, 1.0) : 0.0;
+  const double v = std::isfinite(uv.y()) ? std::clamp(uv.y(), 0.0, 1.0) : 0.0;
+  const double x = u * texture.cols - 0.5, y = (1 - v) * texture.rows - 0.5;
   const double fx = std::floor(x), fy = std::floor(y);
   const double ax = x - fx, ay = y - fy;
   const auto at = [&](double px, double py) {

@@ -32,7 +32,8 @@ double median(std::vector<double>& v) {
 Result<GainMeasurement> measureLampGain(std::span<const Lamp> lamps, const LampWeights& weights,
                                         std::size_t index, const ObjectModel& object,
                                         const GainCapture& cap) {
-  if (index >= lamps.size() || weights.reach.size() != lamps.size() || !lamps[index].model)
+  if (index >= lamps.size() || weights.reach.size() != lamps.size() || !lamps[index].model ||
+      !lamps[index].view || weights.reach[index].size() != lamps[index].view->size)
     return fail(ErrorCode::kInvalidInput, "no such projector in the set");
   if (!cap.camera) return fail(ErrorCode::kInvalidInput, "no camera");
   const cv::Size size(cap.camera->width, cap.camera->height);

@@ -1,6 +1,7 @@
 #include "shader_lamps/lamp_view.hpp"
 
 #include <opencv2/core/utility.hpp>
+#include <string>
 
 namespace procam::lamps {
 
@@ -8,6 +9,11 @@ Result<LampView> castLampView(const geom::CameraModel& projector, const ObjectMo
   const int w = projector.width, h = projector.height;
   if (w < 2 || h < 2 || w > 16384 || h > 16384)
     return fail(ErrorCode::kInvalidInput, "projector size out of range");
+  // 44 bytes a pixel here, about as much again for its weights and frame.
+  if (static_cast<long>(w) * h > kMaxViewPixels)
+    return fail(ErrorCode::kTooLarge, "projector of " + std::to_string(w) + "x" +
+                                          std::to_string(h) + " pixels: over " +
+                                          std::to_string(kMaxViewPixels) + " for shader lamps");
   if (!(projector.K.fx > 0 && projector.K.fy > 0) || !projector.pose.R.allFinite() ||
       !projector.pose.t.allFinite())
     return fail(ErrorCode::kInvalidInput, "projector intrinsics or pose are not valid");

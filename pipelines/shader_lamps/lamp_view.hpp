@@ -24,7 +24,11 @@ struct LampView {
   bool hit(int x, int y) const { return face.at<int>(y, x) >= 0; }
 };
 
-// kInvalidInput for a projector without a valid size (2..16384 per side) or intrinsics.
+// Up to 4096 x 4096 pixels (a view is 44 bytes a pixel).
+constexpr long kMaxViewPixels = 4096L * 4096;
+
+// kInvalidInput for a projector without a valid size (2..16384 per side) or intrinsics;
+// kTooLarge over kMaxViewPixels.
 Result<LampView> castLampView(const geom::CameraModel& projector, const ObjectModel& object);
 
 }  // namespace procam::lamps

@@ -94,6 +94,7 @@ float bilinear(const cv::Mat& m, const Vec2& p) {
 // mesh's rounding). The side matters for a thin part seen from both sides (an open
 // tube): a projector lighting its inside does not light its outside.
 std::optional<Vec2> sees(const Lamp& lamp, const Vec3& point, const Vec3& normal) {
+  if (!lamp.model || !lamp.view || lamp.view->face.empty()) return std::nullopt;
   if (!(normal.dot(lamp.model->pose.center() - point) > 0)) return std::nullopt;
   const auto q = lamp.model->project(point);
   if (!q || !lamp.model->inImage(*q)) return std::nullopt;
@@ -206,6 +207,7 @@ std::vector<std::optional<Vec2>> lampsSeeing(std::span<const Lamp> lamps, const 
 Coverage lampCoverage(std::span<const Lamp> lamps, const LampWeights& weights,
                       const ObjectModel& object, double spacing_m) {
   Coverage c;
+  if (weights.reach.size() != lamps.size()) return c;  // not these projectors' weights
   const geom::TriangleMesh& m = object.mesh();
   const double spacing = std::max(spacing_m, 1e-6);
   for (std::size_t f = 0; f < m.faces.size(); ++f) {

@@ -80,6 +80,7 @@ struct Coverage {
   std::vector<std::uint32_t> unlit_faces;  // faces with a sample only switched-off ones light
 };
 
+// Empty (all zero) when `weights` are not those of `lamps` (another count).
 Coverage lampCoverage(std::span<const Lamp> lamps, const LampWeights& weights,
                       const ObjectModel& object, double spacing_m = 0.002);
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <unordered_map>
 
 #include "core/units.hpp"
 
@@ -16,6 +17,7 @@ Vec3 barycentric(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& p) {
   const double d00 = e0.dot(e0), d01 = e0.dot(e1), d11 = e1.dot(e1);
   const double d20 = d.dot(e0), d21 = d.dot(e1);
   const double den = d00 * d11 - d01 * d01;
+  if (!(den > 0)) return Vec3::Constant(1.0 / 3);  // a sliver: its centre will do
   const double v = (d11 * d20 - d01 * d21) / den;
   const double w = (d00 * d21 - d01 * d20) / den;
   return {1 - v - w, v, w};
@@ -23,24 +25,41 @@ Vec3 barycentric(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& p) {
 
 // A canonical index per vertex position: a textured mesh repeats a vertex along each
 // seam of its texture (one copy per side), and normals must be averaged across the seam
-// as if it were one vertex. Positions within `tolerance` of each other share an index.
+// as if it were one vertex. Positions within `tolerance` of each other (per coordinate)
+// share an index: each position is hashed by its cell of that size and compared with
+// the vertices of the 27 cells around it, so the work stays linear in the vertices.
 std::vector<std::uint32_t> weldedIndices(const std::vector<Vec3>& vertices, double tolerance) {
   const std::size_t n = vertices.size();
-  std::vector<std::uint32_t> order(n), canonical(n);
-  for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<std::uint32_t>(i);
-  std::sort(order.begin(), order.end(),
-            [&](std::uint32_t a, std::uint32_t b) { return vertices[a].x() < vertices[b].x(); });
-  for (std::size_t i = 0; i < n; ++i) canonical[i] = static_cast<std::uint32_t>(i);
-  // Sweep along x: only vertices within the tolerance in x can coincide.
-  for (std::size_t a = 0; a < n; ++a) {
-    const std::uint32_t va = order[a];
-    if (canonical[va] != va) continue;  // already welded to an earlier one
-    for (std::size_t b = a + 1; b < n; ++b) {
-      const std::uint32_t vb = order[b];
-      if (vertices[vb].x() - vertices[va].x() > tolerance) break;
-      if (canonical[vb] == vb && (vertices[vb] - vertices[va]).norm() <= tolerance)
-        canonical[vb] = va;
+  std::vector<std::uint32_t> canonical(n);
+  const double cell = std::max(tolerance, 1e-300);
+  const auto key = [](std::int64_t x, std::int64_t y, std::int64_t z) {
+    return static_cast<std::uint64_t>(x) * 0x9E3779B97F4A7C15ull ^
+           static_cast<std::uint64_t>(y) * 0xC2B2AE3D27D4EB4Full ^
+           static_cast<std::uint64_t>(z) * 0x165667B19E3779F9ull;
+  };
+  std::unordered_multimap<std::uint64_t, std::uint32_t> cells;
+  cells.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 q = (vertices[i] / cell).array().floor().cwiseMax(-1e15).cwiseMin(1e15);
+    const auto cx = static_cast<std::int64_t>(q.x()), cy = static_cast<std::int64_t>(q.y()),
+               cz = static_cast<std::int64_t>(q.z());
+    canonical[i] = static_cast<std::uint32_t>(i);
+    bool found = false;
+    for (int dz = -1; dz <= 1 && !found; ++dz) {
+      for (int dy = -1; dy <= 1 && !found; ++dy) {
+        for (int dx = -1; dx <= 1 && !found; ++dx) {
+          const auto range = cells.equal_range(key(cx + dx, cy + dy, cz + dz));
+          for (auto it = range.first; it != range.second; ++it) {
+            if ((vertices[it->second] - vertices[i]).cwiseAbs().maxCoeff() <= tolerance) {
+              canonical[i] = it->second;
+              found = true;
+              break;
+            }
+          }
+        }
+      }
     }
+    if (!found) cells.emplace(key(cx, cy, cz), static_cast<std::uint32_t>(i));
   }
   return canonical;
 }

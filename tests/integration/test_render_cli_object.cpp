@@ -58,8 +58,8 @@ BoxRig boxRig(const TempDir& dir) {
   const ObjectMesh box = boxMesh(kBoxCentre, kBoxSize, 0.01);
   std::ostringstream ply;
   ply << "ply\nformat ascii 1.0\nelement vertex " << box.mesh.vertices.size()
-      << "\nproperty double x\nproperty double y\nproperty double z\nproperty double u\n"
-         "property double v\nelement face "
+      << "\nproperty double x\nproperty double y\nproperty double z\nproperty double s\n"
+         "property double t\nelement face "
       << box.mesh.faces.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
   ply.precision(17);
   for (std::size_t v = 0; v < box.mesh.vertices.size(); ++v) {
@@ -70,6 +70,16 @@ BoxRig boxRig(const TempDir& dir) {
   for (const auto& f : box.mesh.faces) ply << "3 " << f[0] << ' ' << f[1] << ' ' << f[2] << '\n';
   dir.write("box.ply", ply.str());
   r.mesh = dir.file("box.ply");
+  // The same as OBJ, texture coordinates per face corner.
+  std::ostringstream obj;
+  obj.precision(17);
+  for (const Vec3& x : box.mesh.vertices)
+    obj << "v " << x.x() << ' ' << x.y() << ' ' << x.z() << '\n';
+  for (const Vec2& t : box.uv) obj << "vt " << t.x() << ' ' << t.y() << '\n';
+  for (const auto& f : box.mesh.faces)
+    obj << "f " << f[0] + 1 << '/' << f[0] + 1 << ' ' << f[1] + 1 << '/' << f[1] + 1 << ' '
+        << f[2] + 1 << '/' << f[2] + 1 << '\n';
+  dir.write("box.obj", obj.str());
   // A smooth texture, sRGB-encoded.
   cv::Mat texture(256, 256, CV_8UC3);
   const double pi = std::numbers::pi;
@@ -177,6 +187,17 @@ TEST(RenderCliObject, FramesPaintTheBoxWithItsTexture) {
       display["white"].get<double>(), judged, 100 * error);
   EXPECT_GT(judged, 20000);
   EXPECT_LT(error, 0.03);
+  // The same model as OBJ: the same frames.
+  auto from_obj = run({"--rig", r.rig, "--object", dir.file("box.obj"), "--texture", r.texture,
+                       "--out", dir.file("obj")});
+  ASSERT_TRUE(from_obj) << from_obj.error().message;
+  EXPECT_TRUE((*from_obj)["object"]["textured"].get<bool>());
+  for (const auto& p : r.state.projectors) {
+    const cv::Mat a = cv::imread(dir.file("frames/" + p.spec.name + ".png"), cv::IMREAD_UNCHANGED);
+    const cv::Mat b = cv::imread(dir.file("obj/" + p.spec.name + ".png"), cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(a.size(), b.size());
+    EXPECT_LE(cv::norm(a, b, cv::NORM_INF), 1) << p.spec.name;
+  }
 }
 
 TEST(RenderCliObject, AProjectorSwitchedOffIsDarkAndItsPartReported) {
@@ -213,6 +234,25 @@ TEST(RenderCliObject, BadInputIsNamed) {
   EXPECT_EQ(code({"--rig", r.rig, "--object", r.mesh, "--off", "proj", "--off", "proj_right",
                   "--out", dir.file("x")}),
             ErrorCode::kInvalidInput);
+  // Highlight options without an object.
+  EXPECT_EQ(
+      code({"--rig", r.rig, "--content", r.texture, "--specular", "0.5", "--out", dir.file("x")}),
+      ErrorCode::kInvalidInput);
+  // A texture for a model without texture coordinates.
+  dir.write("bare.obj", "v 0 1.4 0.9\nv 0.1 1.4 0.9\nv 0 1.4 1\nf 1 2 3\n");
+  EXPECT_EQ(code({"--rig", r.rig, "--object", dir.file("bare.obj"), "--texture", r.texture, "--out",
+                  dir.file("x")}),
+            ErrorCode::kInvalidInput);
+  // One projector's brightness measured, the other's not: gains that do not compare.
+  json rig = json::parse(std::ifstream(r.rig));
+  for (auto& p : rig["projectors"])
+    if (p["name"] == "proj_right") p["photometric"].erase("brightness");
+  dir.write("half.json", rig.dump());
+  EXPECT_EQ(code({"--rig", dir.file("half.json"), "--object", r.mesh, "--out", dir.file("x")}),
+            ErrorCode::kInvalidInput);
+  // With it switched off, the one that is on decides.
+  EXPECT_FALSE(code({"--rig", dir.file("half.json"), "--object", r.mesh, "--off", "proj_right",
+                     "--out", dir.file("x")}));
 }
 
 }  // namespace

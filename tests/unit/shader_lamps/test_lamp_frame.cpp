@@ -106,6 +106,9 @@ TEST(ShaderLampFrame, AppearanceTexturesLightsAndHighlights) {
   EXPECT_TRUE(textureAt(m.texture, Vec2(0.25, 0.75)).isApprox(Vec3(1, 0, 0)));
   EXPECT_TRUE(textureAt(m.texture, Vec2(0.75, 0.25)).isApprox(Vec3(1, 1, 1)));
   EXPECT_TRUE(textureAt(m.texture, Vec2(0.5, 0.75)).isApprox(Vec3(0.5, 0.5, 0)));
+  // Past the edge, clamped to it; not a number: a corner, never NaN.
+  EXPECT_TRUE(textureAt(m.texture, Vec2(1e30, -1e30)).isApprox(Vec3(1, 1, 1)));
+  EXPECT_TRUE(textureAt(m.texture, Vec2(std::nan(""), 2)).allFinite());
   // A virtual light at 60 deg from the normal: ambient plus half the rest.
   Material lambert;
   lambert.light_dir = Vec3(std::sqrt(3.0), 0, 1);

@@ -130,11 +130,12 @@ TEST(SimMesh, ObjTextureCoordinatesSplitVerticesOnSeams) {
   ASSERT_EQ(mesh->faces.size(), 3u);
   // Vertices 2 and 3 appear with two texture coordinates each: 4 + 2 vertices.
   ASSERT_EQ(mesh->vertices.size(), 6u);
-  ASSERT_EQ(mesh->uv.size(), 6u);
+  ASSERT_EQ(mesh->texcoord.size(), 6u);
+  EXPECT_TRUE(mesh->uv.empty());  // uv is a measured surface's projector pixels, not these
   for (const auto& f : mesh->faces) {
     for (int k = 0; k < 3; ++k) {
       const Vec3& v = mesh->vertices[f[k]];
-      const Vec2& t = mesh->uv[f[k]];
+      const Vec2& t = mesh->texcoord[f[k]];
       if (&f == &mesh->faces[2])
         EXPECT_EQ(t.x(), v.x() == 0 ? 0.0 : 1.0);  // the third face's own atlas
       else
@@ -145,7 +146,7 @@ TEST(SimMesh, ObjTextureCoordinatesSplitVerticesOnSeams) {
   auto plain = parseObj("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2 3\n", "partial.obj");
   ASSERT_TRUE(plain);
   EXPECT_EQ(plain->vertices.size(), 3u);
-  EXPECT_TRUE(plain->uv.empty());
+  EXPECT_TRUE(plain->texcoord.empty());
   EXPECT_FALSE(parseObj("v 0 0 0\nvt 0 x\nf 1 1 1\n", "bad.obj"));
   EXPECT_FALSE(parseObj("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/2 2/1 3/1\n", "bad.obj"));
 }
