@@ -76,18 +76,6 @@ cv::Mat edgeDistance(const cv::Mat& inside) {
   return dist(cv::Rect(1, 1, inside.cols, inside.rows)).clone();
 }
 
-float bilinear(const cv::Mat& m, const Vec2& p) {
-  const int x0 = static_cast<int>(std::floor(p.x())), y0 = static_cast<int>(std::floor(p.y()));
-  const float ax = static_cast<float>(p.x() - x0), ay = static_cast<float>(p.y() - y0);
-  const auto at = [&](int x, int y) {
-    x = std::clamp(x, 0, m.cols - 1);
-    y = std::clamp(y, 0, m.rows - 1);
-    return m.at<float>(y, x);
-  };
-  return (1 - ay) * ((1 - ax) * at(x0, y0) + ax * at(x0 + 1, y0)) +
-         ay * ((1 - ax) * at(x0, y0 + 1) + ax * at(x0 + 1, y0 + 1));
-}
-
 // Where projector `lamp` sees `point` on the side `normal` faces: the point's pixel
 // when the point faces it and the ray of the nearest pixel meets the object at the
 // point's depth (within two pixels' depth on a surface at 60°, tan 60° < 2, plus the
@@ -117,6 +105,18 @@ bool lights(const Lamp& lamp, const cv::Mat& reach, const Vec3& point, const Vec
 }
 
 }  // namespace
+
+float sampleBilinear(const cv::Mat& m, const Vec2& p) {
+  const int x0 = static_cast<int>(std::floor(p.x())), y0 = static_cast<int>(std::floor(p.y()));
+  const float ax = static_cast<float>(p.x() - x0), ay = static_cast<float>(p.y() - y0);
+  const auto at = [&](int x, int y) {
+    x = std::clamp(x, 0, m.cols - 1);
+    y = std::clamp(y, 0, m.rows - 1);
+    return m.at<float>(y, x);
+  };
+  return (1 - ay) * ((1 - ax) * at(x0, y0) + ax * at(x0 + 1, y0)) +
+         ay * ((1 - ax) * at(x0, y0 + 1) + ax * at(x0 + 1, y0 + 1));
+}
 
 Result<LampWeights> lampWeights(std::span<const Lamp> lamps, const LampWeightOptions& o) {
   if (lamps.empty()) return fail(ErrorCode::kInvalidInput, "no projectors to weigh");
@@ -185,7 +185,8 @@ Result<LampWeights> lampWeights(std::span<const Lamp> lamps, const LampWeightOpt
               if (j == i || !lamps[j].enabled) continue;
               // Its reach read between pixels, so that it fades to zero over the pixel
               // past its last one as its light does.
-              if (const auto q = sees(lamps[j], point, normal)) sum += bilinear(strength[j], *q);
+              if (const auto q = sees(lamps[j], point, normal))
+                sum += sampleBilinear(strength[j], *q);
             }
             w.at<float>(y, x) = static_cast<float>(own / sum);
           }

@@ -64,6 +64,10 @@ struct LampWeights {
 // margin and smoothing in [0, 16], a position error outside [0, 0.1] m).
 Result<LampWeights> lampWeights(std::span<const Lamp> lamps, const LampWeightOptions& options = {});
 
+// A weight or reach image (CV_32FC1) read between pixels, as a projector's light reaches
+// a point between its pixel centres (clamped to the frame's edge pixels).
+float sampleBilinear(const cv::Mat& m, const Vec2& pixel);
+
 // Which projectors see a world point on the side its unit normal faces (the point is the
 // first thing their ray meets there): its framebuffer position in each, or nullopt. Their
 // weights, read there between pixels, are the share of the point's light each gives.

@@ -103,15 +103,6 @@ int main(int argc, char** argv) {
 
   // Error: the weights' sum at the first projector's pixel centres, the others' read
   // between their pixels (as their light reaches the point), and clipping.
-  const auto bilinear = [](const cv::Mat& m, const Vec2& p) {
-    const int x0 = static_cast<int>(std::floor(p.x())), y0 = static_cast<int>(std::floor(p.y()));
-    const double ax = p.x() - x0, ay = p.y() - y0;
-    const auto at = [&](int x, int y) {
-      return m.at<float>(std::clamp(y, 0, m.rows - 1), std::clamp(x, 0, m.cols - 1));
-    };
-    return (1 - ay) * ((1 - ax) * at(x0, y0) + ax * at(x0 + 1, y0)) +
-           ay * ((1 - ax) * at(x0, y0 + 1) + ax * at(x0 + 1, y0 + 1));
-  };
   std::vector<double> off;
   for (int y = 0; y < 1080; y += 2) {
     for (int x = 0; x < 1920; x += 2) {
@@ -122,7 +113,7 @@ int main(int argc, char** argv) {
       const auto seen = lamps::lampsSeeing(set, Vec3(p[0], p[1], p[2]), Vec3(n[0], n[1], n[2]));
       double sum = w;
       for (std::size_t j = 1; j < set.size(); ++j)
-        if (seen[j]) sum += bilinear(weights.weight[j], *seen[j]);
+        if (seen[j]) sum += lamps::sampleBilinear(weights.weight[j], *seen[j]);
       off.push_back(std::abs(sum - 1));
     }
   }

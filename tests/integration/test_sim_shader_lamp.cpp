@@ -329,18 +329,8 @@ Figures paint(Rig rig, const std::vector<bool>& enabled, const Look& look = text
       const auto where = lamps::lampsSeeing(lamp_set, s->point, s->normal);
       for (std::size_t i = 0; i < where.size(); ++i) {
         if (!where[i] || !enabled[i]) continue;
-        const cv::Mat& w = weights->weight[i];
-        const int x0 = static_cast<int>(std::floor(where[i]->x()));
-        const int y0 = static_cast<int>(std::floor(where[i]->y()));
-        const double ax = where[i]->x() - x0, ay = where[i]->y() - y0;
-        double wi = 0, ri = 0;
-        for (int k = 0; k < 4; ++k) {
-          const int px = std::clamp(x0 + (k & 1), 0, w.cols - 1);
-          const int py = std::clamp(y0 + (k >> 1), 0, w.rows - 1);
-          const double share = ((k & 1) ? ax : 1 - ax) * ((k >> 1) ? ay : 1 - ay);
-          wi += share * w.at<float>(py, px);
-          ri += share * weights->reach[i].at<float>(py, px);
-        }
+        const double wi = lamps::sampleBilinear(weights->weight[i], *where[i]);
+        const double ri = lamps::sampleBilinear(weights->reach[i], *where[i]);
         deep = std::max(deep, ri);
         if (wi > 1e-3) set |= 1 << i;
         total += wi;

@@ -13,16 +13,6 @@
 namespace procam::lamps {
 namespace {
 
-float bilinear(const cv::Mat& m, const Vec2& p) {
-  const int x0 = static_cast<int>(std::floor(p.x())), y0 = static_cast<int>(std::floor(p.y()));
-  const double ax = p.x() - x0, ay = p.y() - y0;
-  const auto at = [&](int x, int y) {
-    return m.at<float>(std::clamp(y, 0, m.rows - 1), std::clamp(x, 0, m.cols - 1));
-  };
-  return static_cast<float>((1 - ay) * ((1 - ax) * at(x0, y0) + ax * at(x0 + 1, y0)) +
-                            ay * ((1 - ax) * at(x0, y0 + 1) + ax * at(x0 + 1, y0 + 1)));
-}
-
 TEST(ShaderLampView, DistanceAndIncidenceMatchThePlate) {
   auto plate = ObjectModel::build(test::plate(2.0, 1.0, 4));
   ASSERT_TRUE(plate);
@@ -82,16 +72,16 @@ TEST(ShaderLampWeights, OverlappingProjectorsSumToOne) {
       int inside = 0;
       for (std::size_t i = 0; i < 2; ++i) {
         if (!seen[i]) continue;
-        sum += bilinear(w->weight[i], *seen[i]);
-        inside += bilinear(w->reach[i], *seen[i]) > 8;
+        sum += sampleBilinear(w->weight[i], *seen[i]);
+        inside += sampleBilinear(w->reach[i], *seen[i]) > 8;
       }
       if (seen[0] && seen[1] && inside == 2) {
         ++overlap;
         worst = std::max(worst, std::abs(sum - 1));
       }
-      if (seen[0] && !seen[1] && bilinear(w->reach[0], *seen[0]) > 3) {
+      if (seen[0] && !seen[1] && sampleBilinear(w->reach[0], *seen[0]) > 3) {
         ++alone;
-        EXPECT_NEAR(bilinear(w->weight[0], *seen[0]), 1.0, 1e-6) << x << "," << z;
+        EXPECT_NEAR(sampleBilinear(w->weight[0], *seen[0]), 1.0, 1e-6) << x << "," << z;
       }
     }
   }
