@@ -63,14 +63,23 @@ void Daemon::onDisconnect(ClientId client) {
 void Daemon::handle(ClientId client, const proto::Request& req) {
   using Handler = void (Daemon::*)(ClientId, const proto::Request&);
   static const std::pair<const char*, Handler> kCommands[] = {
-      {"version", &Daemon::cmdVersion},     {"status", &Daemon::cmdStatus},
-      {"devices", &Daemon::cmdDevices},     {"watch", &Daemon::cmdWatch},
-      {"calibrate", &Daemon::cmdCalibrate}, {"cancel", &Daemon::cmdCancel},
-      {"keystone", &Daemon::cmdKeystone},   {"pattern", &Daemon::cmdPattern},
-      {"content", &Daemon::cmdContent},     {"save", &Daemon::cmdSave},
-      {"reload", &Daemon::cmdReload},       {"log-level", &Daemon::cmdLogLevel},
-      {"tracker", &Daemon::cmdTracker},     {"latency", &Daemon::cmdLatency},
-      {"snapshot", &Daemon::cmdSnapshot},   {"calibrate-camera", &Daemon::cmdCalibrateCamera},
+      {"version", &Daemon::cmdVersion},
+      {"status", &Daemon::cmdStatus},
+      {"devices", &Daemon::cmdDevices},
+      {"watch", &Daemon::cmdWatch},
+      {"calibrate", &Daemon::cmdCalibrate},
+      {"cancel", &Daemon::cmdCancel},
+      {"keystone", &Daemon::cmdKeystone},
+      {"pattern", &Daemon::cmdPattern},
+      {"content", &Daemon::cmdContent},
+      {"object", &Daemon::cmdObject},
+      {"save", &Daemon::cmdSave},
+      {"reload", &Daemon::cmdReload},
+      {"log-level", &Daemon::cmdLogLevel},
+      {"tracker", &Daemon::cmdTracker},
+      {"latency", &Daemon::cmdLatency},
+      {"snapshot", &Daemon::cmdSnapshot},
+      {"calibrate-camera", &Daemon::cmdCalibrateCamera},
   };
   for (const auto& [name, fn] : kCommands) {
     if (req.cmd != name) continue;

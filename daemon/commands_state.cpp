@@ -43,6 +43,7 @@ void Daemon::cmdPattern(ClientId client, const proto::Request& req) {
 
 json Daemon::contentJson() const {
   if (live_content_) return liveContentJson();
+  if (object_show_.prepared) return object_show_.prepared->info;
   if (!keystone_rt_.meshes.empty() || !keystone_rt_.mesh_images.empty()) {
     return keystone_rt_.mesh_info;
   }
@@ -52,25 +53,46 @@ json Daemon::contentJson() const {
   return j;
 }
 
+void Daemon::dropContent() {
+  stopLiveContent();
+  settings_.content.clear();
+  content_info_ = {};
+  keystone_rt_.content.reset();
+  keystone_rt_.meshes.clear();
+  keystone_rt_.mesh_images.clear();
+  clearObjectContent();
+}
+
 void Daemon::cmdContent(ClientId client, const proto::Request& req) {
   if (req.body.value("action", json()) == "share") return cmdContentShare(client, req);
   if (req.body.value("action", json()) == "stream") return cmdContentStream(client, req);
   RequestArgs args(req.body);
-  PROCAM_CHECK_KEYS(args, "action", "path");
+  PROCAM_CHECK_KEYS(args, "action", "path", "texture", "specular", "shininess");
   const std::string action = args.string("action").value_or("get");
   auto path = args.string("path");
+  auto texture = args.string("texture");
   if (!args.ok()) return errorTo(client, req, code::kBadArgument, args.error());
+  ObjectLook look;
+  const bool look_args = texture || args.get("specular") || args.get("shininess");
+  for (const char* key : {"specular", "shininess"}) {
+    if (const json* v = args.get(key)) {
+      if (!v->is_number())
+        return errorTo(client, req, code::kBadArgument,
+                       std::string("\"") + key + "\" must be a number");
+      (std::string(key) == "specular" ? look.specular : look.shininess) = v->get<double>();
+    }
+  }
+  if (look_args && (action != "load" || !path || !isMeshFile(*path) || !rig_.surface.object)) {
+    return errorTo(client, req, code::kBadArgument,
+                   "\"texture\", \"specular\" and \"shininess\" go with content load of an "
+                   "object's model (.obj, .ply) on a rig with an object (object place)");
+  }
   if (action == "get" || action == "clear") {
     if (path)
       return errorTo(client, req, code::kBadArgument, "content " + action + " takes no path");
     if (action == "clear") {
       ++content_requests_;
-      stopLiveContent();
-      settings_.content.clear();
-      content_info_ = {};
-      keystone_rt_.content.reset();
-      keystone_rt_.meshes.clear();
-      keystone_rt_.mesh_images.clear();
+      dropContent();
       broadcast("content", {{"content", nullptr}});
       refreshOutputs({}, true);
     }
@@ -85,6 +107,12 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
     return errorTo(client, req, code::kBadArgument, "content load needs \"path\"");
   }
   if (refuseOverJobLimit(client, req)) return;
+  if (isMeshFile(*path) && rig_.surface.object) {
+    // An object rig: the model is the look painted on the object (object_content.hpp).
+    look.file = *path;
+    look.texture = texture.value_or("");
+    return loadObjectContent(client, req, std::move(look));
+  }
   if (isMeshFile(*path)) {
     // 3D content (content_mesh.hpp): prepared on a worker, then shown instead of any image.
     const std::string file = *path;
@@ -101,9 +129,9 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
       }
       outputs.push_back(std::move(o));
     }
-    const auto viewer = viewerEye();
-    const std::optional<Vec3> eye = viewer ? std::optional<Vec3>(viewer->position) : std::nullopt;
-    const json eye_source = viewer ? viewer->source : json();
+    const auto viewer = contentEye();
+    const std::optional<Vec3> eye = viewer.first;
+    const json eye_source = viewer.second;
     server_->hold(client);
     const uint64_t request = ++content_requests_;
     compute_worker_->submit(
@@ -116,10 +144,7 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
             } else if (request != content_requests_) {
               errorTo(client, req, code::kCancelled, kReplacedContent);
             } else {
-              stopLiveContent();
-              settings_.content.clear();
-              content_info_ = {};
-              keystone_rt_.content.reset();
+              dropContent();
               keystone_rt_.meshes = std::move((*prepared)->meshes);
               keystone_rt_.mesh_images = std::move((*prepared)->images);
               keystone_rt_.mesh_info = std::move((*prepared)->info);
@@ -176,12 +201,10 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
               } else if (!failure.empty()) {
                 errorTo(client, req, failure_code, failure);
               } else {
-                stopLiveContent();
+                dropContent();
                 settings_.content = resolved;
                 content_info_ = {image->cols, image->rows};
                 keystone_rt_.content = image;
-                keystone_rt_.meshes.clear();
-                keystone_rt_.mesh_images.clear();
                 broadcast("content", {{"content", contentJson()}});
                 refreshOutputs({}, true);
                 replyTo(client, req, "CONTENT", {{"content", contentJson()}, {"operation", op_id}});

@@ -280,6 +280,7 @@ Result<void> Daemon::startLiveContent(std::unique_ptr<content::ContentSource> so
   content_info_ = {source->size().width, source->size().height};
   keystone_rt_.meshes.clear();
   keystone_rt_.mesh_images.clear();
+  clearObjectContent();
   live_content_ = LiveContent{std::move(source), timer, fd, std::move(info), 0, false};
   pollLiveContent();  // a frame already there shows at once
   broadcast("content", {{"content", contentJson()}});

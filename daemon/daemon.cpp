@@ -152,6 +152,7 @@ Result<void> Daemon::setup() {
   if (auto ok = server_->start(); !ok) return ok;
   setupAutoKeystone();
   setupTrackers();
+  watchObjectOutputs();
   setupDriftCheck();
   loadRigSurfaces();
   loadContentAtStart();

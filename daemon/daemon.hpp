@@ -24,6 +24,7 @@
 #include "geometry/intersect.hpp"
 #include "keystone/keystone_solver.hpp"
 #include "keystone_runtime.hpp"
+#include "object_content.hpp"
 #include "output_draw.hpp"
 #include "registry.hpp"
 #include "render/projective_mesh.hpp"
@@ -120,9 +121,22 @@ class Daemon {
   void cmdSave(ClientId, const proto::Request&);
   void cmdReload(ClientId, const proto::Request&);
   void cmdLogLevel(ClientId, const proto::Request&);
+  // commands_object.cpp: the rig's object (shader lamps) and the look painted on it.
+  void cmdObject(ClientId, const proto::Request&);
+  nlohmann::json objectJson() const;
+  void loadObjectContent(ClientId client, const proto::Request& req, ObjectLook look);
+  // Paints the object's look again for the rig and the usable outputs as they are now
+  // (the rig changed, an output came or went); `why` goes to the log.
+  void repaintObject(const std::string& why);
+  void onObjectViewerSample();
+  void clearObjectContent();
+  std::vector<ObjectOutput> objectOutputs() const;
+  void watchObjectOutputs();
   nlohmann::json statusJson() const;
   nlohmann::json keystoneJson() const;
   nlohmann::json contentJson() const;
+  // Whatever content is shown (image, 3D, live, an object's look) is dropped.
+  void dropContent();
   // content_live.cpp: shared-memory frames, raw frames and video.
   void cmdContentShare(ClientId, const proto::Request&);
   void cmdContentStream(ClientId, const proto::Request&);
@@ -207,6 +221,8 @@ class Daemon {
   std::shared_ptr<const RigSurfaceMesh> rigSurfaceFor(const std::string& projector) const;
   // A tracker's (status `viewer`), else the static one.
   std::optional<ViewerEye> viewerEye() const;
+  // viewerEye() as content takes it: the position (none without a viewer) and its source.
+  std::pair<std::optional<Vec3>, nlohmann::json> contentEye() const;
   // [content] viewer, else the rig model's.
   std::optional<ViewerEye> staticEye() const;
   // `fixed_viewer`: content drawn for that world -> image matrix (3D content), shown by
@@ -348,6 +364,18 @@ class Daemon {
   DriftRuntime drift_rt_;
   TrackerRuntime trackers_;
   MeshFollow mesh_follow_;
+  // Content on an object rig (commands_object.cpp).
+  struct ObjectShow {
+    std::optional<ObjectLook> look;                  // what `content load` asked for
+    std::shared_ptr<const PreparedObject> prepared;  // what the outputs show
+    uint64_t generation = 0;                         // of the look or the rig it was made for
+    std::string tracker;      // the viewer's tracker, when the look has a highlight
+    Vec3 eye = Vec3::Zero();  // the highlight's eye of the frames shown or in flight
+    uint64_t updates = 0;     // repaints for a moved viewer
+    bool in_flight = false;   // a repaint runs on the compute worker
+    bool again = false;       // the rig or the outputs changed while it ran
+  };
+  ObjectShow object_show_;
   // Destroyed in reverse order: server and workers before the loop they use.
   std::unique_ptr<EventLoop> loop_;
   std::unique_ptr<WorkerPool> io_worker_;       // state writes (fsync)

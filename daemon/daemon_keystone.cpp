@@ -546,6 +546,7 @@ void Daemon::accelCalibrationStep(ClientId client, const proto::Request& req,
 
 void Daemon::onRigChanged() {
   loadRigSurfaces();
+  repaintObject("the rig model changed");
   // Auto keystone keeps its tilt state and takes the new intrinsics; when it had
   // none, `keystone auto on` reads the rig again.
   KeystoneRuntime& k = keystone_rt_;

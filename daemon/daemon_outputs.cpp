@@ -36,6 +36,7 @@ render::SceneTraits Daemon::sceneTraits(const std::string& output, bool mesh_con
       (p && rig_.surface.meshes.count(p->name)) || !rig_.surface.unified_mesh.empty();
   t.surface = !rig_.surface.plane && meshed ? render::SurfaceKind::kNonPlanar
                                             : render::SurfaceKind::kPlanar;
+  if (rig_.surface.object) t.surface = render::SurfaceKind::kObject;
   // Tracked: a tracker reports the viewer (the eye viewerEye() gives) or the rig names one.
   if (!viewerJson().is_null() || !rig_.viewer.tracker.empty()) {
     t.viewer = render::ViewerKind::kTracked;
@@ -49,8 +50,20 @@ render::SceneTraits Daemon::sceneTraits(const std::string& output, bool mesh_con
 
 std::optional<OutputDraw> Daemon::planOutput(DeviceEntry& e, const OutputDrawPolicy& policy) {
   KeystoneRuntime& k = keystone_rt_;
-  auto mode = outputMode(e.device.raw());
-  if (!mode) return std::nullopt;
+  int rc = PROCAM_OK;
+  auto mode = outputMode(e.device.raw(), &rc);
+  if (!mode) {
+    // An output that no longer answers for its mode is gone (a projector unplugged): the
+    // device manager closes it and opens it again when it is back. Reported from the loop,
+    // not while the outputs are being walked.
+    if (closesDevice(rc)) {
+      loop_->post([this, name = e.name, rc] {
+        if (const DeviceEntry* gone = devices_.find(name); gone && gone->usable())
+          device_manager_->report(name, rc, "the output does not answer for its mode");
+      });
+    }
+    return std::nullopt;
+  }
   FrameRequest r;
   r.output_size = *mode;
   r.pattern = settings_.pattern;
@@ -68,12 +81,24 @@ std::optional<OutputDraw> Daemon::planOutput(DeviceEntry& e, const OutputDrawPol
     mesh_image = &m->second;
     r.content = m->second.image;
   }
+  // An object's look: each frame was rendered from this projector per pixel (shader
+  // lamps, object_content.hpp) and is shown as it is; an output whose projector does not
+  // light the object shows black.
+  const PreparedObject* object = object_show_.prepared.get();
+  std::string object_note;
+  if (object) {
+    auto f = object->frames.find(e.name);
+    r.content = f != object->frames.end() && f->second->size() == *mode ? f->second : nullptr;
+    if (!r.content) object_note = "no frame of the object's look for this output";
+  }
   // Several projectors on one wall: this output's share of the one display.
-  const bool rig_mode = settings_.rig_keystone && !(settings_.auto_keystone && k.estimate);
+  const bool rig_mode =
+      settings_.rig_keystone && !(settings_.auto_keystone && k.estimate) && !object;
   const KeystoneRuntime::Tiled* tiled = rig_mode ? tiledDisplay(sourceSize(r)) : nullptr;
   int tile = tiled ? tiled->index(e.name) : -1;
-  r.homography = tile >= 0 ? std::optional<Mat3>(tiled->display.content_to_framebuffer[tile])
-                           : currentWarp(sourceSize(r));
+  r.homography = object      ? std::optional<Mat3>(Mat3::Identity())
+                 : tile >= 0 ? std::optional<Mat3>(tiled->display.content_to_framebuffer[tile])
+                             : currentWarp(sourceSize(r));
   auto plan = planFrame(r);
   if (!plan) {
     warn("output '" + e.name + "': " + plan.error().message);
@@ -132,7 +157,9 @@ std::optional<OutputDraw> Daemon::planOutput(DeviceEntry& e, const OutputDrawPol
   }
   // A client waiting for this frame, new still content or a new render path gets its
   // numbers at once.
-  const std::string path = render::toString(plan->setup.path);
+  const std::string path = object && plan->source == "content"
+                               ? render::toString(render::RenderPath::kShaderLamps)
+                               : render::toString(plan->setup.path);
   job.want_stats = policy.waited_for || (new_content && !policy.live) || path != st.path ||
                    policy.now - st.stats_time >= kStatsPeriod;
   if (job.want_stats) st.stats_time = policy.now;
@@ -146,6 +173,13 @@ std::optional<OutputDraw> Daemon::planOutput(DeviceEntry& e, const OutputDrawPol
   st.path_note.clear();
   if (!chosen) {
     st.path_note = chosen.error().message;
+  } else if (!object_note.empty()) {
+    st.path_note = object_note;
+  } else if (traits.surface == render::SurfaceKind::kObject && !object &&
+             plan->source == "content") {
+    st.path_note =
+        "content on an object is painted from its model: content load the object's model "
+        "(with its texture); this content is drawn 2D, by homography";
   } else if (!np_note.empty()) {
     st.path_note = np_note;
   } else if (chosen->path != plan->setup.path && plan->source != "content") {

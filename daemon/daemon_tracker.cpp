@@ -123,6 +123,7 @@ void Daemon::onTrackerSample(const std::string& name, const procam_pose_sample& 
   p.timestamp_ns = s.timestamp_ns;
   p.received = std::chrono::steady_clock::now();
   if (name == mesh_follow_.tracker) onMeshViewerSample();
+  if (name == object_show_.tracker) onObjectViewerSample();
   // Image content on a non-planar surface drawn by the two-pass path follows the viewer:
   // a new frame for the new eye (one at a time; refreshOutputs coalesces).
   for (const auto& [output, st] : keystone_rt_.output_state) {

@@ -140,10 +140,12 @@ OutputDrawn drawOutput(const OutputDraw& j) {
   return r;
 }
 
-std::optional<cv::Size> outputMode(const procam_device& raw) {
+std::optional<cv::Size> outputMode(const procam_device& raw, int* rc) {
   uint32_t w = 0, h = 0;
   double hz = 0;
-  if (raw.ops.output->get_mode(raw.self, &w, &h, &hz) != PROCAM_OK || w < 2 || h < 2) {
+  const int got = raw.ops.output->get_mode(raw.self, &w, &h, &hz);
+  if (rc) *rc = got;
+  if (got != PROCAM_OK || w < 2 || h < 2) {
     return std::nullopt;
   }
   return cv::Size(static_cast<int>(w), static_cast<int>(h));

@@ -69,6 +69,7 @@ struct OutputDrawn {
 OutputDrawn drawOutput(const OutputDraw& job);
 
 // The output's mode (framebuffer size); nullopt when it does not answer or is below 2x2.
-std::optional<cv::Size> outputMode(const procam_device& output);
+// `rc`: the driver's answer.
+std::optional<cv::Size> outputMode(const procam_device& output, int* rc = nullptr);
 
 }  // namespace procam::daemon

@@ -8,6 +8,8 @@ namespace procam::daemon {
 namespace {
 // A rig of 64 cameras and 64 projectors is about 100 KB of JSON.
 constexpr std::uintmax_t kMaxRigBytes = 16u << 20;
+// A surface or object mesh file beside an imported rig.json: [limits] file_mib's default.
+constexpr std::uintmax_t kMaxMeshBytes = std::uintmax_t{256} << 20;
 }  // namespace
 
 StateFile rigStateFile(const std::string& state_dir) {
@@ -76,6 +78,26 @@ Result<rig::RigModel> importRig(const std::string& state_dir, const std::string&
   if (!parsed) return tl::unexpected(parsed.error());
   const StateFile target = rigStateFile(state_dir);
   if (auto ok = target.ensureDirectory(); !ok) return tl::unexpected(ok.error());
+  std::vector<std::string> meshes;
+  for (const auto& [projector, name] : parsed->surface.meshes) meshes.push_back(name);
+  if (!parsed->surface.unified_mesh.empty()) meshes.push_back(parsed->surface.unified_mesh);
+  if (parsed->surface.object) meshes.push_back(parsed->surface.object->mesh);
+  const std::filesystem::path beside = std::filesystem::path(file).parent_path();
+  for (const std::string& name : meshes) {
+    if (!rig::RigSurface::isPlainFileName(name)) {
+      return fail(ErrorCode::kInvalidInput,
+                  file + ": mesh '" + name + "' is not a file name beside it");
+    }
+    const std::filesystem::path from = beside / name;
+    if (!std::filesystem::is_regular_file(from, ec)) continue;  // already in the state directory
+    if (std::filesystem::file_size(from, ec) > kMaxMeshBytes || ec) {
+      return fail(ErrorCode::kInvalidInput, from.string() + ": larger than a mesh file can be");
+    }
+    auto bytes = readWholeFile(from.string());
+    if (!bytes) return tl::unexpected(bytes.error());
+    const StateFile mesh(state_dir, name, [](std::string_view) -> Result<void> { return {}; });
+    if (auto ok = mesh.write(*bytes); !ok) return tl::unexpected(ok.error());
+  }
   // Written as parsed (version 2), so that a later merge keeps its form.
   if (auto ok = target.write(rig::rigToJson(*parsed).dump(2) + "\n"); !ok) {
     return tl::unexpected(ok.error());

@@ -35,7 +35,9 @@ Result<rig::RigModel> mergeIntoRig(const std::string& state_dir, const rig::RigM
                                    const std::map<std::string, std::string>& meshes);
 
 // procamd --rig FILE: FILE checked as a rig model and installed as the state
-// directory's rig.json (replacing what was there, which stays as the backup).
+// directory's rig.json (replacing what was there, which stays as the backup). The mesh
+// files it names (surface meshes, the object's model) that lie beside FILE are copied
+// into the state directory with it; one that does not is looked for there.
 Result<rig::RigModel> importRig(const std::string& state_dir, const std::string& file);
 
 // Now as ISO 8601 UTC, for provenance records.

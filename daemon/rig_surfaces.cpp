@@ -75,6 +75,12 @@ std::optional<Daemon::ViewerEye> Daemon::viewerEye() const {
   return staticEye();
 }
 
+std::pair<std::optional<Vec3>, nlohmann::json> Daemon::contentEye() const {
+  const auto viewer = viewerEye();
+  if (!viewer) return {std::nullopt, nlohmann::json()};
+  return {viewer->position, viewer->source};
+}
+
 std::shared_ptr<const Daemon::RigSurfaceMesh> Daemon::rigSurfaceFor(
     const std::string& projector) const {
   auto s = rig_surfaces_.find(projector);

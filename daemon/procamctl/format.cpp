@@ -88,6 +88,16 @@ std::string contentText(const json& c) {
     if (st.contains("test")) s = "test video " + st["test"].get<std::string>();
   }
   if (c.contains("shared")) s = "shared memory";
+  if (c.contains("object") && c.contains("display")) {
+    const json& d = c["display"];
+    const json& cov = d["coverage"];
+    char line[200];
+    std::snprintf(line, sizeof line,
+                  ", painted on the object: white %.4g (%s), lit %.4f m2, unlit %.4f m2",
+                  d.value("white", 0.0), d.value("units", "").c_str(), cov.value("lit_m2", 0.0),
+                  cov.value("unlit_m2", 0.0));
+    s += line;
+  }
   if (c.contains("size")) s += " (" + scalar(c["size"][0]) + "x" + scalar(c["size"][1]) + ")";
   if (c.contains("frames")) {
     s += ", " + scalar(c["frames"]) + " frames" + (c.value("ended", false) ? ", ended" : "");
@@ -334,6 +344,20 @@ std::string formatReply(const json& r) {
            (r.value("shown", false) ? " (shown)" : " (no output showed it)") + "\n";
   }
   if (cls == "CONTENT") return "content: " + contentText(r["content"]) + "\n";
+  if (cls == "OBJECT") {
+    const json& o = r["object"];
+    if (o.is_null()) return "object: none\n";
+    std::string out =
+        field("object", scalar(o["mesh"]) + " (" + scalar(o["placed"]["method"]) + ")");
+    out += field("position", pairList(o["t"]) + " m");
+    if (o.contains("fit_rms_m")) {
+      char line[64];
+      std::snprintf(line, sizeof line, "%.2f mm RMS", 1000 * o["fit_rms_m"].get<double>());
+      out += field("fit", line);
+    }
+    out += field("painted", o.value("painted", false) ? "yes" : "no");
+    return out;
+  }
   if (cls == "SAVE") return "saved " + scalar(r["path"]) + " (" + scalar(r["bytes"]) + " bytes)\n";
   if (cls == "RELOAD") return "reloaded " + scalar(r["config"]) + "\n";
   if (cls == "LOG-LEVEL") return "log level " + scalar(r["level"]) + "\n";

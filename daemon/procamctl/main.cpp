@@ -37,6 +37,13 @@ constexpr const char* kUsage =
     "  keystone auto on|off\n"
     "  pattern [off|grid|crosshair|white|black]\n"
     "  content [get] | content load PATH | content clear\n"
+    "  content load MODEL [texture=IMAGE] [specular=S] [shininess=N]\n"
+    "                                 on a rig with an object: paint its placed model\n"
+    "                                 (MODEL, .obj or .ply with texture coordinates)\n"
+    "  object [get] | object clear    the object the projectors paint (shader lamps)\n"
+    "  object place MODEL FILE [max_rms_m=M]\n"
+    "                                 register MODEL to the rig from FILE: {\"points\":\n"
+    "                                 [{\"model\": [x,y,z], \"world\": [x,y,z]}, ...]}, 4 or more\n"
     "  content stream PATH [WxH [rgb8|rgba8 [FPS]]]\n"
     "                                 raw frames (with a size) or a video file\n"
     "                                 (PATH: under the daemon's content roots; a relative\n"
@@ -105,6 +112,8 @@ void sizeInto(json& r, const std::string& what, const std::string& text) {
   r["height"] = h;
 }
 
+json keyValueRequest(const std::string& cmd, const std::vector<std::string>& a);
+
 json buildRequest(const std::string& cmd, const std::vector<std::string>& a) {
   auto arity = [&](size_t lo, size_t hi) {
     if (a.size() < lo || a.size() > hi) usage("wrong number of arguments for " + cmd);
@@ -148,8 +157,16 @@ json buildRequest(const std::string& cmd, const std::vector<std::string>& a) {
     const std::string action = a.empty() ? "get" : a[0];
     r["action"] = action;
     if (action == "load") {
-      arity(2, 2);
+      arity(2, 5);
       r["path"] = clientPath(a[1]);
+      // The look of an object's model: KEY=VALUE after it.
+      const json look = keyValueRequest("content", {a.begin() + 2, a.end()});
+      for (const auto& [key, value] : look.items()) {
+        if (key == "cmd") continue;
+        if (key != "texture" && key != "specular" && key != "shininess")
+          usage("content load takes texture=, specular= and shininess= after the path");
+        r[key] = key == "texture" && value.is_string() ? json(clientPath(value)) : value;
+      }
     } else if (action == "get" || action == "clear") {
       arity(0, 1);
     } else if (action == "uri" || action == "v4l2") {
@@ -174,6 +191,27 @@ json buildRequest(const std::string& cmd, const std::vector<std::string>& a) {
       r["pipeline"] = a[1];
     } else {
       usage("unknown content action '" + action + "'");
+    }
+  } else if (cmd == "object") {
+    const std::string action = a.empty() ? "get" : a[0];
+    r["action"] = action;
+    if (action == "get" || action == "clear") {
+      arity(0, 1);
+    } else if (action == "place") {
+      arity(3, 4);
+      r["model"] = clientPath(a[1]);
+      std::ifstream in(a[2]);
+      const json body = json::parse(in, nullptr, false);
+      if (!in.is_open() || !body.is_object() || !body.contains("points"))
+        usage("object place: " + a[2] + " is not a JSON object with \"points\"");
+      r["points"] = body["points"];
+      if (a.size() == 4) {
+        const json extra = keyValueRequest("object", {a[3]});
+        if (!extra.contains("max_rms_m")) usage("object place takes max_rms_m= after FILE");
+        r["max_rms_m"] = extra["max_rms_m"];
+      }
+    } else {
+      usage("unknown object action '" + action + "'");
     }
   } else if (cmd == "tracker") {
     const std::string action = a.empty() ? "get" : a[0];

@@ -35,7 +35,4 @@ struct ObjectRenderInput {
 // kNotFound without a posed projector; errors of reading the mesh and of the pipeline.
 Result<nlohmann::json> renderObject(const ObjectRenderInput& in);
 
-// sRGB codes (8 or 16 bit, grey, RGB or RGBA in OpenCV's order) as linear RGB floats.
-cv::Mat linearTexture(const cv::Mat& image);
-
 }  // namespace procam::render_cli

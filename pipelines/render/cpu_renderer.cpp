@@ -12,6 +12,7 @@ Result<WarpMap> mainPathMap(const RenderSetup& setup) {
     case RenderPath::kLookupWarp:
       return gridMap(setup.lookup, setup.output_size);
     case RenderPath::kPlanar3d:
+    case RenderPath::kShaderLamps:
       break;
   }
   return fail(ErrorCode::kInvalidInput, "cpu renderer: the planar 3D path draws triangles, no map");

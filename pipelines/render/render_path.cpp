@@ -25,10 +25,14 @@ Result<PathChoice> choosePath(const SceneTraits& scene) {
       if (c.path == RenderPath::kLookupWarp) c.post_warp = false;
       return c;
     case SurfaceKind::kObject:
-      break;
+      // Rendered from each projector with its own radiance correction and weights
+      // ([Raskar02] §5.2.5 feathering by reach and depth discontinuities): no post warp,
+      // the weights are the blend. The look does not depend on the content kind.
+      c.path = RenderPath::kShaderLamps;
+      c.post_warp = false;
+      return c;
   }
-  return fail(ErrorCode::kNotFound,
-              "choosePath: object surfaces (shader lamps) are not rendered by this renderer");
+  return fail(ErrorCode::kInvalidInput, "choosePath: unknown surface kind");
 }
 
 const char* toString(RenderPath path) {
@@ -41,6 +45,8 @@ const char* toString(RenderPath path) {
       return "two-pass-mesh";
     case RenderPath::kLookupWarp:
       return "lookup-warp";
+    case RenderPath::kShaderLamps:
+      return "shader-lamps";
   }
   return "unknown";
 }

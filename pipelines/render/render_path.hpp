@@ -20,6 +20,10 @@ enum class RenderPath {
   kPlanar3d,     // planar surface, tracked viewer, 3D content: A'4x4 P_T (§4.2.2-4.2.3)
   kTwoPassMesh,  // non-planar surface, tracked viewer: projective texture (§3.2.3, §4.1.1)
   kLookupWarp,   // non-planar surface, static viewer: measured lookup warp (§4.1.5)
+  // Object surface: every projector pixel's radiance-corrected value is computed by
+  // pipelines/shader_lamps (§5.2.4-5.2.5) and the frame is shown as it is. A RenderSetup
+  // never carries this path: the frame goes out through kHomography with H = I.
+  kShaderLamps,
 };
 
 struct PathChoice {
@@ -28,8 +32,7 @@ struct PathChoice {
   bool blend = false;      // several projectors: alpha mask + weight LUT (§4.1.2)
 };
 
-// kInvalidInput for projectors < 1; kNotFound for object surfaces (shader lamps render
-// from the projector with radiance correction, which this renderer does not provide).
+// kInvalidInput for projectors < 1.
 Result<PathChoice> choosePath(const SceneTraits& scene);
 
 const char* toString(RenderPath path);

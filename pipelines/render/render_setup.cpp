@@ -50,6 +50,10 @@ Result<void> validateSetup(const RenderSetup& s) {
     case RenderPath::kPlanar3d:
       if (!s.planar3d.allFinite()) return fail(ErrorCode::kInvalidInput, "setup: non-finite A'P_T");
       break;
+    case RenderPath::kShaderLamps:
+      return fail(ErrorCode::kInvalidInput,
+                  "setup: shader-lamps frames are computed per pixel and shown by the homography "
+                  "path");
   }
   if (!s.final_stage.alpha.empty() &&
       (s.final_stage.alpha.type() != CV_8UC1 || s.final_stage.alpha.size() != s.output_size)) {

@@ -1,6 +1,7 @@
 #include "rig/rig_model.hpp"
 
 #include <Eigen/SVD>
+#include <algorithm>
 #include <cmath>
 
 namespace procam::rig {
@@ -273,6 +274,28 @@ Result<void> surfaceFrom(const json& s, RigModel& rig, const std::string& where)
     }
   }
   rig.surface.unified_mesh = stringField(s, "unified_mesh", "");
+  if (s.contains("object")) {
+    const json& o = s["object"];
+    const std::string at = where + " surface object";
+    if (!o.is_object() || !o.contains("mesh") || !o["mesh"].is_string())
+      return fail(ErrorCode::kParse, at + ": needs 'mesh', a file name");
+    RigObject object;
+    object.mesh = o["mesh"].get<std::string>();
+    if (o.contains("R")) {
+      auto R = rotation(o, "R", at);
+      if (!R) return tl::unexpected(R.error());
+      object.R = *R;
+    }
+    if (o.contains("t")) {
+      auto t = vector3(o, "t", at);
+      if (!t) return tl::unexpected(t.error());
+      object.t = *t;
+    }
+    object.fit_rms_m = numberField(o, "fit_rms_m", -1);
+    object.points = static_cast<long>(std::clamp(numberField(o, "points", 0), 0.0, 1e9));
+    object.placed = provenance(json{{"calibrated", o.value("placed", json::object())}});
+    rig.surface.object = std::move(object);
+  }
   return {};
 }
 
@@ -447,6 +470,15 @@ json rigToJson(const RigModel& rig) {
     }
     if (!rig.surface.meshes.empty()) s["meshes"] = rig.surface.meshes;
     if (!rig.surface.unified_mesh.empty()) s["unified_mesh"] = rig.surface.unified_mesh;
+    if (const auto& o = rig.surface.object) {
+      json oj = {{"mesh", o->mesh},
+                 {"R", matrixJson(o->R)},
+                 {"t", vecJson(o->t)},
+                 {"points", o->points},
+                 {"placed", provenanceJson(o->placed)}};
+      if (o->fit_rms_m >= 0) oj["fit_rms_m"] = o->fit_rms_m;
+      s["object"] = std::move(oj);
+    }
     j["surface"] = std::move(s);
   }
   if (!rig.viewer.empty()) {
@@ -490,6 +522,7 @@ RigModel mergeRig(RigModel base, const RigModel& update) {
   }
   for (const auto& [proj, file] : update.surface.meshes) base.surface.meshes[proj] = file;
   if (!update.surface.unified_mesh.empty()) base.surface.unified_mesh = update.surface.unified_mesh;
+  if (update.surface.object) base.surface.object = update.surface.object;
   if (update.viewer.position) base.viewer.position = update.viewer.position;
   if (!update.viewer.tracker.empty()) base.viewer.tracker = update.viewer.tracker;
   return base;

@@ -78,15 +78,30 @@ struct RigProjector {
   geom::CameraModel model() const;
 };
 
-// The display surface: a plane, a mesh per projector (in its own pixel grid), or
-// one mesh unified over all projectors. Mesh files live beside rig.json.
+// A physical object the projectors light ([Raskar02] §5.2, shader lamps): its model (a
+// PLY or OBJ file beside rig.json, in the model's own frame, with the texture coordinates
+// a look is painted through) and where it stands: world = R · model + t, from points
+// picked on the object and located in the world (eq. 4.2) or the identity for a model
+// measured in the world (route (a)'s unified mesh).
+struct RigObject {
+  std::string mesh;
+  Mat3 R = Mat3::Identity();
+  Vec3 t = Vec3::Zero();
+  double fit_rms_m = -1;  // of the placement's points; < 0 when unknown
+  long points = 0;        // the points it was placed from
+  Provenance placed;
+};
+
+// The display surface: a plane, a mesh per projector (in its own pixel grid), one mesh
+// unified over all projectors, or an object. Mesh files live beside rig.json.
 struct RigSurface {
   std::optional<geom::Plane> plane;
   double plane_rms_m = -1;
   std::map<std::string, std::string> meshes;  // projector name -> PLY file name
   std::string unified_mesh;
+  std::optional<RigObject> object;
 
-  bool empty() const { return !plane && meshes.empty() && unified_mesh.empty(); }
+  bool empty() const { return !plane && meshes.empty() && unified_mesh.empty() && !object; }
   // A mesh named in rig.json is a file beside it, never a path out of its folder.
   static bool isPlainFileName(const std::string& name) {
     return !name.empty() && name.find('/') == std::string::npos && name[0] != '.';
@@ -129,7 +144,7 @@ nlohmann::json rigToJson(const RigModel& rig);
 
 // `update` merged into `base`: its cameras and projectors replace those of the
 // same name and are added otherwise; its surface parts (plane, per-projector
-// meshes, unified mesh) and viewer replace the base's where present. Everything
+// meshes, unified mesh, object) and viewer replace the base's where present. Everything
 // else of the base is kept.
 RigModel mergeRig(RigModel base, const RigModel& update);
 

@@ -1,5 +1,6 @@
 #include "shader_lamps/object_placement.hpp"
 
+#include <cstdio>
 #include <string>
 
 #include "geometry/rigid.hpp"
@@ -32,6 +33,33 @@ Result<ObjectPlacement> placeObject(std::span<const Vec3> model_points,
 geom::TriangleMesh placedMesh(const geom::TriangleMesh& model, const ObjectPlacement& p) {
   geom::TriangleMesh out = model;
   for (Vec3& v : out.vertices) v = p.R * v + p.t;
+  return out;
+}
+
+std::string modelPly(const geom::TriangleMesh& model) {
+  const bool textured = model.texcoord.size() == model.vertices.size() && !model.vertices.empty();
+  std::string out;
+  out.reserve(128 + model.vertices.size() * 64 + model.faces.size() * 24);
+  out += "ply\nformat ascii 1.0\ncomment procamd object model, model frame, metres\n";
+  out += "element vertex " + std::to_string(model.vertices.size()) + "\n";
+  out += "property double x\nproperty double y\nproperty double z\n";
+  if (textured) out += "property float s\nproperty float t\n";
+  out += "element face " + std::to_string(model.faces.size()) + "\n";
+  out += "property list uchar int vertex_indices\nend_header\n";
+  char line[160];
+  for (std::size_t i = 0; i < model.vertices.size(); ++i) {
+    const Vec3& x = model.vertices[i];
+    int n = std::snprintf(line, sizeof line, "%.9g %.9g %.9g", x.x(), x.y(), x.z());
+    if (textured)
+      n += std::snprintf(line + n, sizeof line - static_cast<std::size_t>(n), " %.7g %.7g",
+                         model.texcoord[i].x(), model.texcoord[i].y());
+    out.append(line, static_cast<std::size_t>(n));
+    out += '\n';
+  }
+  for (const auto& f : model.faces) {
+    std::snprintf(line, sizeof line, "3 %d %d %d\n", f.x(), f.y(), f.z());
+    out += line;
+  }
   return out;
 }
 

@@ -6,6 +6,7 @@
 // transform that places the model; more than the three a rigid transform needs, so
 // that the fit's residual tells a mis-picked point or a model of another object.
 #include <span>
+#include <string>
 
 #include "core/error.hpp"
 #include "core/types.hpp"
@@ -29,5 +30,9 @@ Result<ObjectPlacement> placeObject(std::span<const Vec3> model_points,
 
 // The model's vertices moved into the world.
 geom::TriangleMesh placedMesh(const geom::TriangleMesh& model, const ObjectPlacement& placement);
+
+// The model as an ASCII PLY file (vertices x y z in the model's frame, texture coordinates
+// as s t when it has them, triangles): the form a placed model is kept in beside rig.json.
+std::string modelPly(const geom::TriangleMesh& model);
 
 }  // namespace procam::lamps

@@ -96,6 +96,11 @@ RenderSetupView::RenderSetupView(const render::RenderSetup& s) {
     case render::RenderPath::kLookupWarp:
       v.path = PROCAM_RENDER_LOOKUP_WARP;
       break;
+    case render::RenderPath::kShaderLamps:
+      // No ABI path: such frames are computed per pixel and shown by the homography path.
+      // No enumerator has 0: a driver refuses a setup that carries it.
+      v.path = static_cast<procam_render_path>(0);
+      break;
   }
   rowMajor<3, 3>(s.homography, v.homography);
   rowMajor<4, 4>(s.planar3d, v.planar3d);

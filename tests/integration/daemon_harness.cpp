@@ -39,6 +39,19 @@ std::string contentFile(const TempDir& root, const std::string& name) {
   return root.file("state/content/" + name);
 }
 
+json ctlJson(const DaemonProcess& d, const std::vector<std::string>& args, int& status) {
+  std::vector<std::string> argv = {PROCAMCTL_BIN, "--socket", d.socketPath(), "--json"};
+  argv.insert(argv.end(), args.begin(), args.end());
+  const RunResult r = runProgram(argv);
+  status = r.status;
+  std::string last;
+  std::istringstream lines(r.out);
+  for (std::string line; std::getline(lines, line);) {
+    if (!line.empty()) last = line;
+  }
+  return json::parse(last, nullptr, false);
+}
+
 void writeContent(const TempDir& root, const std::string& name, const std::string& text) {
   std::ofstream(contentFile(root, name), std::ios::binary) << text;
 }

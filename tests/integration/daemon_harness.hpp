@@ -99,6 +99,10 @@ struct RunResult {
 };
 RunResult runProgram(const std::vector<std::string>& argv, const std::string& stdin_text = "");
 
+// `procamctl --json ARGS` against `d`: its last line (an operation prints its started
+// reply and events first), and its exit status in `status`.
+json ctlJson(const DaemonProcess& d, const std::vector<std::string>& args, int& status);
+
 // The virtual cameras ray-cast every capture: about 8x slower under
 // AddressSanitizer or ThreadSanitizer. Tests that wait on captures scale their
 // times by this.

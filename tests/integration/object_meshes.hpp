@@ -5,6 +5,8 @@
 // that checks can stay off the creases between parts.
 #include <cmath>
 #include <numbers>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "core/types.hpp"
@@ -132,6 +134,35 @@ inline ObjectMesh vaseMesh(const Vec3& ball_center, double ball_radius, const Ve
   }
   windOutward(m, neck_first, neck_base, Vec3::UnitZ());
   return m;
+}
+
+// Which side of an axis-aligned box a normal belongs to (0 to 5).
+inline int boxSideOf(const Vec3& n) {
+  return n.x() > 0.5    ? 0
+         : n.x() < -0.5 ? 1
+         : n.y() > 0.5  ? 2
+         : n.y() < -0.5 ? 3
+         : n.z() > 0.5  ? 4
+                        : 5;
+}
+
+// The mesh as an ASCII PLY with its texture coordinates (s t), its vertices in a model
+// frame where world = R · model + t (the identity: world coordinates).
+inline std::string texturedPly(const ObjectMesh& m, const Mat3& R = Mat3::Identity(),
+                               const Vec3& t = Vec3::Zero()) {
+  std::ostringstream ply;
+  ply << "ply\nformat ascii 1.0\nelement vertex " << m.mesh.vertices.size()
+      << "\nproperty double x\nproperty double y\nproperty double z\nproperty double s\n"
+         "property double t\nelement face "
+      << m.mesh.faces.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
+  ply.precision(17);
+  for (std::size_t v = 0; v < m.mesh.vertices.size(); ++v) {
+    const Vec3 x = R.transpose() * (m.mesh.vertices[v] - t);
+    ply << x.x() << ' ' << x.y() << ' ' << x.z() << ' ' << m.uv[v].x() << ' ' << m.uv[v].y()
+        << '\n';
+  }
+  for (const auto& f : m.mesh.faces) ply << "3 " << f[0] << ' ' << f[1] << ' ' << f[2] << '\n';
+  return ply.str();
 }
 
 }  // namespace procam::itest

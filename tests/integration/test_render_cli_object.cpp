@@ -23,10 +23,12 @@
 #include "rig/rig_model.hpp"
 #include "shader_lamps/appearance.hpp"
 #include "shader_lamps/object_model.hpp"
+#include "shader_lamps/rig_lamps.hpp"
 #include "sim/renderer.hpp"
 #include "sim/scene_library.hpp"
 #include "sim/truth_rig.hpp"
 #include "true_brightness.hpp"
+#include "wave_texture.hpp"
 
 namespace procam::itest {
 namespace {
@@ -56,19 +58,7 @@ BoxRig boxRig(const TempDir& dir) {
   r.rig = dir.file("rig.json");
   // The box's model with its texture atlas, as an ASCII PLY.
   const ObjectMesh box = boxMesh(kBoxCentre, kBoxSize, 0.01);
-  std::ostringstream ply;
-  ply << "ply\nformat ascii 1.0\nelement vertex " << box.mesh.vertices.size()
-      << "\nproperty double x\nproperty double y\nproperty double z\nproperty double s\n"
-         "property double t\nelement face "
-      << box.mesh.faces.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
-  ply.precision(17);
-  for (std::size_t v = 0; v < box.mesh.vertices.size(); ++v) {
-    const Vec3& x = box.mesh.vertices[v];
-    ply << x.x() << ' ' << x.y() << ' ' << x.z() << ' ' << box.uv[v].x() << ' ' << box.uv[v].y()
-        << '\n';
-  }
-  for (const auto& f : box.mesh.faces) ply << "3 " << f[0] << ' ' << f[1] << ' ' << f[2] << '\n';
-  dir.write("box.ply", ply.str());
+  dir.write("box.ply", texturedPly(box));
   r.mesh = dir.file("box.ply");
   // The same as OBJ, texture coordinates per face corner.
   std::ostringstream obj;
@@ -81,22 +71,7 @@ BoxRig boxRig(const TempDir& dir) {
         << f[2] + 1 << '/' << f[2] + 1 << '\n';
   dir.write("box.obj", obj.str());
   // A smooth texture, sRGB-encoded.
-  cv::Mat texture(256, 256, CV_8UC3);
-  const double pi = std::numbers::pi;
-  for (int y = 0; y < 256; ++y) {
-    for (int x = 0; x < 256; ++x) {
-      const double u = (x + 0.5) / 256, v = 1 - (y + 0.5) / 256;
-      const double rgb[3] = {0.55 + 0.3 * std::sin(2 * pi * (2 * u + v)),
-                             0.5 + 0.3 * std::cos(2 * pi * (u - 2 * v)),
-                             0.45 + 0.25 * std::sin(6 * pi * v)};
-      for (int c = 0; c < 3; ++c) {
-        const double l = rgb[c];
-        const double e = l <= 0.0031308 ? 12.92 * l : 1.055 * std::pow(l, 1 / 2.4) - 0.055;
-        texture.at<cv::Vec3b>(y, x)[2 - c] = static_cast<std::uint8_t>(std::lround(255 * e));
-      }
-    }
-  }
-  EXPECT_TRUE(cv::imwrite(dir.file("look.png"), texture));
+  EXPECT_TRUE(cv::imwrite(dir.file("look.png"), waveTextureSrgb()));
   r.texture = dir.file("look.png");
   return r;
 }
@@ -121,7 +96,7 @@ double appearanceError(const BoxRig& r, const std::string& dir, double white, lo
   const ObjectMesh box = boxMesh(kBoxCentre, kBoxSize, 0.01);
   auto model = lamps::ObjectModel::build(box.mesh, box.uv);
   EXPECT_TRUE(model);
-  const cv::Mat texture = render_cli::linearTexture(cv::imread(r.texture, cv::IMREAD_UNCHANGED));
+  const cv::Mat texture = lamps::linearTexture(cv::imread(r.texture, cv::IMREAD_UNCHANGED));
   const geom::CameraModel& eye = r.state.viewer;
   cv::Mat group(eye.height, eye.width, CV_32SC1, cv::Scalar(-1));
   std::vector<double> target(static_cast<std::size_t>(eye.width * eye.height), 0);
@@ -133,13 +108,7 @@ double appearanceError(const BoxRig& r, const std::string& dir, double white, lo
       const auto s = model->intersect(*eye.backproject(Vec2(x, y)));
       if (!s) continue;
       // Face by its normal: one group per side of the box.
-      const Vec3 n = t.normal;
-      group.at<int>(y, x) = n.x() > 0.5    ? 0
-                            : n.x() < -0.5 ? 1
-                            : n.y() > 0.5  ? 2
-                            : n.y() < -0.5 ? 3
-                            : n.z() > 0.5  ? 4
-                                           : 5;
+      group.at<int>(y, x) = boxSideOf(t.normal);
       target[static_cast<std::size_t>(y * eye.width + x)] =
           white * luma(lamps::textureAt(texture, s->texcoord));
     }

@@ -36,6 +36,7 @@
 #include "sim/projector_image.hpp"
 #include "sim/renderer.hpp"
 #include "sim/scene_library.hpp"
+#include "wave_texture.hpp"
 
 namespace procam::itest {
 namespace {
@@ -50,23 +51,6 @@ constexpr double kWholeLightPx = 3;
 // Where each scene's object stands (a moved viewer looks there).
 const std::map<std::string, Vec3, std::less<>> kObjectCentre = {
     {"object_box", Vec3(0.1, 1.5, 0.875)}, {"object_vase", Vec3(0.0, 1.5, 0.93)}};
-
-// A smooth linear-RGB texture: three slow waves, every channel in [0.2, 0.85].
-cv::Mat waveTexture() {
-  const int n = 256;
-  cv::Mat t(n, n, CV_32FC3);
-  const double pi = std::numbers::pi;
-  for (int y = 0; y < n; ++y) {
-    for (int x = 0; x < n; ++x) {
-      const double u = (x + 0.5) / n, v = 1 - (y + 0.5) / n;
-      t.at<cv::Vec3f>(y, x) =
-          cv::Vec3f(static_cast<float>(0.55 + 0.3 * std::sin(2 * pi * (2 * u + v))),
-                    static_cast<float>(0.5 + 0.3 * std::cos(2 * pi * (u - 2 * v))),
-                    static_cast<float>(0.45 + 0.25 * std::sin(6 * pi * v)));
-    }
-  }
-  return t;
-}
 
 double luminance(const Vec3& rgb) {
   return 0.2126 * rgb.x() + 0.7152 * rgb.y() + 0.0722 * rgb.z();
@@ -117,7 +101,7 @@ struct Look {
 
 Look texturedLook() {
   Look look;
-  look.material.texture = waveTexture();
+  look.material.texture = waveTextureLinear();
   return look;
 }
 
@@ -542,7 +526,7 @@ TEST(ShaderLamp, AProjectorSwitchedOffLeavesReportedHoles) {
 TEST(ShaderLamp, HighlightsFollowATrackedViewer) {
   const Rig rig = vaseRig();
   Look look;
-  look.material.texture = waveTexture();
+  look.material.texture = waveTextureLinear();
   look.material.albedo_rgb = Vec3::Constant(0.55);
   look.material.specular_rgb = Vec3::Constant(0.35);
   look.material.shininess = 24;

@@ -20,20 +20,6 @@
 namespace procam::itest {
 namespace {
 
-json ctlJson(const DaemonProcess& d, const std::vector<std::string>& args, int& status) {
-  std::vector<std::string> argv = {PROCAMCTL_BIN, "--socket", d.socketPath(), "--json"};
-  argv.insert(argv.end(), args.begin(), args.end());
-  const RunResult r = runProgram(argv);
-  status = r.status;
-  // An operation prints its started reply and events first: the last line is the answer.
-  std::string last;
-  std::istringstream lines(r.out);
-  for (std::string line; std::getline(lines, line);) {
-    if (!line.empty()) last = line;
-  }
-  return json::parse(last, nullptr, false);
-}
-
 TEST(Snapshot, VirtualRigFrameThroughProcamctl) {
   TempDir dir;
   DaemonProcess d(dir, DaemonProcess::Launch{{"--sim", "handheld"}, {}, -1, true});

@@ -260,6 +260,8 @@ Result<void> GlRenderer::configure(const render::RenderSetup& setup) {
       main_quad_size_ = {};
       main_clip_ = clip * setup.planar3d;  // geometry arrives with the content
       break;
+    case render::RenderPath::kShaderLamps:  // refused by validateSetup above
+      return fail(ErrorCode::kInvalidInput, "GL renderer: shader-lamps frames come drawn");
   }
   if (setup.post_warp) {
     std::vector<float> v;

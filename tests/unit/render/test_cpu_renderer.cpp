@@ -36,10 +36,20 @@ TEST(RenderPath, FollowsTheDesignTable) {
             RenderPath::kLookupWarp);
   EXPECT_FALSE(
       pick(SurfaceKind::kNonPlanar, ViewerKind::kTracked, ContentKind::kImage, 1).post_warp);
-  EXPECT_EQ(choosePath({SurfaceKind::kObject, ViewerKind::kTracked, ContentKind::kMesh3d, 1})
-                .error()
-                .code,
-            ErrorCode::kNotFound);
+  // An object is painted from each projector with its own weights: no post warp.
+  const auto lamps = pick(SurfaceKind::kObject, ViewerKind::kTracked, ContentKind::kMesh3d, 3);
+  EXPECT_EQ(lamps.path, RenderPath::kShaderLamps);
+  EXPECT_TRUE(lamps.blend);
+  EXPECT_FALSE(lamps.post_warp);
+  EXPECT_EQ(pick(SurfaceKind::kObject, ViewerKind::kUntracked, ContentKind::kImage, 1).path,
+            RenderPath::kShaderLamps);
+  EXPECT_STREQ(toString(RenderPath::kShaderLamps), "shader-lamps");
+  // No renderer is configured for it: its frames come drawn.
+  RenderSetup drawn;
+  drawn.output_size = {8, 8};
+  drawn.content_size = {8, 8};
+  drawn.path = RenderPath::kShaderLamps;
+  EXPECT_EQ(CpuRenderer().configure(drawn).error().code, ErrorCode::kInvalidInput);
   EXPECT_EQ(
       choosePath({SurfaceKind::kPlanar, ViewerKind::kTracked, ContentKind::kImage, 0}).error().code,
       ErrorCode::kInvalidInput);

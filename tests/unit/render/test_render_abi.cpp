@@ -55,6 +55,13 @@ TEST(RenderAbi, SetupsSurviveTheBoundaryUnchanged) {
     if (path != render::RenderPath::kLookupWarp) expected.lookup = back->lookup;
     EXPECT_TRUE(render::sameSetup(*back, expected)) << render::toString(path);
   }
+  // Shader-lamps frames come drawn: a setup that names the path does not cross as another.
+  render::RenderSetup lamps = twoPassSetup();
+  lamps.path = render::RenderPath::kShaderLamps;
+  const RenderSetupView view(lamps);
+  auto back = setupFromAbi(view.get());
+  ASSERT_FALSE(back);
+  EXPECT_EQ(back.error().code, ErrorCode::kInvalidInput);
 }
 
 TEST(RenderAbi, BrokenSetupsAreRefused) {

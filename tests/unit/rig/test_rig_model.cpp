@@ -3,6 +3,7 @@
 // malformed or hostile documents with a typed error.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 
 #include "rig/rig_model.hpp"
@@ -115,6 +116,54 @@ TEST(RigModel, MergeReplacesWhatWasCalibratedAndKeepsTheRest) {
   EXPECT_EQ(merged.surface.meshes.size(), 2u);
   EXPECT_EQ(merged.viewer.position, Vec3(1, 2, 3));
   EXPECT_EQ(rigToJson(mergeRig(base, RigModel{})), rigToJson(base));  // nothing new: unchanged
+}
+
+// An object the projectors paint: its model file and its placement survive the file
+// and a merge; a broken entry is a typed error.
+TEST(RigModel, ObjectRoundTripAndMerge) {
+  RigModel rig;
+  rig.projectors = {projector("proj_a", 1500)};
+  RigObject object;
+  object.mesh = "object-model.ply";
+  object.R = Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  object.t = Vec3(0.1, 1.5, 0.875);
+  object.fit_rms_m = 0.0011;
+  object.points = 8;
+  object.placed = {"model box.ply placed from 8 points", "2026-11-28T08:00:00Z"};
+  rig.surface.object = object;
+  EXPECT_FALSE(rig.surface.empty());
+  auto back = rigFromJson(rigToJson(rig), "rig.json");
+  ASSERT_TRUE(back) << back.error().message;
+  ASSERT_TRUE(back->surface.object);
+  const RigObject& o = *back->surface.object;
+  EXPECT_EQ(o.mesh, object.mesh);
+  EXPECT_EQ(o.R, object.R);
+  EXPECT_EQ(o.t, object.t);
+  EXPECT_EQ(o.fit_rms_m, object.fit_rms_m);
+  EXPECT_EQ(o.points, 8);
+  EXPECT_EQ(o.placed.method, object.placed.method);
+  EXPECT_EQ(o.placed.time, object.placed.time);
+  EXPECT_EQ(rigToJson(*back), rigToJson(rig));
+
+  // A merge without an object keeps it; one with an object replaces it.
+  RigModel update;
+  update.projectors = {projector("proj_a", 1510)};
+  EXPECT_EQ(mergeRig(rig, update).surface.object->mesh, "object-model.ply");
+  RigObject other;
+  other.mesh = "other.ply";
+  update.surface.object = other;
+  EXPECT_EQ(mergeRig(rig, update).surface.object->mesh, "other.ply");
+  EXPECT_EQ(mergeRig(rig, update).surface.object->R, Mat3::Identity());
+
+  for (const char* broken : {R"({"mesh": 3})", R"({"R": [1,0,0,0,1,0,0,0,1]})",
+                             R"({"mesh": "m.ply", "R": [2,0,0,0,1,0,0,0,1]})",
+                             R"({"mesh": "m.ply", "t": [0, 1]})", R"([])"}) {
+    nlohmann::json doc = rigToJson(rig);
+    doc["surface"]["object"] = nlohmann::json::parse(broken);
+    auto parsed = rigFromJson(doc, "rig.json");
+    ASSERT_FALSE(parsed) << broken;
+    EXPECT_EQ(parsed.error().code, ErrorCode::kParse) << broken;
+  }
 }
 
 TEST(RigModel, CameraMountedOnAProjectorStaysMountedWhenRecalibrated) {

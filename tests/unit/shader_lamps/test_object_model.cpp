@@ -9,6 +9,7 @@
 #include "lamp_rig.hpp"
 #include "shader_lamps/object_model.hpp"
 #include "shader_lamps/object_placement.hpp"
+#include "sim/mesh_io.hpp"
 
 namespace procam::lamps {
 namespace {
@@ -117,6 +118,27 @@ TEST(ShaderLampObject, BadModelsAreRefused) {
   EXPECT_EQ(ObjectModel::build(m, bad).error().code, ErrorCode::kInvalidInput);
   m.faces.emplace_back(0, 0, 1);  // no area
   EXPECT_EQ(ObjectModel::build(m).error().code, ErrorCode::kDegenerate);
+}
+
+// The placed model as it is kept beside rig.json reads back as the same model.
+TEST(ShaderLampPlacement, ModelPlyKeepsVerticesFacesAndTextureCoordinates) {
+  geom::TriangleMesh mesh;
+  mesh.vertices = {{0, 0, 0}, {0.3, 0, 0}, {0, 0.2, 0}, {0.123456789012, -1e-7, 2.5}};
+  mesh.faces = {{0, 1, 2}, {0, 2, 3}};
+  mesh.texcoord = {{0, 0}, {1, 0}, {0, 1}, {0.3333333, 0.25}};
+  auto back = sim::parseMesh(modelPly(mesh), "object-model.ply");
+  ASSERT_TRUE(back) << back.error().message;
+  ASSERT_EQ(back->vertices.size(), 4u);
+  ASSERT_EQ(back->faces, mesh.faces);
+  ASSERT_EQ(back->texcoord.size(), 4u);
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_LT((back->vertices[i] - mesh.vertices[i]).norm(), 1e-9);
+    EXPECT_LT((back->texcoord[i] - mesh.texcoord[i]).norm(), 1e-6);
+  }
+  mesh.texcoord.clear();  // untextured: no s t
+  auto plain = sim::parseMesh(modelPly(mesh), "object-model.ply");
+  ASSERT_TRUE(plain) << plain.error().message;
+  EXPECT_TRUE(plain->texcoord.empty());
 }
 
 }  // namespace

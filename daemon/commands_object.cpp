@@ -1,0 +1,386 @@
+// The rig's object and the look painted on it ([Raskar02] §5.2, shader lamps;
+// PROTOCOL.md `object` and `content load` on an object rig). `object place` registers a
+// given model to the rig from points picked on the physical object and located in the
+// world (eq. 4.2) and keeps the model beside rig.json; `content load` of the same model
+// with texture coordinates then paints it (object_content.hpp). The look is painted again
+// when the rig changes, when an output comes or goes (its projector's share goes to the
+// others and what none reaches is reported unlit) and, for a highlight, when the tracked
+// viewer moves.
+#include <cmath>
+
+#include "content/mesh_content.hpp"
+#include "daemon.hpp"
+#include "json_matrix.hpp"
+#include "log.hpp"
+#include "request_args.hpp"
+#include "shader_lamps/object_placement.hpp"
+
+namespace procam::daemon {
+
+using nlohmann::json;
+namespace code = proto::code;
+
+namespace {
+
+// The file a placed model is kept in, beside rig.json.
+constexpr const char* kObjectModelFile = "object-model.ply";
+// Points to place a model from: a handful are picked; a bound keeps a request small.
+constexpr std::size_t kMaxPlacementPoints = 1024;
+// A placement whose points miss the model by more than this (RMS) is refused by default:
+// a mis-picked point or another object's model, not a few millimetres of picking.
+constexpr double kDefaultMaxPlacementRmsM = 0.01;
+
+std::optional<Vec3> point3(const json& j) {
+  if (!j.is_array() || j.size() != 3) return std::nullopt;
+  Vec3 v;
+  for (int k = 0; k < 3; ++k) {
+    if (!j[k].is_number() || !std::isfinite(j[k].get<double>())) return std::nullopt;
+    v[k] = j[k].get<double>();
+  }
+  return v;
+}
+
+struct PlacementResult {
+  std::string ply;
+  lamps::ObjectPlacement placement;
+  std::vector<double> residuals_m;
+  std::size_t vertices = 0, faces = 0;
+  bool textured = false;
+};
+
+}  // namespace
+
+json Daemon::objectJson() const {
+  if (!rig_.surface.object) return nullptr;
+  const rig::RigObject& o = *rig_.surface.object;
+  json j = {{"mesh", o.mesh},
+            {"R", json::array()},
+            {"t", vectorJson(o.t)},
+            {"points", o.points},
+            {"placed", {{"method", o.placed.method}, {"time", o.placed.time}}}};
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) j["R"].push_back(o.R(r, c));
+  if (o.fit_rms_m >= 0) j["fit_rms_m"] = o.fit_rms_m;
+  j["painted"] = object_show_.prepared != nullptr;
+  return j;
+}
+
+void Daemon::cmdObject(ClientId client, const proto::Request& req) {
+  RequestArgs args(req.body);
+  PROCAM_CHECK_KEYS(args, "action", "model", "points", "max_rms_m");
+  const std::string action = args.string("action").value_or("get");
+  const auto model = args.string("model");
+  if (!args.ok()) return errorTo(client, req, code::kBadArgument, args.error());
+  if (action == "get") {
+    if (model || args.get("points"))
+      return errorTo(client, req, code::kBadArgument, "object get takes no arguments");
+    replyTo(client, req, "OBJECT", {{"object", objectJson()}});
+    return;
+  }
+  if (action == "clear") {
+    if (model || args.get("points"))
+      return errorTo(client, req, code::kBadArgument, "object clear takes no arguments");
+    if (!rig_.surface.object) {
+      replyTo(client, req, "OBJECT", {{"object", nullptr}});
+      return;
+    }
+    if (refuseOverJobLimit(client, req)) return;
+    server_->hold(client);
+    io_worker_->submit(
+        [this, client, req, dir = options_.state_dir] {
+          auto edited = [&]() -> Result<rig::RigModel> {
+            auto loaded = loadRig(dir);
+            if (!loaded) return tl::unexpected(loaded.error());
+            rig::RigModel rig = std::move(loaded->rig);
+            rig.surface.object.reset();
+            if (auto ok = rigStateFile(dir).write(rig::rigToJson(rig).dump(2) + "\n"); !ok)
+              return tl::unexpected(ok.error());
+            return rig;
+          }();
+          return [this, client, req, edited] {
+            if (!edited) {
+              errorTo(client, req, code::kIo, "rig.json not written: " + edited.error().message);
+            } else {
+              rig_ = *edited;
+              logInfo("the rig's object was cleared");
+              replyTo(client, req, "OBJECT", {{"object", nullptr}});
+              onRigChanged();
+            }
+            server_->release(client);
+          };
+        },
+        answerFailure(client, req), client);
+    return;
+  }
+  if (action != "place")
+    return errorTo(client, req, code::kBadArgument,
+                   "unknown object action '" + action + "' (get, place, clear)");
+  if (!model || model->empty())
+    return errorTo(client, req, code::kBadArgument, "object place needs \"model\", a mesh file");
+  if (!isMeshFile(*model))
+    return errorTo(client, req, code::kBadArgument, "\"model\" must be an .obj or .ply file");
+  const json* points = args.get("points");
+  if (!points || !points->is_array() || points->size() < lamps::kMinPlacementPoints ||
+      points->size() > kMaxPlacementPoints) {
+    return errorTo(client, req, code::kBadArgument,
+                   "object place needs \"points\": " + std::to_string(lamps::kMinPlacementPoints) +
+                       " to " + std::to_string(kMaxPlacementPoints) +
+                       " of {\"model\": [x, y, z], \"world\": [x, y, z]}");
+  }
+  std::vector<Vec3> model_points, world_points;
+  for (std::size_t i = 0; i < points->size(); ++i) {
+    const json& p = (*points)[i];
+    const auto m = p.is_object() && p.contains("model") ? point3(p["model"]) : std::nullopt;
+    const auto w = p.is_object() && p.contains("world") ? point3(p["world"]) : std::nullopt;
+    if (!m || !w)
+      return errorTo(client, req, code::kBadArgument,
+                     "point " + std::to_string(i) +
+                         " must be {\"model\": [x, y, z], \"world\": [x, y, z]} of finite numbers");
+    model_points.push_back(*m);
+    world_points.push_back(*w);
+  }
+  double max_rms = kDefaultMaxPlacementRmsM;
+  if (const json* v = args.get("max_rms_m")) {
+    if (!v->is_number() || !(v->get<double>() > 0) || v->get<double>() > 1)
+      return errorTo(client, req, code::kBadArgument, "\"max_rms_m\" must be in (0, 1] metres");
+    max_rms = v->get<double>();
+  }
+  if (refuseOverJobLimit(client, req)) return;
+  server_->hold(client);
+  compute_worker_->submit(
+      [this, client, req, file = *model, model_points, world_points, max_rms,
+       access = contentAccess()] {
+        auto placed = [&]() -> tl::expected<PlacementResult, MeshFailure> {
+          auto bytes = readContentFile(access, file);
+          if (!bytes)
+            return tl::unexpected(
+                MeshFailure{protoCode(bytes.error().code), bytes.error().message});
+          const sim::MeshLimits limits{access.limits.mesh_vertices, access.limits.mesh_faces,
+                                       access.limits.face_indices, access.limits.file_bytes};
+          auto mesh = content::meshContentFromBytes(*bytes, file, limits);
+          if (!mesh)
+            return tl::unexpected(MeshFailure{protoCode(mesh.error().code), mesh.error().message});
+          auto fit = lamps::placeObject(model_points, world_points);
+          if (!fit)
+            return tl::unexpected(MeshFailure{
+                fit.error().code == ErrorCode::kDegenerate ? code::kDegenerate : code::kBadArgument,
+                fit.error().message});
+          PlacementResult out;
+          out.placement = *fit;
+          for (std::size_t i = 0; i < model_points.size(); ++i)
+            out.residuals_m.push_back((fit->R * model_points[i] + fit->t - world_points[i]).norm());
+          if (fit->rms_m > max_rms) {
+            std::string list;
+            for (std::size_t i = 0; i < out.residuals_m.size(); ++i)
+              list += (i ? ", " : "") + std::to_string(i) + ": " +
+                      std::to_string(out.residuals_m[i] * 1000).substr(0, 6) + " mm";
+            return tl::unexpected(MeshFailure{
+                code::kBadArgument, "the points miss the placed model by " +
+                                        std::to_string(fit->rms_m * 1000) + " mm RMS (over " +
+                                        std::to_string(max_rms * 1000) +
+                                        " mm): a mis-picked point or another object's model? "
+                                        "Per point: " +
+                                        list});
+          }
+          out.ply = lamps::modelPly(mesh->mesh);
+          out.vertices = mesh->mesh.vertices.size();
+          out.faces = mesh->mesh.faces.size();
+          out.textured = mesh->mesh.texcoord.size() == mesh->mesh.vertices.size();
+          return out;
+        }();
+        auto result =
+            std::make_shared<tl::expected<PlacementResult, MeshFailure>>(std::move(placed));
+        return [this, client, req, file, result] {
+          if (!*result) {
+            errorTo(client, req, (*result).error().code, (*result).error().message);
+            server_->release(client);
+            return;
+          }
+          const PlacementResult& r = **result;
+          rig::RigModel update;
+          rig::RigObject object;
+          object.mesh = kObjectModelFile;
+          object.R = r.placement.R;
+          object.t = r.placement.t;
+          object.fit_rms_m = r.placement.rms_m;
+          object.points = static_cast<long>(r.residuals_m.size());
+          object.placed = {"model " + std::filesystem::path(file).filename().string() +
+                               " placed from " + std::to_string(r.residuals_m.size()) + " points",
+                           utcNow()};
+          update.surface.object = object;
+          json reply = {
+              {"fit_rms_m", r.placement.rms_m},
+              {"fit_max_m", r.placement.max_m},
+              {"residuals_m", r.residuals_m},
+              {"model",
+               {{"vertices", r.vertices}, {"triangles", r.faces}, {"textured", r.textured}}}};
+          writeRig(std::move(update), {{kObjectModelFile, r.ply}},
+                   [this, client, req, reply](const Result<std::string>& path) mutable {
+                     if (!path) {
+                       errorTo(client, req, code::kIo, path.error().message);
+                     } else {
+                       reply["path"] = *path;
+                       reply["object"] = objectJson();
+                       replyTo(client, req, "OBJECT", reply);
+                     }
+                     server_->release(client);
+                   });
+        };
+      },
+      answerFailure(client, req), client);
+}
+
+std::vector<ObjectOutput> Daemon::objectOutputs() const {
+  std::vector<ObjectOutput> out;
+  for (const auto& e : devices_.entries()) {
+    if (e.description.family != PROCAM_FAMILY_OUTPUT || !e.usable()) continue;
+    if (auto mode = outputMode(e.device.raw())) out.push_back({e.name, *mode});
+  }
+  return out;
+}
+
+void Daemon::clearObjectContent() {
+  const uint64_t generation = object_show_.generation + 1;
+  object_show_ = ObjectShow{};
+  object_show_.generation = generation;
+}
+
+void Daemon::loadObjectContent(ClientId client, const proto::Request& req, ObjectLook look) {
+  server_->hold(client);
+  const uint64_t request = ++content_requests_;
+  compute_worker_->submit(
+      [this, client, req, look, rig = rig_, outputs = objectOutputs(), viewer = contentEye(),
+       dir = options_.state_dir, access = contentAccess(), request] {
+        auto prepared = std::make_shared<tl::expected<PreparedObject, MeshFailure>>(
+            prepareObjectContent(access, dir, rig, look, outputs, viewer.first, viewer.second));
+        return [this, client, req, look, prepared, request, viewer] {
+          if (!*prepared) {
+            errorTo(client, req, (*prepared).error().code, (*prepared).error().message);
+          } else if (request != content_requests_) {
+            errorTo(client, req, code::kCancelled, "replaced by a later content request");
+          } else {
+            dropContent();
+            object_show_.look = look;
+            object_show_.prepared = std::make_shared<const PreparedObject>(std::move(**prepared));
+            if (object_show_.prepared->view_dependent && viewer.first) {
+              object_show_.eye = *viewer.first;
+              if (viewer.second.value("source", "") == "tracker")
+                object_show_.tracker = viewer.second.value("tracker", "");
+            }
+            broadcast("content", {{"content", contentJson()}});
+            refreshOutputs({}, true);
+            replyTo(client, req, "CONTENT", {{"content", contentJson()}});
+          }
+          server_->release(client);
+        };
+      },
+      answerFailure(client, req), client);
+}
+
+void Daemon::repaintObject(const std::string& why) {
+  ObjectShow& s = object_show_;
+  if (!s.look) return;
+  if (s.in_flight) {
+    s.again = true;
+    return;
+  }
+  if (!rig_.surface.object) {
+    warn("object content cleared: the rig model no longer has an object");
+    clearObjectContent();
+    broadcast("content", {{"content", contentJson()}});
+    refreshOutputs({}, true);
+    return;
+  }
+  const auto viewer = contentEye();
+  const std::optional<Vec3> eye = viewer.first;
+  const json eye_source = viewer.second;
+  s.in_flight = true;
+  s.again = false;
+  logInfo("painting the object again: " + why);
+  compute_worker_->submit(
+      [this, look = *s.look, rig = rig_, outputs = objectOutputs(), eye, eye_source,
+       dir = options_.state_dir, access = contentAccess(), generation = s.generation] {
+        auto prepared = std::make_shared<tl::expected<PreparedObject, MeshFailure>>(
+            prepareObjectContent(access, dir, rig, look, outputs, eye, eye_source));
+        return [this, prepared, generation, eye] {
+          ObjectShow& s = object_show_;
+          if (s.generation != generation) return;  // other content meanwhile
+          s.in_flight = false;
+          if (!*prepared) {
+            // The last good frames stay shown: a rig or output set that cannot be
+            // painted now may come back.
+            warn("object content not painted again: " + (*prepared).error().message);
+          } else {
+            s.prepared = std::make_shared<const PreparedObject>(std::move(**prepared));
+            if (s.prepared->view_dependent && eye) s.eye = *eye;
+            broadcast("content", {{"content", contentJson()}});
+            refreshOutputs({}, true);
+          }
+          if (s.again) repaintObject("changed while painting");
+        };
+      },
+      [this, generation = s.generation](const std::string& what) {
+        if (object_show_.generation == generation) object_show_.in_flight = false;
+        warn("object content not painted again: " + what);
+      });
+}
+
+void Daemon::onObjectViewerSample() {
+  ObjectShow& s = object_show_;
+  if (!s.prepared || !s.prepared->view_dependent || s.tracker.empty() || s.in_flight) return;
+  auto latest = trackers_.latest.find(s.tracker);
+  if (latest == trackers_.latest.end()) return;
+  const Vec3 eye = latest->second.world;
+  if ((eye - s.eye).norm() <= config_.content_viewer_threshold_m) return;
+  // Only the highlight moves: the views, weights and gains stay, each frame is shaded
+  // again for the new eye on the compute worker ([Raskar02] §5.2.3).
+  s.in_flight = true;
+  s.eye = eye;
+  compute_worker_->submit(
+      [this, prepared = s.prepared, eye, generation = s.generation] {
+        json projectors;
+        auto frames =
+            std::make_shared<Result<std::map<std::string, std::shared_ptr<const cv::Mat>>>>(
+                paintObjectFrames(*prepared, eye, &projectors));
+        return [this, prepared, frames, projectors, eye, generation] {
+          ObjectShow& s = object_show_;
+          if (s.generation != generation || s.prepared != prepared) {
+            if (s.generation == generation) s.in_flight = false;
+            if (s.generation == generation && s.again) repaintObject("changed while painting");
+            return;
+          }
+          s.in_flight = false;
+          if (!*frames) {
+            warn("object content not shaded for the moved viewer: " + frames->error().message);
+          } else {
+            auto next = std::make_shared<PreparedObject>(*prepared);
+            next->frames = std::move(**frames);
+            next->info["projectors"] = projectors;
+            ++s.updates;
+            next->info["display"]["viewer"]["position"] = vectorJson(eye);
+            next->info["display"]["view_updates"] = s.updates;
+            s.prepared = std::move(next);
+            refreshOutputs();
+          }
+          if (s.again) return repaintObject("changed while painting");
+          onObjectViewerSample();  // the viewer may have moved on meanwhile
+        };
+      },
+      [this, generation = s.generation](const std::string& what) {
+        if (object_show_.generation == generation) object_show_.in_flight = false;
+        warn("object content not shaded for the moved viewer: " + what);
+      });
+}
+
+void Daemon::watchObjectOutputs() {
+  device_manager_->onDeviceAdded([this](const DeviceEntry& e) {
+    if (e.description.family == PROCAM_FAMILY_OUTPUT && object_show_.look)
+      repaintObject("output '" + e.name + "' came");
+  });
+  device_manager_->onDeviceRemoved([this](const DeviceEntry& e) {
+    if (e.description.family == PROCAM_FAMILY_OUTPUT && object_show_.look)
+      repaintObject("output '" + e.name + "' went away");
+  });
+}
+
+}  // namespace procam::daemon
