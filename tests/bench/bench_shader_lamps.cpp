@@ -7,10 +7,15 @@
 //    diffuse look and for a glossy one shaded for a tracked eye, against OpenCV's
 //    cv::remap of a 1080p BGR texture through a float map (one bilinear look-up per
 //    pixel: the least a textured frame costs) in the same run, as a ratio.
+//  - per frame and projector on a GLES output (GLES 3 on the surfaceless EGL platform when
+//    built; Mesa llvmpipe here): what procamd's outputs do with a shaded frame — the RGBA
+//    frame uploaded and drawn through the homography path with H = I, then glFinish —
+//    alone, and a tracked eye's whole update (the glossy frame shaded on the CPU, made
+//    RGBA, shown), and that the frame read back is the one shaded (largest difference in
+//    code values). The shading itself has no GLES program: it runs on the CPU.
 // Error beside the time: the largest departure of the weights' sum from one at the pixel
 // centres of the first projector (exact by construction: it guards the normalisation),
-// and the share of lit pixels whose intensity clipped. The headless GLES output has no
-// shader-lamps program yet, so only the CPU is timed.
+// and the share of lit pixels whose intensity clipped.
 // Writes shader_lamps.csv to --out DIR.
 //
 //   bench_shader_lamps [--out DIR] [--runs N]
@@ -28,6 +33,10 @@
 #include "shader_lamps/lamp_view.hpp"
 #include "shader_lamps/lamp_weights.hpp"
 #include "shader_lamps/object_model.hpp"
+#if PROCAM_BENCH_GLES
+#include "egl/egl_context.hpp"
+#include "gl/gl_renderer.hpp"
+#endif
 
 using namespace procam;
 
@@ -43,6 +52,60 @@ geom::CameraModel projector(const Vec3& at) {
   m.pose = geom::Pose::lookAt(at, Vec3(0, 1.5, 0.9), Vec3::UnitZ());
   return m;
 }
+
+#if PROCAM_BENCH_GLES
+// A shaded frame on the headless GLES output, as procamd shows it (H = I).
+void benchGles(std::ofstream& csv, int runs, const lamps::LampFrameInput& lamp,
+               const lamps::Material& glossy, double white, double remap_ms) {
+  auto ctx = output::egl::EglContext::surfaceless();
+  if (!ctx) {
+    std::printf("GLES: unavailable: %s\n", ctx.error().message.c_str());
+    csv << "gles_unavailable,,,\n";
+    return;
+  }
+  auto gl = output::gl::GlRenderer::create(output::gl::GlTarget{true, 0});
+  if (!gl) {
+    std::printf("GLES: %s\n", gl.error().message.c_str());
+    return;
+  }
+  render::RenderSetup setup;
+  setup.output_size = lamp.view->size;
+  setup.content_size = lamp.view->size;
+  setup.homography = Mat3::Identity();
+  if (auto ok = (*gl)->configure(setup); !ok) {
+    std::printf("GLES: %s\n", ok.error().message.c_str());
+    return;
+  }
+  const Vec3 eye(0, 0.3, 1.4);
+  cv::Mat rgba, shown;
+  cv::cvtColor(*lamps::lampFrame(lamp, glossy, white, eye), rgba, cv::COLOR_BGR2RGBA);
+  uint64_t version = 0;
+  (void)(*gl)->render({&rgba, nullptr, ++version});
+  (void)(*gl)->readFrame(shown);  // compile shaders, allocate, warm the driver
+  const double diff = cv::norm(rgba, shown, cv::NORM_INF);
+  const bench::Timing show = bench::measure(runs, [&] {
+    (void)(*gl)->render({&rgba, nullptr, ++version});  // a new frame each time
+    glFinish();
+  });
+  const bench::Timing update = bench::measure(runs, [&] {
+    cv::cvtColor(*lamps::lampFrame(lamp, glossy, white, eye), rgba, cv::COLOR_BGR2RGBA);
+    (void)(*gl)->render({&rgba, nullptr, ++version});
+    glFinish();
+  });
+  std::printf(
+      "GLES (%s), the frame shown (H = I): %.1f ms median; a tracked eye's update "
+      "(shade on the CPU + show) %.1f ms median (%.2fx cv::remap); shown frame off "
+      "the shaded one by %.0f code values at most\n",
+      (*ctx)->renderer().c_str(), show.median_ms, update.median_ms, update.median_ms / remap_ms,
+      diff);
+  csv << "gles_show," << show.median_ms << ',' << show.min_ms << ',' << show.median_ms / remap_ms
+      << '\n';
+  csv << "gles_glossy_update," << update.median_ms << ',' << update.min_ms << ','
+      << update.median_ms / remap_ms << '\n';
+  csv << "# GLES renderer " << (*ctx)->renderer() << "; shown frame off the shaded one by " << diff
+      << " code values at most\n";
+}
+#endif
 
 }  // namespace
 
@@ -145,5 +208,8 @@ int main(int argc, char** argv) {
       << frame[1].median_ms / frame[2].median_ms << '\n';
   csv << "remap," << frame[2].median_ms << ',' << frame[2].min_ms << ",1\n";
   csv << "# weights' sum off one: 99th percentile " << off_p99 << ", largest " << off_max << '\n';
+#if PROCAM_BENCH_GLES
+  benchGles(csv, runs, inputs[0], glossy, white, frame[2].median_ms);
+#endif
   return 0;
 }
