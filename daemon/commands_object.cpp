@@ -245,15 +245,28 @@ void Daemon::clearObjectContent() {
   object_show_.generation = generation;
 }
 
+namespace {
+
+bool sameOutputs(const std::vector<ObjectOutput>& a, const std::vector<ObjectOutput>& b) {
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(),
+                    [](const ObjectOutput& x, const ObjectOutput& y) {
+                      return x.name == y.name && x.mode == y.mode;
+                    });
+}
+
+}  // namespace
+
 void Daemon::loadObjectContent(ClientId client, const proto::Request& req, ObjectLook look) {
   server_->hold(client);
   const uint64_t request = ++content_requests_;
+  const std::vector<ObjectOutput> outputs = objectOutputs();
   compute_worker_->submit(
-      [this, client, req, look, rig = rig_, outputs = objectOutputs(), viewer = contentEye(),
-       dir = options_.state_dir, access = contentAccess(), request] {
+      [this, client, req, look, rig = rig_, outputs, viewer = contentEye(),
+       dir = options_.state_dir, access = contentAccess(), request,
+       rig_generation = rig_generation_] {
         auto prepared = std::make_shared<tl::expected<PreparedObject, MeshFailure>>(
             prepareObjectContent(access, dir, rig, look, outputs, viewer.first, viewer.second));
-        return [this, client, req, look, prepared, request, viewer] {
+        return [this, client, req, look, prepared, request, viewer, outputs, rig_generation] {
           if (!*prepared) {
             errorTo(client, req, (*prepared).error().code, (*prepared).error().message);
           } else if (request != content_requests_) {
@@ -261,6 +274,7 @@ void Daemon::loadObjectContent(ClientId client, const proto::Request& req, Objec
           } else {
             dropContent();
             object_show_.look = look;
+            object_show_.rig_generation = rig_generation;
             object_show_.prepared = std::make_shared<const PreparedObject>(std::move(**prepared));
             if (object_show_.prepared->view_dependent && viewer.first) {
               object_show_.eye = *viewer.first;
@@ -270,6 +284,9 @@ void Daemon::loadObjectContent(ClientId client, const proto::Request& req, Objec
             broadcast("content", {{"content", contentJson()}});
             refreshOutputs({}, true);
             replyTo(client, req, "CONTENT", {{"content", contentJson()}});
+            // The rig or the outputs changed while it was painted: again for them.
+            if (rig_generation != rig_generation_ || !sameOutputs(outputs, objectOutputs()))
+              repaintObject("the rig or the outputs changed while the look was loaded");
           }
           server_->release(client);
         };
@@ -299,20 +316,36 @@ void Daemon::repaintObject(const std::string& why) {
   logInfo("painting the object again: " + why);
   compute_worker_->submit(
       [this, look = *s.look, rig = rig_, outputs = objectOutputs(), eye, eye_source,
-       dir = options_.state_dir, access = contentAccess(), generation = s.generation] {
+       dir = options_.state_dir, access = contentAccess(), generation = s.generation,
+       rig_generation = rig_generation_] {
         auto prepared = std::make_shared<tl::expected<PreparedObject, MeshFailure>>(
             prepareObjectContent(access, dir, rig, look, outputs, eye, eye_source));
-        return [this, prepared, generation, eye] {
+        return [this, prepared, generation, eye, rig_generation] {
           ObjectShow& s = object_show_;
           if (s.generation != generation) return;  // other content meanwhile
           s.in_flight = false;
+          if (!*prepared && s.rig_generation != rig_generation) {
+            // Frames made for another object or placement would light the wrong places.
+            warn("object content cleared: the look does not fit the rig as it is now: " +
+                 (*prepared).error().message);
+            clearObjectContent();
+            broadcast("content", {{"content", contentJson()}});
+            refreshOutputs({}, true);
+            return;
+          }
           if (!*prepared) {
-            // The last good frames stay shown: a rig or output set that cannot be
-            // painted now may come back.
+            // Same rig, fewer outputs than it can paint with: the last good frames stay
+            // shown until the outputs come back.
             warn("object content not painted again: " + (*prepared).error().message);
           } else {
             s.prepared = std::make_shared<const PreparedObject>(std::move(**prepared));
+            s.rig_generation = rig_generation;
             if (s.prepared->view_dependent && eye) s.eye = *eye;
+            if (s.prepared->view_dependent) {
+              auto info = std::make_shared<PreparedObject>(*s.prepared);
+              info->info["display"]["view_updates"] = s.updates;
+              s.prepared = std::move(info);
+            }
             broadcast("content", {{"content", contentJson()}});
             refreshOutputs({}, true);
           }
@@ -320,8 +353,10 @@ void Daemon::repaintObject(const std::string& why) {
         };
       },
       [this, generation = s.generation](const std::string& what) {
-        if (object_show_.generation == generation) object_show_.in_flight = false;
         warn("object content not painted again: " + what);
+        if (object_show_.generation != generation) return;
+        object_show_.in_flight = false;
+        if (object_show_.again) repaintObject("changed while painting");
       });
 }
 
@@ -335,14 +370,15 @@ void Daemon::onObjectViewerSample() {
   // Only the highlight moves: the views, weights and gains stay, each frame is shaded
   // again for the new eye on the compute worker ([Raskar02] §5.2.3).
   s.in_flight = true;
+  const Vec3 shaded_before = s.eye;
   s.eye = eye;
   compute_worker_->submit(
-      [this, prepared = s.prepared, eye, generation = s.generation] {
+      [this, prepared = s.prepared, eye, generation = s.generation, shaded_before] {
         json projectors;
         auto frames =
             std::make_shared<Result<std::map<std::string, std::shared_ptr<const cv::Mat>>>>(
                 paintObjectFrames(*prepared, eye, &projectors));
-        return [this, prepared, frames, projectors, eye, generation] {
+        return [this, prepared, frames, projectors, eye, generation, shaded_before] {
           ObjectShow& s = object_show_;
           if (s.generation != generation || s.prepared != prepared) {
             if (s.generation == generation) s.in_flight = false;
@@ -352,6 +388,7 @@ void Daemon::onObjectViewerSample() {
           s.in_flight = false;
           if (!*frames) {
             warn("object content not shaded for the moved viewer: " + frames->error().message);
+            s.eye = shaded_before;  // the frames shown are still for that eye
           } else {
             auto next = std::make_shared<PreparedObject>(*prepared);
             next->frames = std::move(**frames);
@@ -366,9 +403,12 @@ void Daemon::onObjectViewerSample() {
           onObjectViewerSample();  // the viewer may have moved on meanwhile
         };
       },
-      [this, generation = s.generation](const std::string& what) {
-        if (object_show_.generation == generation) object_show_.in_flight = false;
+      [this, generation = s.generation, shaded_before](const std::string& what) {
         warn("object content not shaded for the moved viewer: " + what);
+        if (object_show_.generation != generation) return;
+        object_show_.in_flight = false;
+        object_show_.eye = shaded_before;
+        if (object_show_.again) repaintObject("changed while painting");
       });
 }
 

@@ -368,7 +368,8 @@ class Daemon {
   struct ObjectShow {
     std::optional<ObjectLook> look;                  // what `content load` asked for
     std::shared_ptr<const PreparedObject> prepared;  // what the outputs show
-    uint64_t generation = 0;                         // of the look or the rig it was made for
+    uint64_t generation = 0;                         // of the look: a new one drops jobs
+    uint64_t rig_generation = 0;                     // rig_generation_ of the frames shown
     std::string tracker;      // the viewer's tracker, when the look has a highlight
     Vec3 eye = Vec3::Zero();  // the highlight's eye of the frames shown or in flight
     uint64_t updates = 0;     // repaints for a moved viewer

@@ -83,8 +83,8 @@ std::optional<OutputDraw> Daemon::planOutput(DeviceEntry& e, const OutputDrawPol
   }
   // An object's look: each frame was rendered from this projector per pixel (shader
   // lamps, object_content.hpp) and is shown as it is; an output whose projector does not
-  // light the object shows black.
-  const PreparedObject* object = object_show_.prepared.get();
+  // light the object shows black. A pattern is drawn as on any rig (keystone, tiles).
+  const PreparedObject* object = r.pattern == "off" ? object_show_.prepared.get() : nullptr;
   std::string object_note;
   if (object) {
     auto f = object->frames.find(e.name);

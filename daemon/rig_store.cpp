@@ -89,7 +89,11 @@ Result<rig::RigModel> importRig(const std::string& state_dir, const std::string&
                   file + ": mesh '" + name + "' is not a file name beside it");
     }
     const std::filesystem::path from = beside / name;
-    if (!std::filesystem::is_regular_file(from, ec)) continue;  // already in the state directory
+    if (!std::filesystem::is_regular_file(from, ec)) {
+      if (std::filesystem::is_regular_file(std::filesystem::path(state_dir) / name, ec)) continue;
+      return fail(ErrorCode::kNotFound,
+                  file + ": mesh '" + name + "' is neither beside it nor in the state directory");
+    }
     if (std::filesystem::file_size(from, ec) > kMaxMeshBytes || ec) {
       return fail(ErrorCode::kInvalidInput, from.string() + ": larger than a mesh file can be");
     }

@@ -88,9 +88,9 @@ std::string contentText(const json& c) {
     if (st.contains("test")) s = "test video " + st["test"].get<std::string>();
   }
   if (c.contains("shared")) s = "shared memory";
-  if (c.contains("object") && c.contains("display")) {
+  if (c.contains("object") && c.contains("display") && c["display"].is_object()) {
     const json& d = c["display"];
-    const json& cov = d["coverage"];
+    const json cov = d.value("coverage", json::object());
     char line[200];
     std::snprintf(line, sizeof line,
                   ", painted on the object: white %.4g (%s), lit %.4f m2, unlit %.4f m2",
@@ -345,12 +345,13 @@ std::string formatReply(const json& r) {
   }
   if (cls == "CONTENT") return "content: " + contentText(r["content"]) + "\n";
   if (cls == "OBJECT") {
-    const json& o = r["object"];
-    if (o.is_null()) return "object: none\n";
-    std::string out =
-        field("object", scalar(o["mesh"]) + " (" + scalar(o["placed"]["method"]) + ")");
-    out += field("position", pairList(o["t"]) + " m");
-    if (o.contains("fit_rms_m")) {
+    const json o = r.value("object", json());
+    if (!o.is_object()) return "object: none\n";
+    const json placed = o.value("placed", json::object());
+    std::string out = field("object", o.value("mesh", std::string()) + " (" +
+                                          placed.value("method", std::string()) + ")");
+    out += field("position", pairList(o.value("t", json::array())) + " m");
+    if (o.contains("fit_rms_m") && o["fit_rms_m"].is_number()) {
       char line[64];
       std::snprintf(line, sizeof line, "%.2f mm RMS", 1000 * o["fit_rms_m"].get<double>());
       out += field("fit", line);
