@@ -354,7 +354,8 @@ TEST(ShaderLamp, DaemonPaintsAModelPlacedFromPickedCorners) {
   EXPECT_TRUE(eventually(
       [&] {
         if (!(*c.call({{"cmd", "content"}}))["content"].is_null()) return false;
-        for (const auto& o : (*c.call({{"cmd", "status"}}))["outputs"]["shown"])
+        const json status = *c.call({{"cmd", "status"}});
+        for (const auto& o : status["outputs"]["shown"])
           if (o["lit_fraction"].get<double>() != 0 || o["source"] != "none") return false;
         return true;
       },
@@ -386,7 +387,7 @@ TEST(ShaderLamp, DaemonReportsWhatAnUnpluggedProjectorLeftUnlit) {
                         {"model", "box_model.ply"},
                         {"points", cornerPoints(0)}},
                        30s);
-  ASSERT_TRUE(placed);
+  ASSERT_TRUE(placed) << d.log();
   ASSERT_EQ((*placed)["class"], "OBJECT") << placed->dump();
   auto loaded = c.call(
       {{"cmd", "content"}, {"action", "load"}, {"path", "box_model.ply"}, {"texture", "look.png"}},
