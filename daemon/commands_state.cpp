@@ -82,10 +82,15 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
       (std::string(key) == "specular" ? look.specular : look.shininess) = v->get<double>();
     }
   }
-  if (look_args && (action != "load" || !path || !isMeshFile(*path) || !rig_.surface.object)) {
+  if (look_args && (action != "load" || !path || !rig_.surface.object)) {
     return errorTo(client, req, code::kBadArgument,
-                   "\"texture\", \"specular\" and \"shininess\" go with content load of an "
-                   "object's model (.obj, .ply) on a rig with an object (object place)");
+                   "\"texture\", \"specular\" and \"shininess\" go with content load on a "
+                   "rig with an object (object place)");
+  }
+  if (texture && path && !isMeshFile(*path)) {
+    return errorTo(client, req, code::kBadArgument,
+                   "\"texture\" goes with the object's model (.obj, .ply); an image loaded on an "
+                   "object rig is the texture itself");
   }
   if (action == "get" || action == "clear") {
     if (path)
@@ -111,6 +116,11 @@ void Daemon::cmdContent(ClientId client, const proto::Request& req) {
     // An object rig: the model is the look painted on the object (object_content.hpp).
     look.file = *path;
     look.texture = texture.value_or("");
+    return loadObjectContent(client, req, std::move(look));
+  }
+  if (rig_.surface.object) {
+    // An image on an object rig: the texture of the rig's model, painted on the object.
+    look.texture = *path;
     return loadObjectContent(client, req, std::move(look));
   }
   if (isMeshFile(*path)) {

@@ -178,8 +178,8 @@ std::optional<OutputDraw> Daemon::planOutput(DeviceEntry& e, const OutputDrawPol
   } else if (traits.surface == render::SurfaceKind::kObject && !object &&
              plan->source == "content") {
     st.path_note =
-        "content on an object is painted from its model: content load the object's model "
-        "(with its texture); this content is drawn 2D, by homography";
+        "content on an object is painted through its model: content load an image (the "
+        "model's texture) or the model; streamed or shared frames are drawn 2D, by homography";
   } else if (!np_note.empty()) {
     st.path_note = np_note;
   } else if (chosen->path != plan->setup.path && plan->source != "content") {

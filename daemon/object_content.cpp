@@ -119,27 +119,35 @@ tl::expected<PreparedObject, MeshFailure> prepareObjectContent(
 
   auto model = rigObjectMesh(rig, state_dir);
   if (!model) return failure(code::kUnavailable, "the rig's object: " + model.error().message);
-  auto bytes = readContentFile(access, look.file);
-  if (!bytes)
-    return tl::unexpected(MeshFailure{protoCode(bytes.error().code), bytes.error().message});
-  const sim::MeshLimits limits{access.limits.mesh_vertices, access.limits.mesh_faces,
-                               access.limits.face_indices, access.limits.file_bytes};
-  auto content = content::meshContentFromBytes(*bytes, look.file, limits);
-  if (!content)
-    return tl::unexpected(MeshFailure{protoCode(content.error().code), content.error().message});
-  // Both placed by the rig's pose, compared in the world.
   const rig::RigObject& placed = *rig.surface.object;
-  geom::TriangleMesh in_world = lamps::placedMesh(content->mesh, {placed.R, placed.t, 0, 0});
-  if (auto why = differsFrom(in_world, *model))
-    return failure(code::kBadArgument, look.file + " is not the rig's object model: " + *why +
-                                           " (place this model with `object place` first)");
+  // The texture coordinates: the content model's, or (an image alone) the rig's model's.
+  std::vector<Vec2> texcoord = model->texcoord;
+  std::string coordinates_of = "the rig's object model " + placed.mesh;
+  if (!look.file.empty()) {
+    auto bytes = readContentFile(access, look.file);
+    if (!bytes)
+      return tl::unexpected(MeshFailure{protoCode(bytes.error().code), bytes.error().message});
+    const sim::MeshLimits limits{access.limits.mesh_vertices, access.limits.mesh_faces,
+                                 access.limits.face_indices, access.limits.file_bytes};
+    auto content = content::meshContentFromBytes(*bytes, look.file, limits);
+    if (!content)
+      return tl::unexpected(MeshFailure{protoCode(content.error().code), content.error().message});
+    // Both placed by the rig's pose, compared in the world.
+    geom::TriangleMesh in_world = lamps::placedMesh(content->mesh, {placed.R, placed.t, 0, 0});
+    if (auto why = differsFrom(in_world, *model))
+      return failure(code::kBadArgument, look.file + " is not the rig's object model: " + *why +
+                                             " (place this model with `object place` first)");
+    texcoord = std::move(content->mesh.texcoord);
+    coordinates_of = look.file;
+  }
 
   auto material = std::make_shared<lamps::Material>();
   const bool textured = !look.texture.empty();
   if (textured) {
-    if (content->mesh.texcoord.size() != content->mesh.vertices.size())
-      return failure(code::kBadArgument,
-                     look.file + " has no texture coordinates (OBJ vt, PLY s t) for the texture");
+    if (texcoord.size() != model->vertices.size())
+      return failure(code::kBadArgument, coordinates_of +
+                                             " has no texture coordinates (OBJ vt, PLY s t) "
+                                             "for the texture");
     auto decoded = decodeContent(access, look.texture);
     if (!decoded)
       return tl::unexpected(MeshFailure{protoCode(decoded.error().code), decoded.error().message});
@@ -152,8 +160,7 @@ tl::expected<PreparedObject, MeshFailure> prepareObjectContent(
   if (auto ok = lamps::checkMaterial(*material); !ok)
     return failure(code::kBadArgument, ok.error().message);
 
-  auto object =
-      lamps::ObjectModel::build(*model, textured ? content->mesh.texcoord : std::vector<Vec2>{});
+  auto object = lamps::ObjectModel::build(*model, textured ? texcoord : std::vector<Vec2>{});
   if (!object) return failure(code::kBadArgument, "the object model: " + object.error().message);
   auto prepared_lamps = lamps::prepareRigLamps(rig, *object, options);
   if (!prepared_lamps)
@@ -191,7 +198,7 @@ tl::expected<PreparedObject, MeshFailure> prepareObjectContent(
                       {"textured", textured},
                       {"placed", {{"method", placed.placed.method}, {"time", placed.placed.time}}}};
   if (placed.fit_rms_m >= 0) object_info["fit_rms_m"] = placed.fit_rms_m;
-  out.info = {{"path", look.file},
+  out.info = {{"path", look.file.empty() ? look.texture : look.file},
               {"object", object_info},
               {"look",
                {{"texture", textured ? json(look.texture) : json(nullptr)},

@@ -25,7 +25,7 @@ namespace procam::daemon {
 
 // What `content load` asked for on an object rig.
 struct ObjectLook {
-  std::string file;     // the textured model (.obj / .ply)
+  std::string file;     // the textured model (.obj / .ply); empty: the rig's model's coordinates
   std::string texture;  // an image under the content roots; empty: white
   double specular = 0;  // Blinn-Phong highlight for the viewer's eye, 0..1
   double shininess = 32;
@@ -51,7 +51,8 @@ struct PreparedObject {
 // The rig's object model, read from `state_dir`, placed in the world.
 Result<geom::TriangleMesh> rigObjectMesh(const rig::RigModel& rig, const std::string& state_dir);
 
-// Reads the look and paints the rig's object with every output's projector; projectors
+// Reads the look (a model's texture coordinates, or the rig's model's own with an image
+// alone) and paints the rig's object with every output's projector; projectors
 // of the rig without a usable output are off (what only they reach is reported unlit).
 // `unavailable` when the rig has no object or no posed projector for any output;
 // `bad-argument` when the content is not the rig's object model (other vertices or

@@ -320,18 +320,20 @@ TEST(ShaderLamp, DaemonPaintsAModelPlacedFromPickedCorners) {
     EXPECT_GT(p["lit_pixels"].get<long>(), 10000);
   }
   // Both outputs draw it by the shader-lamps path, as choosePath chose.
-  ASSERT_TRUE(eventually(
-      [&] {
-        auto s = c.call({{"cmd", "status"}});
-        if (!s || (*s)["outputs"]["shown"].size() != 2) return false;
-        for (const auto& o : (*s)["outputs"]["shown"])
-          if (o["path"] != "shader-lamps" || o["chosen_path"] != "shader-lamps" ||
-              o["source"] != "content" || !(o["lit_fraction"].get<double>() > 0.02))
-            return false;
-        return true;
-      },
-      20s * kSlowdown))
-      << c.call({{"cmd", "status"}})->dump();
+  std::map<std::string, json> shown;  // output -> its mean RGB
+  const auto drawnByLamps = [&] {
+    auto s = c.call({{"cmd", "status"}});
+    if (!s || (*s)["outputs"]["shown"].size() != 2) return false;
+    for (const auto& o : (*s)["outputs"]["shown"]) {
+      if (o["path"] != "shader-lamps" || o["chosen_path"] != "shader-lamps" ||
+          o["source"] != "content" || !(o["lit_fraction"].get<double>() > 0.02))
+        return false;
+      shown[o["name"]] = o["mean_rgb"];
+    }
+    return true;
+  };
+  ASSERT_TRUE(eventually(drawnByLamps, 20s * kSlowdown)) << c.call({{"cmd", "status"}})->dump();
+  const std::map<std::string, json> from_model = shown;
 
   const cv::Mat lit = meanSnapshot(c, "cam_colour", kShots);
   cv::Mat texture_bgr = waveTextureSrgb();
@@ -346,6 +348,30 @@ TEST(ShaderLamp, DaemonPaintsAModelPlacedFromPickedCorners) {
   EXPECT_GT(seen.judged, 20000);
   EXPECT_LT(seen.mean_rel, 0.03);
   EXPECT_EQ(seen.spilled, 0);
+
+  // The image alone is the placed model's texture: the same frames.
+  bad = c.call(
+      {{"cmd", "content"}, {"action", "load"}, {"path", "look.png"}, {"texture", "look.png"}});
+  ASSERT_TRUE(bad);
+  EXPECT_EQ((*bad)["code"], "bad-argument") << bad->dump();
+  auto image =
+      c.call({{"cmd", "content"}, {"action", "load"}, {"path", "look.png"}}, 120s * kSlowdown);
+  ASSERT_TRUE(image);
+  ASSERT_EQ((*image)["class"], "CONTENT") << image->dump();
+  EXPECT_EQ((*image)["content"]["path"], "look.png");
+  EXPECT_EQ((*image)["content"]["look"]["texture"], "look.png");
+  EXPECT_TRUE((*image)["content"]["object"]["textured"].get<bool>());
+  EXPECT_TRUE(eventually(
+      [&] {
+        shown.clear();
+        if (!drawnByLamps()) return false;
+        for (const auto& [name, rgb] : from_model)
+          for (int k = 0; k < 3; ++k)
+            if (std::abs(shown[name][k].get<double>() - rgb[k].get<double>()) > 1e-6) return false;
+        return true;
+      },
+      20s * kSlowdown))
+      << c.call({{"cmd", "status"}})->dump();
 
   // The object cleared from the rig: the look goes with it, the outputs go dark.
   auto cleared = c.call({{"cmd", "object"}, {"action", "clear"}}, 10s);
