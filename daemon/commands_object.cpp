@@ -30,20 +30,9 @@ constexpr std::size_t kMaxPlacementPoints = 1024;
 // a mis-picked point or another object's model, not a few millimetres of picking.
 constexpr double kDefaultMaxPlacementRmsM = 0.01;
 
-std::optional<Vec3> point3(const json& j) {
-  if (!j.is_array() || j.size() != 3) return std::nullopt;
-  Vec3 v;
-  for (int k = 0; k < 3; ++k) {
-    if (!j[k].is_number() || !std::isfinite(j[k].get<double>())) return std::nullopt;
-    v[k] = j[k].get<double>();
-  }
-  return v;
-}
-
 struct PlacementResult {
   std::string ply;
   lamps::ObjectPlacement placement;
-  std::vector<double> residuals_m;
   std::size_t vertices = 0, faces = 0;
   bool textured = false;
 };
@@ -54,12 +43,10 @@ json Daemon::objectJson() const {
   if (!rig_.surface.object) return nullptr;
   const rig::RigObject& o = *rig_.surface.object;
   json j = {{"mesh", o.mesh},
-            {"R", json::array()},
+            {"R", rowMajor(o.R)},
             {"t", vectorJson(o.t)},
             {"points", o.points},
             {"placed", {{"method", o.placed.method}, {"time", o.placed.time}}}};
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) j["R"].push_back(o.R(r, c));
   if (o.fit_rms_m >= 0) j["fit_rms_m"] = o.fit_rms_m;
   j["painted"] = object_show_.prepared != nullptr;
   return j;
@@ -130,8 +117,8 @@ void Daemon::cmdObject(ClientId client, const proto::Request& req) {
   std::vector<Vec3> model_points, world_points;
   for (std::size_t i = 0; i < points->size(); ++i) {
     const json& p = (*points)[i];
-    const auto m = p.is_object() && p.contains("model") ? point3(p["model"]) : std::nullopt;
-    const auto w = p.is_object() && p.contains("world") ? point3(p["world"]) : std::nullopt;
+    const auto m = p.is_object() && p.contains("model") ? vectorFromJson(p["model"]) : std::nullopt;
+    const auto w = p.is_object() && p.contains("world") ? vectorFromJson(p["world"]) : std::nullopt;
     if (!m || !w)
       return errorTo(client, req, code::kBadArgument,
                      "point " + std::to_string(i) +
@@ -167,13 +154,11 @@ void Daemon::cmdObject(ClientId client, const proto::Request& req) {
                 fit.error().message});
           PlacementResult out;
           out.placement = *fit;
-          for (std::size_t i = 0; i < model_points.size(); ++i)
-            out.residuals_m.push_back((fit->R * model_points[i] + fit->t - world_points[i]).norm());
           if (fit->rms_m > max_rms) {
             std::string list;
-            for (std::size_t i = 0; i < out.residuals_m.size(); ++i)
+            for (std::size_t i = 0; i < out.placement.residuals_m.size(); ++i)
               list += (i ? ", " : "") + std::to_string(i) + ": " +
-                      std::to_string(out.residuals_m[i] * 1000).substr(0, 6) + " mm";
+                      std::to_string(out.placement.residuals_m[i] * 1000).substr(0, 6) + " mm";
             return tl::unexpected(MeshFailure{
                 code::kBadArgument, "the points miss the placed model by " +
                                         std::to_string(fit->rms_m * 1000) + " mm RMS (over " +
@@ -203,15 +188,16 @@ void Daemon::cmdObject(ClientId client, const proto::Request& req) {
           object.R = r.placement.R;
           object.t = r.placement.t;
           object.fit_rms_m = r.placement.rms_m;
-          object.points = static_cast<long>(r.residuals_m.size());
+          object.points = static_cast<long>(r.placement.residuals_m.size());
           object.placed = {"model " + std::filesystem::path(file).filename().string() +
-                               " placed from " + std::to_string(r.residuals_m.size()) + " points",
+                               " placed from " + std::to_string(r.placement.residuals_m.size()) +
+                               " points",
                            utcNow()};
           update.surface.object = object;
           json reply = {
               {"fit_rms_m", r.placement.rms_m},
               {"fit_max_m", r.placement.max_m},
-              {"residuals_m", r.residuals_m},
+              {"residuals_m", r.placement.residuals_m},
               {"model",
                {{"vertices", r.vertices}, {"triangles", r.faces}, {"textured", r.textured}}}};
           writeRig(std::move(update), {{kObjectModelFile, r.ply}},
@@ -338,14 +324,12 @@ void Daemon::repaintObject(const std::string& why) {
             // shown until the outputs come back.
             warn("object content not painted again: " + (*prepared).error().message);
           } else {
+            if ((*prepared)->view_dependent) {
+              (*prepared)->info["display"]["view_updates"] = s.updates;
+              if (eye) s.eye = *eye;
+            }
             s.prepared = std::make_shared<const PreparedObject>(std::move(**prepared));
             s.rig_generation = rig_generation;
-            if (s.prepared->view_dependent && eye) s.eye = *eye;
-            if (s.prepared->view_dependent) {
-              auto info = std::make_shared<PreparedObject>(*s.prepared);
-              info->info["display"]["view_updates"] = s.updates;
-              s.prepared = std::move(info);
-            }
             broadcast("content", {{"content", contentJson()}});
             refreshOutputs({}, true);
           }

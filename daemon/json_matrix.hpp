@@ -1,7 +1,9 @@
 #pragma once
 // Vectors and matrices as the protocol writes them: JSON arrays of numbers, matrices
 // row-major.
+#include <cmath>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "core/types.hpp"
 
@@ -13,6 +15,17 @@ inline nlohmann::json vectorJson(const Vec2& v) {
 
 inline nlohmann::json vectorJson(const Vec3& v) {
   return {v.x(), v.y(), v.z()};
+}
+
+// [x, y, z] of finite numbers; nullopt for anything else.
+inline std::optional<Vec3> vectorFromJson(const nlohmann::json& j) {
+  if (!j.is_array() || j.size() != 3) return std::nullopt;
+  Vec3 v;
+  for (int k = 0; k < 3; ++k) {
+    if (!j[k].is_number() || !std::isfinite(j[k].get<double>())) return std::nullopt;
+    v[k] = j[k].get<double>();
+  }
+  return v;
 }
 
 inline nlohmann::json rowMajor(const Mat34& m) {

@@ -47,6 +47,14 @@ std::optional<std::string> differsFrom(const geom::TriangleMesh& content,
   return std::nullopt;
 }
 
+// The rig's placement of its object, world = R · model + t.
+lamps::ObjectPlacement placementOf(const rig::RigObject& o) {
+  lamps::ObjectPlacement p;
+  p.R = o.R;
+  p.t = o.t;
+  return p;
+}
+
 }  // namespace
 
 Result<geom::TriangleMesh> rigObjectMesh(const rig::RigModel& rig, const std::string& state_dir) {
@@ -57,7 +65,7 @@ Result<geom::TriangleMesh> rigObjectMesh(const rig::RigModel& rig, const std::st
                 "object mesh '" + o.mesh + "' is not a file name in the state directory");
   auto loaded = content::loadMeshContent(std::filesystem::path(state_dir) / o.mesh);
   if (!loaded) return tl::unexpected(loaded.error());
-  return lamps::placedMesh(loaded->mesh, {o.R, o.t, 0, 0});
+  return lamps::placedMesh(loaded->mesh, placementOf(o));
 }
 
 Result<std::map<std::string, std::shared_ptr<const cv::Mat>>> paintObjectFrames(
@@ -69,9 +77,7 @@ Result<std::map<std::string, std::shared_ptr<const cv::Mat>>> paintObjectFrames(
     lamps::LampFrameStats stats;
     auto frame = lamps::rigLampFrame(*prepared.lamps, i, *prepared.material, 0, eye, &stats);
     if (!frame) return tl::unexpected(frame.error());
-    std::string output;
-    for (const auto& [name, index] : prepared.lamp_of)
-      if (index == i) output = name;
+    const std::string& output = prepared.shown_by[i];
     if (!output.empty()) {
       auto rgba = std::make_shared<cv::Mat>();
       cv::cvtColor(*frame, *rgba, cv::COLOR_BGR2RGBA);
@@ -99,7 +105,6 @@ tl::expected<PreparedObject, MeshFailure> prepareObjectContent(
   if (!(look.shininess >= 1 && look.shininess <= 10000))
     return failure(code::kBadArgument, "\"shininess\" must be from 1 to 10000");
   // Which projector each output shows: the others of the rig are off.
-  rig::RigModel lit = rig;
   std::map<std::string, std::string> output_of;  // projector -> output
   for (const ObjectOutput& o : outputs) {
     const rig::RigProjector* p = rig.projectorForOutput(o.name);
@@ -133,7 +138,7 @@ tl::expected<PreparedObject, MeshFailure> prepareObjectContent(
     if (!content)
       return tl::unexpected(MeshFailure{protoCode(content.error().code), content.error().message});
     // Both placed by the rig's pose, compared in the world.
-    geom::TriangleMesh in_world = lamps::placedMesh(content->mesh, {placed.R, placed.t, 0, 0});
+    geom::TriangleMesh in_world = lamps::placedMesh(content->mesh, placementOf(placed));
     if (auto why = differsFrom(in_world, *model))
       return failure(code::kBadArgument, look.file + " is not the rig's object model: " + *why +
                                              " (place this model with `object place` first)");
@@ -172,9 +177,9 @@ tl::expected<PreparedObject, MeshFailure> prepareObjectContent(
   out.lamps = std::make_shared<const lamps::RigLamps>(std::move(*prepared_lamps));
   out.material = std::move(material);
   out.view_dependent = look.specular > 0;
-  for (std::size_t i = 0; i < out.lamps->lamps.size(); ++i) {
-    auto it = output_of.find(out.lamps->lamps[i].name);
-    if (it != output_of.end()) out.lamp_of[it->second] = i;
+  for (const lamps::RigLamp& lamp : out.lamps->lamps) {
+    auto it = output_of.find(lamp.name);
+    out.shown_by.push_back(it != output_of.end() ? it->second : std::string());
   }
   json projectors;
   const std::optional<Vec3> shade_eye = out.view_dependent ? eye : std::nullopt;

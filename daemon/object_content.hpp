@@ -43,9 +43,9 @@ struct PreparedObject {
   std::map<std::string, std::shared_ptr<const cv::Mat>> frames;
   std::shared_ptr<const lamps::RigLamps> lamps;  // views and weights: kept for a new eye
   std::shared_ptr<const lamps::Material> material;
-  std::map<std::string, std::size_t> lamp_of;  // output name -> its lamp
-  bool view_dependent = false;                 // the look depends on the eye (specular)
-  nlohmann::json info;                         // the `content` object of replies
+  std::vector<std::string> shown_by;  // per lamp: the output showing it; empty: none
+  bool view_dependent = false;        // the look depends on the eye (specular)
+  nlohmann::json info;                // the `content` object of replies
 };
 
 // The rig's object model, read from `state_dir`, placed in the world.

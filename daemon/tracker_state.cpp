@@ -3,6 +3,8 @@
 #include <cmath>
 #include <vector>
 
+#include "json_matrix.hpp"
+
 namespace procam::daemon {
 
 using nlohmann::json;
@@ -22,11 +24,8 @@ bool finiteNumbers(const json& j, size_t n, double* out) {
 }
 
 Result<Vec3> point(const json& j, const std::string& key) {
-  double v[3];
-  if (!finiteNumbers(j, 3, v)) {
-    return fail(ErrorCode::kInvalidInput, "\"" + key + "\" must be [x, y, z] (metres)");
-  }
-  return Vec3(v[0], v[1], v[2]);
+  if (auto v = vectorFromJson(j)) return *v;
+  return fail(ErrorCode::kInvalidInput, "\"" + key + "\" must be [x, y, z] (metres)");
 }
 
 Result<size_t> index(const json& request, const char* key, size_t count) {

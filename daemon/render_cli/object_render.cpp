@@ -42,11 +42,7 @@ Result<json> renderObject(const ObjectRenderInput& in) {
     return fail(ErrorCode::kInvalidInput, "--white must be positive");
   lamps::RigLampOptions options{in.projectors, in.off, in.max_incidence_deg};
   auto prepared = lamps::prepareRigLamps(*in.rig, *object, options);
-  if (!prepared) {
-    if (prepared.error().message.rfind("no posed projector '", 0) == 0)
-      return fail(ErrorCode::kNotFound, "--off: " + prepared.error().message);
-    return tl::unexpected(prepared.error());
-  }
+  if (!prepared) return tl::unexpected(prepared.error());
   const double white = in.white ? *in.white : prepared->white;
 
   lamps::Material material;

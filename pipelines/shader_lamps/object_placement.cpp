@@ -25,8 +25,10 @@ Result<ObjectPlacement> placeObject(std::span<const Vec3> model_points,
   out.R = fit->R;
   out.t = fit->t;
   out.rms_m = fit->rms;
-  for (std::size_t i = 0; i < model_points.size(); ++i)
-    out.max_m = std::max(out.max_m, (fit->R * model_points[i] + fit->t - world_points[i]).norm());
+  for (std::size_t i = 0; i < model_points.size(); ++i) {
+    out.residuals_m.push_back((fit->R * model_points[i] + fit->t - world_points[i]).norm());
+    out.max_m = std::max(out.max_m, out.residuals_m.back());
+  }
   return out;
 }
 

@@ -7,6 +7,7 @@
 // that the fit's residual tells a mis-picked point or a model of another object.
 #include <span>
 #include <string>
+#include <vector>
 
 #include "core/error.hpp"
 #include "core/types.hpp"
@@ -17,8 +18,9 @@ namespace procam::lamps {
 struct ObjectPlacement {
   Mat3 R = Mat3::Identity();  // world = R · model + t
   Vec3 t = Vec3::Zero();
-  double rms_m = 0;  // of the points' residuals after the fit
-  double max_m = 0;  // the largest residual
+  double rms_m = 0;                 // of the points' residuals after the fit
+  double max_m = 0;                 // the largest residual
+  std::vector<double> residuals_m;  // per point, in the order given
 };
 
 constexpr std::size_t kMinPlacementPoints = 4;

@@ -15,6 +15,7 @@
 #include <numbers>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <random>
 #include <regex>
 #include <sstream>
@@ -420,11 +421,14 @@ TEST(ShaderLamp, DaemonReportsWhatAnUnpluggedProjectorLeftUnlit) {
       60s * kSlowdown);
   ASSERT_TRUE(loaded);
   ASSERT_EQ((*loaded)["class"], "CONTENT") << loaded->dump();
-  if (std::chrono::steady_clock::now() - t0 > std::chrono::seconds(gone) - 500ms)
-    GTEST_SKIP() << "too slow a start to see the projector before it is unplugged";
-  const json both = (*loaded)["content"];
-  EXPECT_EQ(both["display"]["coverage"]["unlit_m2"].get<double>(), 0.0);
-  const double area = both["display"]["coverage"]["lit_m2"].get<double>();
+  // Painted while both were plugged in (a slow start may already be past `gone`: then
+  // the both-projector figures come from their return below).
+  std::optional<double> area_first;
+  if (std::chrono::steady_clock::now() - t0 < std::chrono::seconds(gone) - 500ms) {
+    const json both = (*loaded)["content"];
+    EXPECT_EQ(both["display"]["coverage"]["unlit_m2"].get<double>(), 0.0);
+    area_first = both["display"]["coverage"]["lit_m2"].get<double>();
+  }
 
   // Unplugged: found at its next frame (a pattern shown and taken back draws two);
   // painted without it.
@@ -447,14 +451,9 @@ TEST(ShaderLamp, DaemonReportsWhatAnUnpluggedProjectorLeftUnlit) {
   EXPECT_EQ(by_name["proj"]["shown_by"], "proj");
   const double unlit = one["display"]["coverage"]["unlit_m2"].get<double>();
   const double lit = one["display"]["coverage"]["lit_m2"].get<double>();
-  std::printf(
-      "proj_right unplugged: %.4f m2 of the box lit, %.4f m2 unlit (%zu faces), "
-      "%.4f m2 lit with both\n",
-      lit, unlit, one["display"]["coverage"]["unlit_faces"].get<std::size_t>(), area);
   // The box's top far left corner and most of its right side are the right projector's
-  // alone (tests/scenes/object_box.toml); what is lit and what is not make the whole.
+  // alone (tests/scenes/object_box.toml).
   EXPECT_GT(unlit, 0.001);
-  EXPECT_NEAR(lit + unlit, area, 1e-9);
 
   // Back: painted again with both.
   json two;
@@ -465,7 +464,16 @@ TEST(ShaderLamp, DaemonReportsWhatAnUnpluggedProjectorLeftUnlit) {
       },
       std::chrono::seconds(back - gone + 20 * kSlowdown)))
       << two.dump() << d.log();
-  EXPECT_NEAR(two["display"]["coverage"]["lit_m2"].get<double>(), area, 1e-9);
+  const double area = two["display"]["coverage"]["lit_m2"].get<double>();
+  std::printf(
+      "proj_right unplugged: %.4f m2 of the box lit, %.4f m2 unlit (%zu faces), "
+      "%.4f m2 lit with both\n",
+      lit, unlit, one["display"]["coverage"]["unlit_faces"].get<std::size_t>(), area);
+  // What is lit and what is not make the whole.
+  EXPECT_NEAR(lit + unlit, area, 1e-9);
+  if (area_first) {
+    EXPECT_NEAR(*area_first, area, 1e-9);
+  }
   for (const auto& p : two["projectors"]) EXPECT_EQ(p["shown_by"], p["name"]) << two.dump();
 }
 

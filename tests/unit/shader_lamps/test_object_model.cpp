@@ -2,6 +2,7 @@
 // seams of its texture, sharp at a box's edges; texture coordinates interpolated.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -161,6 +162,12 @@ TEST(ShaderLampPlacement, FourOrMorePointsPlaceTheModel) {
   EXPECT_LT((placement->t - t).norm(), 0.002);
   EXPECT_GT(placement->max_m, 0.001);  // the mis-picked point shows in the residual
   EXPECT_LT(placement->max_m, 0.002);
+  ASSERT_EQ(placement->residuals_m.size(), model.size());
+  EXPECT_EQ(*std::max_element(placement->residuals_m.begin(), placement->residuals_m.end()),
+            placement->max_m);
+  EXPECT_EQ(std::max_element(placement->residuals_m.begin(), placement->residuals_m.end()) -
+                placement->residuals_m.begin(),
+            4);  // the mis-picked one
   geom::TriangleMesh mesh;
   mesh.vertices = model;
   mesh.faces.emplace_back(0, 1, 2);
