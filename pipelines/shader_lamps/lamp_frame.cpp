@@ -6,9 +6,7 @@
 
 namespace procam::lamps {
 
-namespace {
-
-Result<void> checkInput(const LampFrameInput& l) {
+Result<void> checkLampInput(const LampFrameInput& l) {
   if (!l.view || !l.weight || l.view->face.empty())
     return fail(ErrorCode::kInvalidInput, "a projector has no view or weights");
   if (l.weight->size() != l.view->size || l.weight->type() != CV_32FC1)
@@ -20,12 +18,10 @@ Result<void> checkInput(const LampFrameInput& l) {
   return {};
 }
 
-}  // namespace
-
 Result<double> lampWhiteLevel(std::span<const LampFrameInput> lamps) {
   double best = std::numeric_limits<double>::infinity();
   for (const LampFrameInput& l : lamps) {
-    if (auto ok = checkInput(l); !ok) return tl::unexpected(ok.error());
+    if (auto ok = checkLampInput(l); !ok) return tl::unexpected(ok.error());
     const double gain = l.photometry.gain_rgb.minCoeff();
     for (int y = 0; y < l.view->size.height; ++y) {
       for (int x = 0; x < l.view->size.width; ++x) {
@@ -46,7 +42,7 @@ Result<cv::Mat> lampFrame(const LampFrameInput& l, const Material& material, dou
                           const std::optional<Vec3>& eye, LampFrameStats* stats, int bit_depth) {
   if (bit_depth != 8 && bit_depth != 16)
     return fail(ErrorCode::kInvalidInput, "frames are 8 or 16 bits deep");
-  if (auto ok = checkInput(l); !ok) return tl::unexpected(ok.error());
+  if (auto ok = checkLampInput(l); !ok) return tl::unexpected(ok.error());
   if (auto ok = checkMaterial(material); !ok) return tl::unexpected(ok.error());
   if (!(std::isfinite(white) && white > 0))
     return fail(ErrorCode::kInvalidInput, "the white level must be finite and positive");

@@ -33,6 +33,10 @@ struct LampFrameInput {
   LampPhotometry photometry;
 };
 
+// kInvalidInput for a missing view or weight, mismatched sizes, a gamma outside [1, 4] or
+// a gain that is not finite and positive.
+Result<void> checkLampInput(const LampFrameInput& lamp);
+
 // The brightest white level (radiance of a white texel, L = 1) that every projector can
 // give at every point it lights with its weight: the smallest k·B·cos θ / (w · d²) over
 // lit pixels and channels. kNotFound when no pixel lights the object.

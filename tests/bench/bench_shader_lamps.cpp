@@ -7,12 +7,17 @@
 //    diffuse look and for a glossy one shaded for a tracked eye, against OpenCV's
 //    cv::remap of a 1080p BGR texture through a float map (one bilinear look-up per
 //    pixel: the least a textured frame costs) in the same run, as a ratio.
-//  - per frame and projector on a GLES output (GLES 3 on the surfaceless EGL platform when
-//    built; Mesa llvmpipe here): what procamd's outputs do with a shaded frame — the RGBA
-//    frame uploaded and drawn through the homography path with H = I, then glFinish —
-//    alone, and a tracked eye's whole update (the glossy frame shaded on the CPU, made
-//    RGBA, shown), and that the frame read back is the one shaded (largest difference in
-//    code values). The shading itself has no GLES program: it runs on the CPU.
+//  - per frame and projector with GLES 3 (the surfaceless EGL platform when built; Mesa
+//    llvmpipe here, a GPU on a rig):
+//    - the shading on the GPU (gl/gl_lamp_shader.hpp): the view's buffers uploaded once
+//      per rig, then per frame the textured diffuse look and the glossy one for a tracked
+//      eye shaded by the fragment program (glFinish), and with the frame read back; the
+//      read-back frame against lampFrame's (largest difference in code values, share of
+//      lit pixels that differ: float against double rounding);
+//    - what procamd's outputs do with a frame shaded on the CPU: the RGBA frame uploaded
+//      and drawn through the homography path with H = I, then glFinish, alone, and a
+//      tracked eye's whole update (CPU shading, RGBA, shown), and that the frame read back
+//      is the one shaded.
 // Error beside the time: the largest departure of the weights' sum from one at the pixel
 // centres of the first projector (exact by construction: it guards the normalisation),
 // and the share of lit pixels whose intensity clipped.
@@ -33,8 +38,10 @@
 #include "shader_lamps/lamp_view.hpp"
 #include "shader_lamps/lamp_weights.hpp"
 #include "shader_lamps/object_model.hpp"
+#include "unit/shader_lamps/lamp_rig.hpp"
 #if PROCAM_BENCH_GLES
 #include "egl/egl_context.hpp"
+#include "gl/gl_lamp_shader.hpp"
 #include "gl/gl_renderer.hpp"
 #endif
 
@@ -43,26 +50,80 @@ using namespace procam;
 namespace {
 
 geom::CameraModel projector(const Vec3& at) {
-  geom::CameraModel m;
-  m.width = 1920;
-  m.height = 1080;
-  m.K.fx = m.K.fy = 3400;
-  m.K.cx = 959.5;
-  m.K.cy = 539.5;
-  m.pose = geom::Pose::lookAt(at, Vec3(0, 1.5, 0.9), Vec3::UnitZ());
-  return m;
+  return lamps::test::projectorAt(at, Vec3(0, 1.5, 0.9), 1920, 1080, 3400);
 }
 
 #if PROCAM_BENCH_GLES
-// A shaded frame on the headless GLES output, as procamd shows it (H = I).
+// The frames shaded by the GLES program, against lampFrame's.
+void benchGlesShading(std::ofstream& csv, int runs, const lamps::LampFrameInput& lamp,
+                      const lamps::Material& textured, const lamps::Material& glossy, double white,
+                      double remap_ms) {
+  auto shader = output::gl::GlLampShader::create();
+  if (!shader) {
+    std::printf("GLES shading: %s\n", shader.error().message.c_str());
+    return;
+  }
+  output::gl::GlLampShader& gl = **shader;
+  const Vec3 eye(0, 0.3, 1.4);
+  const bench::Timing upload = bench::measure(runs, [&] {
+    (void)gl.setView(lamp);
+    glFinish();
+  });
+  (void)gl.setMaterial(glossy);
+  cv::Mat frame;
+  (void)gl.shade(white, eye);
+  (void)gl.readFrame(frame);  // compile, allocate, warm the driver
+  cv::Mat diff;
+  cv::absdiff(frame, *lamps::lampFrame(lamp, glossy, white, eye), diff);
+  const double largest = cv::norm(diff, cv::NORM_INF);
+  cv::Mat any;
+  cv::transform(diff, any, cv::Matx13f(1, 1, 1));
+  const long differing = cv::countNonZero(any);
+  const long lit = cv::countNonZero(*lamp.weight > 0);
+  (void)gl.setMaterial(textured);
+  const bench::Timing diffuse = bench::measure(runs, [&] {
+    (void)gl.shade(white, std::nullopt);
+    glFinish();
+  });
+  (void)gl.setMaterial(glossy);
+  const bench::Timing tracked = bench::measure(runs, [&] {
+    (void)gl.shade(white, eye);
+    glFinish();
+  });
+  const bench::Timing read = bench::measure(runs, [&] {
+    (void)gl.shade(white, eye);
+    (void)gl.readFrame(frame);
+  });
+  std::printf(
+      "GLES shading: view upload (once per rig) %.1f ms median; frame textured %.1f ms "
+      "(%.2fx cv::remap), glossy for a tracked eye %.1f ms (%.2fx), with read-back %.1f "
+      "ms; against lampFrame: largest difference %.0f code values, %ld of %ld lit "
+      "pixels differ\n",
+      upload.median_ms, diffuse.median_ms, diffuse.median_ms / remap_ms, tracked.median_ms,
+      tracked.median_ms / remap_ms, read.median_ms, largest, differing, lit);
+  csv << "gles_view_upload," << upload.median_ms << ',' << upload.min_ms << ",\n";
+  csv << "gles_shade_textured," << diffuse.median_ms << ',' << diffuse.min_ms << ','
+      << diffuse.median_ms / remap_ms << '\n';
+  csv << "gles_shade_glossy," << tracked.median_ms << ',' << tracked.min_ms << ','
+      << tracked.median_ms / remap_ms << '\n';
+  csv << "gles_shade_glossy_readback," << read.median_ms << ',' << read.min_ms << ','
+      << read.median_ms / remap_ms << '\n';
+  csv << "# GLES shading against lampFrame: largest difference " << largest << " code values, "
+      << differing << " of " << lit << " lit pixels differ\n";
+}
+
+// A shaded frame on the headless GLES output, as procamd shows it (H = I), and the
+// shading on the GPU.
 void benchGles(std::ofstream& csv, int runs, const lamps::LampFrameInput& lamp,
-               const lamps::Material& glossy, double white, double remap_ms) {
+               const lamps::Material& textured, const lamps::Material& glossy, double white,
+               double remap_ms) {
   auto ctx = output::egl::EglContext::surfaceless();
   if (!ctx) {
     std::printf("GLES: unavailable: %s\n", ctx.error().message.c_str());
     csv << "gles_unavailable,,,\n";
     return;
   }
+  benchGlesShading(csv, runs, lamp, textured, glossy, white, remap_ms);
   auto gl = output::gl::GlRenderer::create(output::gl::GlTarget{true, 0});
   if (!gl) {
     std::printf("GLES: %s\n", gl.error().message.c_str());
@@ -209,7 +270,7 @@ int main(int argc, char** argv) {
   csv << "remap," << frame[2].median_ms << ',' << frame[2].min_ms << ",1\n";
   csv << "# weights' sum off one: 99th percentile " << off_p99 << ", largest " << off_max << '\n';
 #if PROCAM_BENCH_GLES
-  benchGles(csv, runs, inputs[0], glossy, white, frame[2].median_ms);
+  benchGles(csv, runs, inputs[0], textured, glossy, white, frame[2].median_ms);
 #endif
   return 0;
 }

@@ -109,7 +109,9 @@ Result<Shader> compile(GLenum type, const char* src) {
   return s;
 }
 
-Result<Program> link(const char* vs, const char* fs) {
+}  // namespace
+
+Result<Program> linkProgram(const char* vs, const char* fs) {
   auto v = compile(GL_VERTEX_SHADER, vs);
   if (!v) return tl::unexpected(v.error());
   auto f = compile(GL_FRAGMENT_SHADER, fs);
@@ -128,8 +130,10 @@ Result<Program> link(const char* vs, const char* fs) {
   return p;
 }
 
+namespace {
+
 Result<SampleProgram> sampleProgram(const char* vs) {
-  auto p = link(vs, kSampleFs);
+  auto p = linkProgram(vs, kSampleFs);
   if (!p) return tl::unexpected(p.error());
   SampleProgram s;
   s.clip = glGetUniformLocation(p->get(), "uClip");
@@ -149,11 +153,11 @@ Result<Programs> buildPrograms() {
   auto sm = sampleProgram(kSampleMeshVs);
   if (!sm) return tl::unexpected(sm.error());
   out.sample_mesh = std::move(*sm);
-  auto c = link(kColorVs, kColorFs);
+  auto c = linkProgram(kColorVs, kColorFs);
   if (!c) return tl::unexpected(c.error());
   out.color.clip = glGetUniformLocation(c->get(), "uClip");
   out.color.program = std::move(*c);
-  auto f = link(kFinalVs, kFinalFs);
+  auto f = linkProgram(kFinalVs, kFinalFs);
   if (!f) return tl::unexpected(f.error());
   const GLuint id = f->get();
   out.final_stage.clip = glGetUniformLocation(id, "uClip");

@@ -36,6 +36,10 @@ struct Programs {
   FinalProgram final_stage;   // attributes: 0 vec2 pixel
 };
 
+// Compiles and links one program from its vertex and fragment sources; kIo with the GL
+// info log on failure.
+Result<Program> linkProgram(const char* vs, const char* fs);
+
 // Compiles and links every program; kIo with the GL info log on failure.
 Result<Programs> buildPrograms();
 

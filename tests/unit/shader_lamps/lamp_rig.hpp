@@ -8,14 +8,16 @@
 
 namespace procam::lamps::test {
 
-// A 400 x 300 projector at `centre` looking at `target`, f = 400.
-inline geom::CameraModel projectorAt(const Vec3& centre, const Vec3& target) {
+// A projector at `centre` looking at `target` (+Z up), 400 x 300 with f = 400 unless
+// told, its principal point at the frame's centre.
+inline geom::CameraModel projectorAt(const Vec3& centre, const Vec3& target, int width = 400,
+                                     int height = 300, double f = 400) {
   geom::CameraModel m;
-  m.width = 400;
-  m.height = 300;
-  m.K.fx = m.K.fy = 400;
-  m.K.cx = 199.5;
-  m.K.cy = 149.5;
+  m.width = width;
+  m.height = height;
+  m.K.fx = m.K.fy = f;
+  m.K.cx = (width - 1) / 2.0;
+  m.K.cy = (height - 1) / 2.0;
   m.pose = geom::Pose::lookAt(centre, target, Vec3::UnitZ());
   return m;
 }
