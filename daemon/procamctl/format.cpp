@@ -10,7 +10,7 @@ using nlohmann::json;
 
 namespace {
 
-std::string scalar(const json& v) {
+std::string scalar(json v) {
   if (v.is_null()) return "-";
   if (v.is_string()) return v.get<std::string>();
   if (v.is_number_float()) {
@@ -21,10 +21,10 @@ std::string scalar(const json& v) {
   return v.dump();
 }
 
-std::string pairList(const json& v) {
+std::string pairList(json v) {
   if (!v.is_array()) return scalar(v);
   std::string out;
-  for (const auto& p : v) {
+  for (json p : v) {
     if (!out.empty()) out += " ";
     if (p.is_array() && p.size() == 2) {
       out += scalar(p[0]) + "," + scalar(p[1]);
@@ -41,16 +41,16 @@ std::string field(const char* name, const std::string& value) {
   return buf + value + "\n";
 }
 
-std::string keystoneText(const json& k) {
+std::string keystoneText(json k) {
   std::string out = field("auto keystone", k.value("auto", false) ? "on" : "off");
-  const json& corners = k.contains("corners") ? k["corners"] : json(nullptr);
+  json corners = k.contains("corners") ? k["corners"] : json(nullptr);
   out += field("corners", corners.is_null() ? "none (no manual correction)" : pairList(corners));
   if (k.contains("output_size") && !k["output_size"].is_null()) {
     out += field("output", scalar(k["output_size"][0]) + "x" + scalar(k["output_size"][1]));
   }
   // The yaw a tilt sensor cannot see: from the camera on the projector, or why not.
   if (k.contains("tilt") && k["tilt"].is_object() && k["tilt"].contains("yaw")) {
-    const json& y = k["tilt"]["yaw"];
+    json y = k["tilt"]["yaw"];
     std::string text = y.value("source", "");
     if (y.contains("yaw_deg") && y["yaw_deg"].is_number()) {
       char deg[32];
@@ -62,7 +62,7 @@ std::string keystoneText(const json& k) {
   }
   // How long a tilt reading takes to reach the wall.
   if (k.contains("latency") && k["latency"].is_object()) {
-    const json& l = k["latency"];
+    json l = k["latency"];
     char text[128];
     std::snprintf(text, sizeof text, "median %.1f ms, 95%% %.1f ms, max %.1f ms (%llu frames)",
                   l.value("median_ms", 0.0), l.value("p95_ms", 0.0), l.value("max_ms", 0.0),
@@ -77,11 +77,11 @@ std::string keystoneText(const json& k) {
   return out;
 }
 
-std::string contentText(const json& c) {
+std::string contentText(json c) {
   if (c.is_null()) return "none";
   std::string s = c.value("path", "");
   if (c.contains("stream")) {
-    const json& st = c["stream"];
+    json st = c["stream"];
     for (const char* key : {"path", "uri", "v4l2", "pipeline"}) {
       if (st.contains(key)) s = st[key].get<std::string>();
     }
@@ -89,8 +89,8 @@ std::string contentText(const json& c) {
   }
   if (c.contains("shared")) s = "shared memory";
   if (c.contains("object") && c.contains("display") && c["display"].is_object()) {
-    const json& d = c["display"];
-    const json cov = d.value("coverage", json::object());
+    json d = c["display"];
+    json cov = d.value("coverage", json::object());
     char line[200];
     std::snprintf(line, sizeof line,
                   ", painted on the object: white %.4g (%s), lit %.4f m2, unlit %.4f m2",
@@ -105,13 +105,13 @@ std::string contentText(const json& c) {
   return s;
 }
 
-std::string calibrateText(const json& r) {
+std::string calibrateText(json r) {
   if (r.value("state", "") == "started") {
     return "calibration " + scalar(r["operation"]) + ": " + scalar(r["frames"]) +
            " pattern frames on " + scalar(r["output"]) + ", cameras " + pairList(r["cameras"]) +
            " (" + scalar(r["mode"]) + ")\n";
   }
-  const json& p = r["projector"];
+  json p = r["projector"];
   std::string out =
       field("projector", scalar(p["name"]) + " " + scalar(p["width"]) + "x" + scalar(p["height"]));
   // Route (b') calibrates a plane homography: no intrinsics, no position.
@@ -129,7 +129,7 @@ std::string calibrateText(const json& r) {
   return out;
 }
 
-std::string latencyText(const json& r) {
+std::string latencyText(json r) {
   if (r.value("state", "") == "started") {
     return "latency " + scalar(r["operation"]) + ": output " + scalar(r["output"]) + ", cameras " +
            pairList(r["cameras"]) + ", " + scalar(r["repeats"]) + " repeats\n";
@@ -139,8 +139,8 @@ std::string latencyText(const json& r) {
                 r.value("latency_s", 0.0) * 1e3, scalar(r["settle_frames"]).c_str(),
                 r.value("refresh_hz", 0.0), scalar(r["margin_frames"]).c_str());
   std::string out = field("output", scalar(r["output"])) + field("latency", line);
-  for (const auto& c : r["cameras"]) {
-    const json& l = c["latency_s"];
+  for (json c : r["cameras"]) {
+    json l = c["latency_s"];
     const size_t samples = c["samples"].is_array() ? c["samples"].size() : 0;
     std::snprintf(line, sizeof line, "median %.1f ms, spread %.1f ms, %zu samples, contrast %.1f",
                   l.value("median", 0.0) * 1e3, l.value("spread", 0.0) * 1e3, samples,
@@ -150,7 +150,7 @@ std::string latencyText(const json& r) {
   return out;
 }
 
-std::string snapshotText(const json& r) {
+std::string snapshotText(json r) {
   std::string out = field("camera", scalar(r["camera"]) + " " + scalar(r["width"]) + "x" +
                                         scalar(r["height"]) + " " + scalar(r["format"]));
   char line[160];
@@ -178,13 +178,13 @@ std::string snapshotText(const json& r) {
   return out;
 }
 
-std::string calibrateCameraText(const json& r) {
+std::string calibrateCameraText(json r) {
   if (r.contains("finishing")) return "finishing " + pairList(r["finishing"]) + "\n";
   if (r.value("state", "") == "started") {
     return "camera calibration " + scalar(r["operation"]) + ": camera " + scalar(r["camera"]) +
            ", board " + scalar(r["board"]) + "; move the board before the camera\n";
   }
-  const json& c = r["camera"];
+  json c = r["camera"];
   char line[200];
   std::string out =
       field("camera", scalar(c["name"]) + " " + scalar(c["width"]) + "x" + scalar(c["height"]));
@@ -206,9 +206,9 @@ std::string calibrateCameraText(const json& r) {
   return out;
 }
 
-std::string trackerText(const json& r) {
+std::string trackerText(json r) {
   if (r.contains("tracker")) {  // a registration was made
-    const json& g = r["registration"];
+    json g = r["registration"];
     char line[160];
     std::snprintf(line, sizeof line, "%s registered from %s points (%s), rms %.3f mm\n",
                   scalar(r["tracker"]).c_str(), scalar(g["points"]).c_str(),
@@ -217,14 +217,14 @@ std::string trackerText(const json& r) {
   }
   std::string out;
   if (r["trackers"].empty()) out += "no trackers\n";
-  for (const auto& t : r["trackers"]) {
+  for (json t : r["trackers"]) {
     char line[256];
     std::snprintf(line, sizeof line, "%-16s %-6s %s m, %.1f Hz, %s samples",
                   scalar(t["name"]).c_str(), scalar(t["state"]).c_str(),
                   pairList(t["position"]).c_str(), t.value("rate_hz", 0.0),
                   scalar(t["samples"]).c_str());
     out += line;
-    const json& g = t["registration"];
+    json g = t["registration"];
     if (g.is_object()) {
       std::snprintf(line, sizeof line, ", registered (%s, %s points, rms %.3f mm)",
                     scalar(g["source"]).c_str(), scalar(g["points"]).c_str(),
@@ -251,15 +251,15 @@ std::string progressBar(double fraction, int width, const std::string& stage) {
 }
 
 // Per output: where recalibrate = "on-drift" stands (status outputs.shown[].drift).
-static std::string driftText(const json& status) {
+static std::string driftText(json status) {
   std::string out;
   if (status.contains("drift") && status["drift"].is_object()) {
     out += field("recalibrate", scalar(status["drift"]["policy"]));
   }
   if (!status.contains("outputs") || !status["outputs"].is_object()) return out;
-  for (const json& o : status["outputs"].value("shown", json::array())) {
+  for (json o : status["outputs"].value("shown", json::array())) {
     if (!o.is_object() || !o.contains("drift") || !o["drift"].is_object()) continue;
-    const json& d = o["drift"];
+    json d = o["drift"];
     std::string text;
     if (d.contains("unavailable")) {
       text = "not checked: " + scalar(d["unavailable"]);
@@ -277,7 +277,11 @@ static std::string driftText(const json& status) {
   return out;
 }
 
-std::string formatReply(const json& r) {
+namespace {
+
+// The reply as text. Takes it by value: a key a reply lacks (a procamd of another
+// version) reads as null through the non-const operator[], never past a map's end.
+std::string replyText(json r) {
   const std::string cls = r.value("class", "");
   if (cls == "ERROR")
     return "error (" + r.value("code", "") + "): " + r.value("message", "") + "\n";
@@ -314,13 +318,13 @@ std::string formatReply(const json& r) {
       caps += (caps.empty() ? "" : ", ") + name + (on.get<bool>() ? "" : " (not built)");
     }
     out += field("capabilities", caps);
-    for (const auto& w : r["warnings"]) out += field("warning", scalar(w));
+    for (json w : r["warnings"]) out += field("warning", scalar(w));
     return out;
   }
   if (cls == "DEVICES") {
     std::string out;
     if (r["devices"].empty()) out += "no devices\n";
-    for (const auto& d : r["devices"]) {
+    for (json d : r["devices"]) {
       char line[256];
       std::snprintf(line, sizeof line, "%-8s %-16s %-20s %s", scalar(d["family"]).c_str(),
                     scalar(d["name"]).c_str(), scalar(d["driver"]).c_str(),
@@ -345,9 +349,9 @@ std::string formatReply(const json& r) {
   }
   if (cls == "CONTENT") return "content: " + contentText(r["content"]) + "\n";
   if (cls == "OBJECT") {
-    const json o = r.value("object", json());
+    json o = r.value("object", json());
     if (!o.is_object()) return "object: none\n";
-    const json placed = o.value("placed", json::object());
+    json placed = o.value("placed", json::object());
     std::string out = field("object", o.value("mesh", std::string()) + " (" +
                                           placed.value("method", std::string()) + ")");
     out += field("position", pairList(o.value("t", json::array())) + " m");
@@ -355,6 +359,20 @@ std::string formatReply(const json& r) {
       char line[64];
       std::snprintf(line, sizeof line, "%.2f mm RMS", 1000 * o["fit_rms_m"].get<double>());
       out += field("fit", line);
+    }
+    json g = r.value("refined", json());
+    if (g.is_object()) {
+      char line[160];
+      std::snprintf(line, sizeof line,
+                    "from %ld of %ld measured points: moved %.2f mm, turned %.3f deg, %.2f mm RMS",
+                    g.value("points", 0L), g.value("candidates", 0L),
+                    1000 * g.value("moved_m", 0.0), g.value("turned_deg", 0.0),
+                    1000 * g.value("rms_m", 0.0));
+      out += field("refined", line);
+      for (json f : g.value("free", json::array())) {
+        out += field("not fixed", f.value("kind", std::string()) + " along " +
+                                      pairList(f.value("axis", json::array())) + " (as placed)");
+      }
     }
     out += field("painted", o.value("painted", false) ? "yes" : "no");
     return out;
@@ -373,6 +391,17 @@ std::string formatReply(const json& r) {
                                      : "not watching\n";
   }
   return r.dump() + "\n";
+}
+
+}  // namespace
+
+std::string formatReply(const json& reply) {
+  try {
+    return replyText(reply);
+  } catch (const json::exception&) {
+    // A value of another type than this procamctl expects: the reply as it came.
+    return reply.dump() + "\n";
+  }
 }
 
 std::string formatEvent(const json& e) {

@@ -1,0 +1,64 @@
+// procamctl's text form of replies: every reply class it knows, from a procamd that sent
+// less than this procamctl reads (keys missing) or other types than it expects, gives
+// text and never reads past what came.
+#include <gtest/gtest.h>
+
+#include "format.hpp"
+
+namespace procam::ctl {
+namespace {
+
+using nlohmann::json;
+
+const char* const kClasses[] = {"VERSION", "STATUS",    "DEVICES", "KEYSTONE", "PATTERN",
+                                "CONTENT", "OBJECT",    "SAVE",    "RELOAD",   "LOG-LEVEL",
+                                "TRACKER", "CALIBRATE", "LATENCY", "SNAPSHOT", "CALIBRATE-CAMERA",
+                                "CANCEL",  "WATCH",     "ERROR"};
+
+TEST(CtlFormat, RepliesMissingTheirKeysStillRead) {
+  for (const char* cls : kClasses) {
+    const std::string text = formatReply(json{{"class", cls}});
+    EXPECT_FALSE(text.empty()) << cls;
+    EXPECT_EQ(text.back(), '\n') << cls;
+  }
+}
+
+TEST(CtlFormat, ValuesOfAnotherTypeGiveTheReplyAsItCame) {
+  for (const char* cls : kClasses) {
+    // Every key a formatter might read, each the wrong type.
+    json r = {{"class", cls}};
+    for (const char* key :
+         {"release",      "pid",         "uptime_s",    "sim",     "config",    "devices",
+          "capabilities", "warnings",    "outputs",     "auto",    "corners",   "pattern",
+          "shown",        "content",     "object",      "refined", "path",      "bytes",
+          "level",        "trackers",    "cameras",     "camera",  "cancelled", "events",
+          "enabled",      "proto_major", "proto_minor", "code",    "message",   "keystone",
+          "drift"}) {
+      r[key] = json::array({json::object({{"x", 1}}), 2});
+    }
+    const std::string text = formatReply(r);
+    EXPECT_FALSE(text.empty()) << cls;
+  }
+  // A reply that is not an object at all.
+  EXPECT_EQ(formatReply(json::array({1, 2})), "[1,2]\n");
+}
+
+TEST(CtlFormat, AnObjectRefinementIsShown) {
+  const json r = {{"class", "OBJECT"},
+                  {"object", {{"mesh", "object-model.ply"}, {"t", {0.1, 1.5, 0.875}}}},
+                  {"refined",
+                   {{"points", 713},
+                    {"candidates", 3324},
+                    {"moved_m", 0.0021},
+                    {"turned_deg", 0.75},
+                    {"rms_m", 0.00038},
+                    {"free", {{{"kind", "slide"}, {"axis", {1, 0, 0}}}}}}}};
+  const std::string text = formatReply(r);
+  EXPECT_NE(text.find("from 713 of 3324 measured points: moved 2.10 mm, turned 0.750 deg"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("slide along 1 0 0 (as placed)"), std::string::npos) << text;
+}
+
+}  // namespace
+}  // namespace procam::ctl
