@@ -14,6 +14,7 @@
 #include "log.hpp"
 #include "request_args.hpp"
 #include "shader_lamps/object_placement.hpp"
+#include "shader_lamps/object_refinement.hpp"
 
 namespace procam::daemon {
 
@@ -54,7 +55,7 @@ json Daemon::objectJson() const {
 
 void Daemon::cmdObject(ClientId client, const proto::Request& req) {
   RequestArgs args(req.body);
-  PROCAM_CHECK_KEYS(args, "action", "model", "points", "max_rms_m");
+  PROCAM_CHECK_KEYS(args, "action", "model", "points", "max_rms_m", "max_distance_m");
   const std::string action = args.string("action").value_or("get");
   const auto model = args.string("model");
   if (!args.ok()) return errorTo(client, req, code::kBadArgument, args.error());
@@ -99,9 +100,10 @@ void Daemon::cmdObject(ClientId client, const proto::Request& req) {
         answerFailure(client, req), client);
     return;
   }
+  if (action == "refine") return objectRefine(client, req, args);
   if (action != "place")
     return errorTo(client, req, code::kBadArgument,
-                   "unknown object action '" + action + "' (get, place, clear)");
+                   "unknown object action '" + action + "' (get, place, refine, clear)");
   if (!model || model->empty())
     return errorTo(client, req, code::kBadArgument, "object place needs \"model\", a mesh file");
   if (!isMeshFile(*model))
@@ -200,20 +202,140 @@ void Daemon::cmdObject(ClientId client, const proto::Request& req) {
               {"residuals_m", r.placement.residuals_m},
               {"model",
                {{"vertices", r.vertices}, {"triangles", r.faces}, {"textured", r.textured}}}};
-          writeRig(std::move(update), {{kObjectModelFile, r.ply}},
-                   [this, client, req, reply](const Result<std::string>& path) mutable {
-                     if (!path) {
-                       errorTo(client, req, code::kIo, path.error().message);
-                     } else {
-                       reply["path"] = *path;
-                       reply["object"] = objectJson();
-                       replyTo(client, req, "OBJECT", reply);
-                     }
-                     server_->release(client);
-                   });
+          writeObject(client, req, std::move(update), {{kObjectModelFile, r.ply}}, reply);
         };
       },
       answerFailure(client, req), client);
+}
+
+namespace {
+
+// The rig's measured surface: each projector's mesh (unified in the overlaps), or the
+// unified one when there is no other.
+Result<std::vector<geom::TriangleMesh>> measuredMeshes(const rig::RigModel& rig,
+                                                       const std::string& state_dir) {
+  std::vector<std::string> files;
+  for (const auto& [projector, file] : rig.surface.meshes) files.push_back(file);
+  if (files.empty() && !rig.surface.unified_mesh.empty()) files.push_back(rig.surface.unified_mesh);
+  if (files.empty())
+    return fail(ErrorCode::kNotFound,
+                "the rig has no measured surface meshes (calibrate with two cameras)");
+  std::vector<geom::TriangleMesh> meshes;
+  for (const std::string& file : files) {
+    if (!rig::RigSurface::isPlainFileName(file))
+      return fail(ErrorCode::kInvalidInput,
+                  "surface mesh '" + file + "' is not a file name in the state directory");
+    auto loaded = content::loadMeshContent(std::filesystem::path(state_dir) / file);
+    if (!loaded) return tl::unexpected(loaded.error());
+    meshes.push_back(std::move(loaded->mesh));
+  }
+  return meshes;
+}
+
+}  // namespace
+
+// `object refine`: the placed model's pose refined against the surface calibration
+// measured (lamps::refinePlacement); rig.json keeps the refined pose.
+void Daemon::objectRefine(ClientId client, const proto::Request& req, RequestArgs& args) {
+  if (args.get("model") || args.get("points") || args.get("max_rms_m"))
+    return errorTo(client, req, code::kBadArgument, "object refine takes only max_distance_m");
+  if (!rig_.surface.object)
+    return errorTo(client, req, code::kUnavailable, "the rig has no object (object place)");
+  lamps::RefineOptions options;
+  if (const json* v = args.get("max_distance_m")) {
+    if (!v->is_number() || !(v->get<double>() >= options.final_distance_m) ||
+        v->get<double>() > 0.1)
+      return errorTo(client, req, code::kBadArgument,
+                     "\"max_distance_m\" must be from 0.003 to 0.1 metres");
+    options.max_distance_m = v->get<double>();
+  }
+  if (refuseOverJobLimit(client, req)) return;
+  server_->hold(client);
+  compute_worker_->submit(
+      [this, client, req, rig = rig_, options, dir = options_.state_dir] {
+        const rig::RigObject& object = *rig.surface.object;
+        auto refined = std::make_shared<Result<lamps::ObjectRefinement>>(
+            [&]() -> Result<lamps::ObjectRefinement> {
+              auto meshes = measuredMeshes(rig, dir);
+              if (!meshes) return tl::unexpected(meshes.error());
+              if (!rig::RigSurface::isPlainFileName(object.mesh))
+                return fail(ErrorCode::kInvalidInput, "object mesh '" + object.mesh +
+                                                          "' is not a file name in the state "
+                                                          "directory");
+              auto model = content::loadMeshContent(std::filesystem::path(dir) / object.mesh);
+              if (!model) return tl::unexpected(model.error());
+              lamps::ObjectPlacement start;
+              start.R = object.R;
+              start.t = object.t;
+              return lamps::refinePlacement(*meshes, model->mesh, start, options);
+            }());
+        return [this, client, req, object, refined] {
+          const auto& now = rig_.surface.object;
+          if (!now || now->mesh != object.mesh || now->R != object.R || now->t != object.t) {
+            errorTo(client, req, code::kCancelled, "the rig's object changed meanwhile");
+            server_->release(client);
+            return;
+          }
+          if (!*refined) {
+            const ErrorCode c = refined->error().code;
+            errorTo(client, req,
+                    c == ErrorCode::kNotFound       ? code::kUnavailable
+                    : c == ErrorCode::kDegenerate   ? code::kDegenerate
+                    : c == ErrorCode::kTooFewPoints ? code::kTooFewPoints
+                                                    : code::kBadArgument,
+                    "object refine: " + refined->error().message);
+            server_->release(client);
+            return;
+          }
+          const lamps::ObjectRefinement& r = **refined;
+          rig::RigModel update;
+          rig::RigObject moved = object;
+          moved.R = r.placement.R;
+          moved.t = r.placement.t;
+          moved.fit_rms_m = r.placement.rms_m;
+          moved.points = r.points;
+          moved.placed = {"refined from " + std::to_string(r.points) +
+                              " points of the measured surface (" + object.placed.method + ")",
+                          utcNow()};
+          update.surface.object = moved;
+          json free = json::array();
+          for (const lamps::FreeDirection& f : r.free)
+            free.push_back({{"kind", f.turn ? "turn" : "slide"}, {"axis", vectorJson(f.axis)}});
+          json reply = {{"refined",
+                         {{"free", free},
+                          {"points", r.points},
+                          {"candidates", r.candidates},
+                          {"iterations", r.iterations},
+                          {"rms_m", r.placement.rms_m},
+                          {"max_m", r.placement.max_m},
+                          {"moved_m", r.moved_m},
+                          {"turned_deg", r.turned_deg}}}};
+          logInfo("the rig's object refined from " + std::to_string(r.points) +
+                  " measured points: moved " + std::to_string(r.moved_m * 1000) + " mm, turned " +
+                  std::to_string(r.turned_deg) + " deg" +
+                  (r.free.empty() ? std::string()
+                                  : "; " + std::to_string(r.free.size()) +
+                                        " direction(s) the measured surface does not fix kept "
+                                        "as placed"));
+          writeObject(client, req, std::move(update), {}, reply);
+        };
+      },
+      answerFailure(client, req), client);
+}
+
+void Daemon::writeObject(ClientId client, const proto::Request& req, rig::RigModel update,
+                         std::map<std::string, std::string> files, json reply) {
+  writeRig(std::move(update), std::move(files),
+           [this, client, req, reply](const Result<std::string>& path) mutable {
+             if (!path) {
+               errorTo(client, req, code::kIo, path.error().message);
+             } else {
+               reply["path"] = *path;
+               reply["object"] = objectJson();
+               replyTo(client, req, "OBJECT", reply);
+             }
+             server_->release(client);
+           });
 }
 
 std::vector<ObjectOutput> Daemon::objectOutputs() const {

@@ -39,6 +39,7 @@ namespace procam::daemon {
 
 struct CalibrationHooks;    // calibration_job.hpp
 struct CalibrationFailure;  // calibration_job.hpp
+class RequestArgs;          // request_args.hpp
 struct CalibrationProgress;
 
 struct DaemonOptions {
@@ -123,6 +124,11 @@ class Daemon {
   void cmdLogLevel(ClientId, const proto::Request&);
   // commands_object.cpp: the rig's object (shader lamps) and the look painted on it.
   void cmdObject(ClientId, const proto::Request&);
+  void objectRefine(ClientId, const proto::Request&, RequestArgs& args);
+  // Merges the object's update into rig.json (with `files` beside it), answers OBJECT with
+  // `reply`, the rig.json path and the object, and releases the held client.
+  void writeObject(ClientId client, const proto::Request& req, rig::RigModel update,
+                   std::map<std::string, std::string> files, nlohmann::json reply);
   nlohmann::json objectJson() const;
   void loadObjectContent(ClientId client, const proto::Request& req, ObjectLook look);
   // Paints the object's look again for the rig and the usable outputs as they are now

@@ -44,6 +44,9 @@ constexpr const char* kUsage =
     "  object place MODEL FILE [max_rms_m=M]\n"
     "                                 register MODEL to the rig from FILE: {\"points\":\n"
     "                                 [{\"model\": [x,y,z], \"world\": [x,y,z]}, ...]}, 4 or more\n"
+    "  object refine [max_distance_m=D]\n"
+    "                                 refine the placed model's pose against the surface\n"
+    "                                 calibration measured, from within D (default 0.01 m)\n"
     "  content stream PATH [WxH [rgb8|rgba8 [FPS]]]\n"
     "                                 raw frames (with a size) or a video file\n"
     "                                 (PATH: under the daemon's content roots; a relative\n"
@@ -209,6 +212,13 @@ json buildRequest(const std::string& cmd, const std::vector<std::string>& a) {
         const json extra = keyValueRequest("object", {a[3]});
         if (!extra.contains("max_rms_m")) usage("object place takes max_rms_m= after FILE");
         r["max_rms_m"] = extra["max_rms_m"];
+      }
+    } else if (action == "refine") {
+      arity(1, 2);
+      if (a.size() == 2) {
+        const json extra = keyValueRequest("object", {a[1]});
+        if (!extra.contains("max_distance_m")) usage("object refine takes max_distance_m=");
+        r["max_distance_m"] = extra["max_distance_m"];
       }
     } else {
       usage("unknown object action '" + action + "'");
