@@ -60,13 +60,13 @@ void Daemon::cmdObject(ClientId client, const proto::Request& req) {
   const auto model = args.string("model");
   if (!args.ok()) return errorTo(client, req, code::kBadArgument, args.error());
   if (action == "get") {
-    if (model || args.get("points"))
+    if (model || args.get("points") || args.get("max_distance_m"))
       return errorTo(client, req, code::kBadArgument, "object get takes no arguments");
     replyTo(client, req, "OBJECT", {{"object", objectJson()}});
     return;
   }
   if (action == "clear") {
-    if (model || args.get("points"))
+    if (model || args.get("points") || args.get("max_distance_m"))
       return errorTo(client, req, code::kBadArgument, "object clear takes no arguments");
     if (!rig_.surface.object) {
       replyTo(client, req, "OBJECT", {{"object", nullptr}});
@@ -74,6 +74,8 @@ void Daemon::cmdObject(ClientId client, const proto::Request& req) {
     }
     if (refuseOverJobLimit(client, req)) return;
     server_->hold(client);
+    ++object_edits_;
+    ++object_writes_;
     io_worker_->submit(
         [this, client, req, dir = options_.state_dir] {
           auto edited = [&]() -> Result<rig::RigModel> {
@@ -86,6 +88,7 @@ void Daemon::cmdObject(ClientId client, const proto::Request& req) {
             return rig;
           }();
           return [this, client, req, edited] {
+            --object_writes_;
             if (!edited) {
               errorTo(client, req, code::kIo, "rig.json not written: " + edited.error().message);
             } else {
@@ -97,13 +100,19 @@ void Daemon::cmdObject(ClientId client, const proto::Request& req) {
             server_->release(client);
           };
         },
-        answerFailure(client, req), client);
+        [this, failed = answerFailure(client, req)](const std::string& what) {
+          --object_writes_;
+          failed(what);
+        },
+        client);
     return;
   }
   if (action == "refine") return objectRefine(client, req, args);
   if (action != "place")
     return errorTo(client, req, code::kBadArgument,
                    "unknown object action '" + action + "' (get, place, refine, clear)");
+  if (args.get("max_distance_m"))
+    return errorTo(client, req, code::kBadArgument, "max_distance_m is for object refine");
   if (!model || model->empty())
     return errorTo(client, req, code::kBadArgument, "object place needs \"model\", a mesh file");
   if (!isMeshFile(*model))
@@ -202,6 +211,8 @@ void Daemon::cmdObject(ClientId client, const proto::Request& req) {
               {"residuals_m", r.placement.residuals_m},
               {"model",
                {{"vertices", r.vertices}, {"triangles", r.faces}, {"textured", r.textured}}}};
+          ++object_edits_;
+          ++object_writes_;
           writeObject(client, req, std::move(update), {{kObjectModelFile, r.ply}}, reply);
         };
       },
@@ -249,10 +260,13 @@ void Daemon::objectRefine(ClientId client, const proto::Request& req, RequestArg
                      "\"max_distance_m\" must be from 0.003 to 0.1 metres");
     options.max_distance_m = v->get<double>();
   }
+  // Refined from the object as rig.json will hold it, not one a write is replacing.
+  if (object_writes_ > 0)
+    return errorTo(client, req, code::kBusy, "the rig's object is being written; try again");
   if (refuseOverJobLimit(client, req)) return;
   server_->hold(client);
   compute_worker_->submit(
-      [this, client, req, rig = rig_, options, dir = options_.state_dir] {
+      [this, client, req, rig = rig_, options, dir = options_.state_dir, edits = object_edits_] {
         const rig::RigObject& object = *rig.surface.object;
         auto refined = std::make_shared<Result<lamps::ObjectRefinement>>(
             [&]() -> Result<lamps::ObjectRefinement> {
@@ -269,9 +283,10 @@ void Daemon::objectRefine(ClientId client, const proto::Request& req, RequestArg
               start.t = object.t;
               return lamps::refinePlacement(*meshes, model->mesh, start, options);
             }());
-        return [this, client, req, object, refined] {
-          const auto& now = rig_.surface.object;
-          if (!now || now->mesh != object.mesh || now->R != object.R || now->t != object.t) {
+        return [this, client, req, object, refined, edits] {
+          // Another place, clear or refine started writing since (its rig.json merge may
+          // still be on its way): this pose is of an object that is no more.
+          if (edits != object_edits_) {
             errorTo(client, req, code::kCancelled, "the rig's object changed meanwhile");
             server_->release(client);
             return;
@@ -279,7 +294,8 @@ void Daemon::objectRefine(ClientId client, const proto::Request& req, RequestArg
           if (!*refined) {
             const ErrorCode c = refined->error().code;
             errorTo(client, req,
-                    c == ErrorCode::kNotFound       ? code::kUnavailable
+                    c == ErrorCode::kIo             ? code::kIo
+                    : c == ErrorCode::kNotFound     ? code::kUnavailable
                     : c == ErrorCode::kDegenerate   ? code::kDegenerate
                     : c == ErrorCode::kTooFewPoints ? code::kTooFewPoints
                                                     : code::kBadArgument,
@@ -294,13 +310,23 @@ void Daemon::objectRefine(ClientId client, const proto::Request& req, RequestArg
           moved.t = r.placement.t;
           moved.fit_rms_m = r.placement.rms_m;
           moved.points = r.points;
-          moved.placed = {"refined from " + std::to_string(r.points) +
-                              " points of the measured surface (" + object.placed.method + ")",
+          // "refined from N points of the measured surface (how it was placed)", the
+          // placement named once however often it is refined.
+          const std::string prefix = "refined from ";
+          std::string placed_by = object.placed.method;
+          const std::size_t open = placed_by.find(" (");
+          if (placed_by.rfind(prefix, 0) == 0 && open != std::string::npos &&
+              placed_by.back() == ')')
+            placed_by = placed_by.substr(open + 2, placed_by.size() - open - 3);
+          moved.placed = {prefix + std::to_string(r.points) + " points of the measured surface (" +
+                              placed_by + ")",
                           utcNow()};
           update.surface.object = moved;
           json free = json::array();
           for (const lamps::FreeDirection& f : r.free)
-            free.push_back({{"kind", f.turn ? "turn" : "slide"}, {"axis", vectorJson(f.axis)}});
+            free.push_back({{"kind", f.turn ? "turn" : "slide"},
+                            {"axis", vectorJson(f.axis)},
+                            {"through", vectorJson(f.through)}});
           json reply = {{"refined",
                          {{"free", free},
                           {"points", r.points},
@@ -317,6 +343,8 @@ void Daemon::objectRefine(ClientId client, const proto::Request& req, RequestArg
                                   : "; " + std::to_string(r.free.size()) +
                                         " direction(s) the measured surface does not fix kept "
                                         "as placed"));
+          ++object_edits_;
+          ++object_writes_;
           writeObject(client, req, std::move(update), {}, reply);
         };
       },
@@ -327,6 +355,7 @@ void Daemon::writeObject(ClientId client, const proto::Request& req, rig::RigMod
                          std::map<std::string, std::string> files, json reply) {
   writeRig(std::move(update), std::move(files),
            [this, client, req, reply](const Result<std::string>& path) mutable {
+             --object_writes_;
              if (!path) {
                errorTo(client, req, code::kIo, path.error().message);
              } else {

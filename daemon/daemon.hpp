@@ -383,6 +383,10 @@ class Daemon {
     bool again = false;       // the rig or the outputs changed while it ran
   };
   ObjectShow object_show_;
+  // Object writes (place, clear, refine) started: a refine that finishes after another
+  // began is of an object that is no more.
+  uint64_t object_edits_ = 0;
+  int object_writes_ = 0;  // of those, on their way to rig.json
   // Destroyed in reverse order: server and workers before the loop they use.
   std::unique_ptr<EventLoop> loop_;
   std::unique_ptr<WorkerPool> io_worker_;       // state writes (fsync)

@@ -10,6 +10,24 @@ using nlohmann::json;
 
 namespace {
 
+// j[key] as T, or `fallback` when j is not an object, lacks the key or holds another type
+// (a procamd of another version): unlike json::value, never throws.
+template <class T>
+T val(const json& j, const char* key, T fallback) {
+  if (!j.is_object()) return fallback;
+  const auto it = j.find(key);
+  if (it == j.end()) return fallback;
+  try {
+    return it->get<T>();
+  } catch (const json::exception&) {
+    return fallback;
+  }
+}
+
+std::string val(const json& j, const char* key, const char* fallback) {
+  return val(j, key, std::string(fallback));
+}
+
 std::string scalar(json v) {
   if (v.is_null()) return "-";
   if (v.is_string()) return v.get<std::string>();
@@ -42,7 +60,7 @@ std::string field(const char* name, const std::string& value) {
 }
 
 std::string keystoneText(json k) {
-  std::string out = field("auto keystone", k.value("auto", false) ? "on" : "off");
+  std::string out = field("auto keystone", val(k, "auto", false) ? "on" : "off");
   json corners = k.contains("corners") ? k["corners"] : json(nullptr);
   out += field("corners", corners.is_null() ? "none (no manual correction)" : pairList(corners));
   if (k.contains("output_size") && !k["output_size"].is_null()) {
@@ -51,7 +69,7 @@ std::string keystoneText(json k) {
   // The yaw a tilt sensor cannot see: from the camera on the projector, or why not.
   if (k.contains("tilt") && k["tilt"].is_object() && k["tilt"].contains("yaw")) {
     json y = k["tilt"]["yaw"];
-    std::string text = y.value("source", "");
+    std::string text = val(y, "source", "");
     if (y.contains("yaw_deg") && y["yaw_deg"].is_number()) {
       char deg[32];
       std::snprintf(deg, sizeof deg, "%.3f deg, ", y["yaw_deg"].get<double>());
@@ -65,8 +83,8 @@ std::string keystoneText(json k) {
     json l = k["latency"];
     char text[128];
     std::snprintf(text, sizeof text, "median %.1f ms, 95%% %.1f ms, max %.1f ms (%llu frames)",
-                  l.value("median_ms", 0.0), l.value("p95_ms", 0.0), l.value("max_ms", 0.0),
-                  static_cast<unsigned long long>(l.value("frames", 0ULL)));
+                  val(l, "median_ms", 0.0), val(l, "p95_ms", 0.0), val(l, "max_ms", 0.0),
+                  static_cast<unsigned long long>(val(l, "frames", 0ULL)));
     out += field("tilt to shown", text);
   }
   if (k.contains("homography") && k["homography"].is_array()) {
@@ -79,7 +97,7 @@ std::string keystoneText(json k) {
 
 std::string contentText(json c) {
   if (c.is_null()) return "none";
-  std::string s = c.value("path", "");
+  std::string s = val(c, "path", "");
   if (c.contains("stream")) {
     json st = c["stream"];
     for (const char* key : {"path", "uri", "v4l2", "pipeline"}) {
@@ -90,23 +108,23 @@ std::string contentText(json c) {
   if (c.contains("shared")) s = "shared memory";
   if (c.contains("object") && c.contains("display") && c["display"].is_object()) {
     json d = c["display"];
-    json cov = d.value("coverage", json::object());
+    json cov = val(d, "coverage", json::object());
     char line[200];
     std::snprintf(line, sizeof line,
                   ", painted on the object: white %.4g (%s), lit %.4f m2, unlit %.4f m2",
-                  d.value("white", 0.0), d.value("units", "").c_str(), cov.value("lit_m2", 0.0),
-                  cov.value("unlit_m2", 0.0));
+                  val(d, "white", 0.0), val(d, "units", "").c_str(), val(cov, "lit_m2", 0.0),
+                  val(cov, "unlit_m2", 0.0));
     s += line;
   }
   if (c.contains("size")) s += " (" + scalar(c["size"][0]) + "x" + scalar(c["size"][1]) + ")";
   if (c.contains("frames")) {
-    s += ", " + scalar(c["frames"]) + " frames" + (c.value("ended", false) ? ", ended" : "");
+    s += ", " + scalar(c["frames"]) + " frames" + (val(c, "ended", false) ? ", ended" : "");
   }
   return s;
 }
 
 std::string calibrateText(json r) {
-  if (r.value("state", "") == "started") {
+  if (val(r, "state", "") == "started") {
     return "calibration " + scalar(r["operation"]) + ": " + scalar(r["frames"]) +
            " pattern frames on " + scalar(r["output"]) + ", cameras " + pairList(r["cameras"]) +
            " (" + scalar(r["mode"]) + ")\n";
@@ -130,21 +148,21 @@ std::string calibrateText(json r) {
 }
 
 std::string latencyText(json r) {
-  if (r.value("state", "") == "started") {
+  if (val(r, "state", "") == "started") {
     return "latency " + scalar(r["operation"]) + ": output " + scalar(r["output"]) + ", cameras " +
            pairList(r["cameras"]) + ", " + scalar(r["repeats"]) + " repeats\n";
   }
   char line[200];
   std::snprintf(line, sizeof line, "%.1f ms -> settle %s frames at %.1f Hz (margin %s)",
-                r.value("latency_s", 0.0) * 1e3, scalar(r["settle_frames"]).c_str(),
-                r.value("refresh_hz", 0.0), scalar(r["margin_frames"]).c_str());
+                val(r, "latency_s", 0.0) * 1e3, scalar(r["settle_frames"]).c_str(),
+                val(r, "refresh_hz", 0.0), scalar(r["margin_frames"]).c_str());
   std::string out = field("output", scalar(r["output"])) + field("latency", line);
   for (json c : r["cameras"]) {
     json l = c["latency_s"];
     const size_t samples = c["samples"].is_array() ? c["samples"].size() : 0;
     std::snprintf(line, sizeof line, "median %.1f ms, spread %.1f ms, %zu samples, contrast %.1f",
-                  l.value("median", 0.0) * 1e3, l.value("spread", 0.0) * 1e3, samples,
-                  c.value("contrast", 0.0));
+                  val(l, "median", 0.0) * 1e3, val(l, "spread", 0.0) * 1e3, samples,
+                  val(c, "contrast", 0.0));
     out += field(("camera " + scalar(c["name"])).c_str(), line);
   }
   return out;
@@ -163,7 +181,7 @@ std::string snapshotText(json r) {
     out += field("exposure", unknown);
   }
   if (r.contains("gain") && r["gain"].is_number()) {
-    const bool db = r.value("gain_unit", "") == "dB";
+    const bool db = val(r, "gain_unit", "") == "dB";
     std::snprintf(line, sizeof line, db ? "%.2f dB" : "%.6g (device units)",
                   r["gain"].get<double>());
     out += field("gain", line);
@@ -171,8 +189,8 @@ std::string snapshotText(json r) {
     out += field("gain", unknown);
   }
   std::snprintf(line, sizeof line, "%.2f %% saturated, %.2f %% under-exposed, mean %.1f %%",
-                r.value("saturated_pct", 0.0), r.value("underexposed_pct", 0.0),
-                r.value("mean_pct", 0.0));
+                val(r, "saturated_pct", 0.0), val(r, "underexposed_pct", 0.0),
+                val(r, "mean_pct", 0.0));
   out += field("levels", line);
   if (r.contains("path")) out += field("written", scalar(r["path"]));
   return out;
@@ -180,7 +198,7 @@ std::string snapshotText(json r) {
 
 std::string calibrateCameraText(json r) {
   if (r.contains("finishing")) return "finishing " + pairList(r["finishing"]) + "\n";
-  if (r.value("state", "") == "started") {
+  if (val(r, "state", "") == "started") {
     return "camera calibration " + scalar(r["operation"]) + ": camera " + scalar(r["camera"]) +
            ", board " + scalar(r["board"]) + "; move the board before the camera\n";
   }
@@ -194,14 +212,14 @@ std::string calibrateCameraText(json r) {
     out += field("intrinsics", line);
   }
   std::snprintf(line, sizeof line, "%.3f px RMS over %s views (%s frames, %s rejected)",
-                r.value("reprojection_rms_px", 0.0), scalar(r["views"]).c_str(),
+                val(r, "reprojection_rms_px", 0.0), scalar(r["views"]).c_str(),
                 scalar(r["frames"]).c_str(), scalar(r["rejected"]).c_str());
   out += field("reprojection", line);
-  std::snprintf(line, sizeof line, "%.0f %% of the image", 100.0 * r.value("coverage", 0.0));
+  std::snprintf(line, sizeof line, "%.0f %% of the image", 100.0 * val(r, "coverage", 0.0));
   out += field("coverage", line);
   out += field("stopped", scalar(r["stopped"]));
-  out += field("pose", c.value("pose_known", false) ? "kept from the rig model"
-                                                    : "unknown (calibrate the pair for it)");
+  out += field("pose", val(c, "pose_known", false) ? "kept from the rig model"
+                                                   : "unknown (calibrate the pair for it)");
   out += field("written", scalar(r["path"]));
   return out;
 }
@@ -212,7 +230,7 @@ std::string trackerText(json r) {
     char line[160];
     std::snprintf(line, sizeof line, "%s registered from %s points (%s), rms %.3f mm\n",
                   scalar(r["tracker"]).c_str(), scalar(g["points"]).c_str(),
-                  scalar(g["source"]).c_str(), g.value("rms_m", 0.0) * 1e3);
+                  scalar(g["source"]).c_str(), val(g, "rms_m", 0.0) * 1e3);
     return line + field("written", scalar(r["path"]));
   }
   std::string out;
@@ -221,14 +239,14 @@ std::string trackerText(json r) {
     char line[256];
     std::snprintf(line, sizeof line, "%-16s %-6s %s m, %.1f Hz, %s samples",
                   scalar(t["name"]).c_str(), scalar(t["state"]).c_str(),
-                  pairList(t["position"]).c_str(), t.value("rate_hz", 0.0),
+                  pairList(t["position"]).c_str(), val(t, "rate_hz", 0.0),
                   scalar(t["samples"]).c_str());
     out += line;
     json g = t["registration"];
     if (g.is_object()) {
       std::snprintf(line, sizeof line, ", registered (%s, %s points, rms %.3f mm)",
                     scalar(g["source"]).c_str(), scalar(g["points"]).c_str(),
-                    g.value("rms_m", 0.0) * 1e3);
+                    val(g, "rms_m", 0.0) * 1e3);
       out += line;
     } else {
       out += ", not registered";
@@ -257,7 +275,7 @@ static std::string driftText(json status) {
     out += field("recalibrate", scalar(status["drift"]["policy"]));
   }
   if (!status.contains("outputs") || !status["outputs"].is_object()) return out;
-  for (json o : status["outputs"].value("shown", json::array())) {
+  for (json o : val(status["outputs"], "shown", json::array())) {
     if (!o.is_object() || !o.contains("drift") || !o["drift"].is_object()) continue;
     json d = o["drift"];
     std::string text;
@@ -266,13 +284,13 @@ static std::string driftText(json status) {
     } else {
       char line[256];
       std::snprintf(line, sizeof line, "%s, %.3f px (camera %s, %s tiles), %s correction(s)",
-                    scalar(d.value("state", json())).c_str(), d.value("misregistration_px", 0.0),
-                    scalar(d.value("camera", json())).c_str(),
+                    scalar(val(d, "state", json())).c_str(), val(d, "misregistration_px", 0.0),
+                    scalar(val(d, "camera", json())).c_str(),
                     d.contains("tiles") ? scalar(d["tiles"]["used"]).c_str() : "no",
-                    scalar(d.value("corrections", json(0))).c_str());
+                    scalar(val(d, "corrections", json(0))).c_str());
       text = line;
     }
-    out += field(("drift " + scalar(o.value("name", json()))).c_str(), text);
+    out += field(("drift " + scalar(val(o, "name", json()))).c_str(), text);
   }
   return out;
 }
@@ -282,19 +300,17 @@ namespace {
 // The reply as text. Takes it by value: a key a reply lacks (a procamd of another
 // version) reads as null through the non-const operator[], never past a map's end.
 std::string replyText(json r) {
-  const std::string cls = r.value("class", "");
-  if (cls == "ERROR")
-    return "error (" + r.value("code", "") + "): " + r.value("message", "") + "\n";
+  const std::string cls = val(r, "class", "");
+  if (cls == "ERROR") return "error (" + val(r, "code", "") + "): " + val(r, "message", "") + "\n";
   if (cls == "VERSION") {
-    return "procamd " + r.value("release", "") + ", protocol " + scalar(r["proto_major"]) + "." +
-           scalar(r["proto_minor"]) + ", plugin ABI " + scalar(r.value("plugin_abi", json())) +
-           "\n";
+    return "procamd " + val(r, "release", "") + ", protocol " + scalar(r["proto_major"]) + "." +
+           scalar(r["proto_minor"]) + ", plugin ABI " + scalar(val(r, "plugin_abi", json())) + "\n";
   }
   if (cls == "STATUS") {
-    std::string out = field("release", r.value("release", ""));
+    std::string out = field("release", val(r, "release", ""));
     out += field("pid", scalar(r["pid"]));
     char up[32];
-    std::snprintf(up, sizeof up, "%.0f s", r.value("uptime_s", 0.0));
+    std::snprintf(up, sizeof up, "%.0f s", val(r, "uptime_s", 0.0));
     out += field("uptime", up);
     out += field("virtual rig", scalar(r["sim"]));
     out += field("config", scalar(r["config"]));
@@ -334,7 +350,7 @@ std::string replyText(json r) {
       for (const char* count : {"frames", "samples"}) {
         if (!d.contains(count)) continue;
         std::snprintf(line, sizeof line, ", %s %s at %.1f Hz", scalar(d[count]).c_str(), count,
-                      d.value("rate_hz", 0.0));
+                      val(d, "rate_hz", 0.0));
         out += line;
       }
       out += "\n";
@@ -345,36 +361,35 @@ std::string replyText(json r) {
   if (cls == "KEYSTONE") return keystoneText(r);
   if (cls == "PATTERN") {
     return "pattern " + scalar(r["pattern"]) +
-           (r.value("shown", false) ? " (shown)" : " (no output showed it)") + "\n";
+           (val(r, "shown", false) ? " (shown)" : " (no output showed it)") + "\n";
   }
   if (cls == "CONTENT") return "content: " + contentText(r["content"]) + "\n";
   if (cls == "OBJECT") {
-    json o = r.value("object", json());
+    json o = val(r, "object", json());
     if (!o.is_object()) return "object: none\n";
-    json placed = o.value("placed", json::object());
-    std::string out = field("object", o.value("mesh", std::string()) + " (" +
-                                          placed.value("method", std::string()) + ")");
-    out += field("position", pairList(o.value("t", json::array())) + " m");
+    json placed = val(o, "placed", json::object());
+    std::string out = field("object", val(o, "mesh", std::string()) + " (" +
+                                          val(placed, "method", std::string()) + ")");
+    out += field("position", pairList(val(o, "t", json::array())) + " m");
     if (o.contains("fit_rms_m") && o["fit_rms_m"].is_number()) {
       char line[64];
       std::snprintf(line, sizeof line, "%.2f mm RMS", 1000 * o["fit_rms_m"].get<double>());
       out += field("fit", line);
     }
-    json g = r.value("refined", json());
+    json g = val(r, "refined", json());
     if (g.is_object()) {
       char line[160];
       std::snprintf(line, sizeof line,
                     "from %ld of %ld measured points: moved %.2f mm, turned %.3f deg, %.2f mm RMS",
-                    g.value("points", 0L), g.value("candidates", 0L),
-                    1000 * g.value("moved_m", 0.0), g.value("turned_deg", 0.0),
-                    1000 * g.value("rms_m", 0.0));
+                    val(g, "points", 0L), val(g, "candidates", 0L), 1000 * val(g, "moved_m", 0.0),
+                    val(g, "turned_deg", 0.0), 1000 * val(g, "rms_m", 0.0));
       out += field("refined", line);
-      for (json f : g.value("free", json::array())) {
-        out += field("not fixed", f.value("kind", std::string()) + " along " +
-                                      pairList(f.value("axis", json::array())) + " (as placed)");
+      for (json f : val(g, "free", json::array())) {
+        out += field("not fixed", val(f, "kind", std::string()) + " along " +
+                                      pairList(val(f, "axis", json::array())) + " (as placed)");
       }
     }
-    out += field("painted", o.value("painted", false) ? "yes" : "no");
+    out += field("painted", val(o, "painted", false) ? "yes" : "no");
     return out;
   }
   if (cls == "SAVE") return "saved " + scalar(r["path"]) + " (" + scalar(r["bytes"]) + " bytes)\n";
@@ -387,8 +402,8 @@ std::string replyText(json r) {
   if (cls == "CALIBRATE-CAMERA") return calibrateCameraText(r);
   if (cls == "CANCEL") return "cancelled " + pairList(r["cancelled"]) + "\n";
   if (cls == "WATCH") {
-    return r.value("enabled", false) ? "watching: " + pairList(r["events"]) + "\n"
-                                     : "not watching\n";
+    return val(r, "enabled", false) ? "watching: " + pairList(r["events"]) + "\n"
+                                    : "not watching\n";
   }
   return r.dump() + "\n";
 }
@@ -405,7 +420,8 @@ std::string formatReply(const json& reply) {
 }
 
 std::string formatEvent(const json& e) {
-  std::string out = e.value("event", "event");
+  if (!e.is_object()) return e.dump() + "\n";
+  std::string out = val(e, "event", "event");
   for (const auto& [k, v] : e.items()) {
     if (k == "class" || k == "id" || k == "event") continue;
     out += " " + k + "=" + (v.is_array() ? pairList(v) : v.is_object() ? v.dump() : scalar(v));

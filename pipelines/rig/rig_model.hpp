@@ -87,8 +87,10 @@ struct RigObject {
   std::string mesh;
   Mat3 R = Mat3::Identity();
   Vec3 t = Vec3::Zero();
-  double fit_rms_m = -1;  // of the placement's points; < 0 when unknown
-  long points = 0;        // the points it was placed from
+  // Of the placement's points (picked, or the measured surface's after `object refine`);
+  // < 0 when unknown.
+  double fit_rms_m = -1;
+  long points = 0;  // the points it was placed (or last refined) from
   Provenance placed;
 };
 

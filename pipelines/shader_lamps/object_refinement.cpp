@@ -160,11 +160,15 @@ Result<ObjectRefinement> refinePlacement(std::span<const geom::TriangleMesh> mea
     const Eigen::Matrix<double, 6, 1> x = eig.eigenvectors() * step;
     out.free.clear();
     for (const auto& f : free) {
-      // In the world: a turn (about the centroid) or a slide, whichever the direction is
-      // mostly.
+      // In the world: a turn or a slide, whichever the direction is mostly.
       FreeDirection d;
       d.turn = f.head<3>().norm() > f.tail<3>().norm();
-      d.axis = (R * (d.turn ? f.head<3>() : f.tail<3>())).normalized();
+      const Vec3 fw = f.head<3>() / s, ftau = f.tail<3>();
+      d.axis = (R * (d.turn ? fw : ftau)).normalized();
+      // m -> fw x (m - c) + ftau turns about the axis through c + (fw x ftau) / |fw|^2
+      // (the part of ftau along fw slides along it).
+      const Vec3 pivot = d.turn ? Vec3(c + fw.cross(ftau) / fw.squaredNorm()) : c;
+      d.through = R * pivot + t;
       out.free.push_back(d);
     }
     const Vec3 w = x.head<3>() / s, tau = x.tail<3>();

@@ -27,10 +27,11 @@ struct RefineOptions {
 };
 
 // A direction the measured points do not fix (in the world): a turn about `axis` through
-// their centroid, or a slide along it.
+// the point `through`, or a slide along `axis` (`through`: the measured points' centroid).
 struct FreeDirection {
   bool turn = false;
   Vec3 axis = Vec3::UnitX();
+  Vec3 through = Vec3::Zero();
 };
 
 struct ObjectRefinement {

@@ -161,6 +161,7 @@ Result<void> GlLampShader::setView(const lamps::LampFrameInput& lamp) {
     size_ = v.size;
   }
   photometry_ = lamp.photometry;
+  shaded_ = false;
   if (auto ok = glStatus("uploading a projector's view"); !ok) {
     has_view_ = false;
     return ok;
@@ -196,6 +197,8 @@ Result<void> GlLampShader::shade(double white, const std::optional<Vec3>& eye) {
   glViewport(0, 0, size_.width, size_.height);
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_BLEND);
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_SCISSOR_TEST);
   glUseProgram(program_.get());
   const Texture* units[] = {&point_, &normal_, &shade_, &texture_};
   const GLint samplers[] = {u_.point, u_.normal, u_.shade, u_.texture};
@@ -222,11 +225,14 @@ Result<void> GlLampShader::shade(double white, const std::optional<Vec3>& eye) {
   glBindVertexArray(0);
   glActiveTexture(GL_TEXTURE0);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  return glStatus("shading a shader-lamp frame");
+  if (auto ok = glStatus("shading a shader-lamp frame"); !ok) return ok;
+  shaded_ = true;
+  return {};
 }
 
 Result<void> GlLampShader::readFrame(cv::Mat& bgr) {
-  if (!has_view_) return fail(ErrorCode::kInvalidInput, "no frame has been shaded");
+  if (!has_view_ || !shaded_)
+    return fail(ErrorCode::kInvalidInput, "no frame has been shaded for this view");
   cv::Mat rgba(size_, CV_8UC4);
   glBindFramebuffer(GL_FRAMEBUFFER, fbo_.get());
   glPixelStorei(GL_PACK_ALIGNMENT, 4);

@@ -9,7 +9,10 @@
 // into 8-bit code values — the same inputs and formula as lamps::lampFrame, evaluated in
 // 32-bit floats instead of doubles (the frames agree to one code value, a rounding of a
 // value that lands within 1e-4 of a half code).
-// Needs a current GLES 3 context on the calling thread for its whole life.
+// Needs a current GLES 3 context on the calling thread for its whole life. shade() and
+// readFrame() leave GL_FRAMEBUFFER bound to 0 and texture unit 0 active; they change the
+// viewport, the program, the textures bound to units 0-3 and the vertex array binding
+// (0 after), and turn off depth test, blending, culling and the scissor test.
 #include <memory>
 #include <optional>
 
@@ -22,7 +25,7 @@ namespace procam::output::gl {
 
 class GlLampShader {
  public:
-  // kIo when the program does not build or the context lacks 32-bit float textures.
+  // kIo when the program does not build.
   static Result<std::unique_ptr<GlLampShader>> create();
   ~GlLampShader();
   GlLampShader(const GlLampShader&) = delete;
@@ -39,7 +42,8 @@ class GlLampShader {
   // part) into the shader's framebuffer. kInvalidInput before setView/setMaterial, or for
   // a white level that is not finite and positive or an eye that is not finite.
   Result<void> shade(double white, const std::optional<Vec3>& eye);
-  // The last shaded frame read back, BGR CV_8UC3, image row 0 first.
+  // The last shaded frame read back, BGR CV_8UC3, image row 0 first. kInvalidInput when
+  // no frame was shaded since the view was set.
   Result<void> readFrame(cv::Mat& bgr);
   // The frame's RGBA8 texture (image row 0 at texture row 0), for an output to show.
   GLuint frameTexture() const { return frame_.get(); }
@@ -59,7 +63,7 @@ class GlLampShader {
   Texture point_, normal_, shade_, texture_, frame_;
   Framebuffer fbo_;
   cv::Size size_;
-  bool has_view_ = false, has_material_ = false;
+  bool has_view_ = false, has_material_ = false, shaded_ = false;
   lamps::LampPhotometry photometry_;
   lamps::Material material_;  // without its texture (uploaded)
   bool has_texture_ = false;

@@ -15,15 +15,22 @@ const char* const kClasses[] = {"VERSION", "STATUS",    "DEVICES", "KEYSTONE", "
                                 "TRACKER", "CALIBRATE", "LATENCY", "SNAPSHOT", "CALIBRATE-CAMERA",
                                 "CANCEL",  "WATCH",     "ERROR"};
 
+// Text, not the reply's JSON handed back: every line the formatter could write was written
+// with its keys absent.
 TEST(CtlFormat, RepliesMissingTheirKeysStillRead) {
   for (const char* cls : kClasses) {
-    const std::string text = formatReply(json{{"class", cls}});
-    EXPECT_FALSE(text.empty()) << cls;
+    const json r = {{"class", cls}};
+    std::string text;
+    ASSERT_NO_THROW(text = formatReply(r)) << cls;
     EXPECT_EQ(text.back(), '\n') << cls;
+    EXPECT_NE(text, r.dump() + "\n") << cls << " fell back to the raw reply";
   }
+  const std::string status = formatReply({{"class", "STATUS"}});
+  EXPECT_NE(status.find("pid:"), std::string::npos) << status;
+  EXPECT_NE(status.find("auto keystone: off"), std::string::npos) << status;
 }
 
-TEST(CtlFormat, ValuesOfAnotherTypeGiveTheReplyAsItCame) {
+TEST(CtlFormat, ValuesOfAnotherTypeReadAsAbsent) {
   for (const char* cls : kClasses) {
     // Every key a formatter might read, each the wrong type.
     json r = {{"class", cls}};
@@ -32,15 +39,17 @@ TEST(CtlFormat, ValuesOfAnotherTypeGiveTheReplyAsItCame) {
           "capabilities", "warnings",    "outputs",     "auto",    "corners",   "pattern",
           "shown",        "content",     "object",      "refined", "path",      "bytes",
           "level",        "trackers",    "cameras",     "camera",  "cancelled", "events",
-          "enabled",      "proto_major", "proto_minor", "code",    "message",   "keystone",
-          "drift"}) {
+          "enabled",      "proto_major", "proto_minor", "message", "keystone",  "drift"}) {
       r[key] = json::array({json::object({{"x", 1}}), 2});
     }
-    const std::string text = formatReply(r);
+    std::string text;
+    ASSERT_NO_THROW(text = formatReply(r)) << cls;
     EXPECT_FALSE(text.empty()) << cls;
   }
-  // A reply that is not an object at all.
+  // A reply or event that is not an object at all: as it came.
   EXPECT_EQ(formatReply(json::array({1, 2})), "[1,2]\n");
+  EXPECT_EQ(formatEvent(json::array({1, 2})), "[1,2]\n");
+  EXPECT_EQ(formatEvent({{"event", 3}, {"a", 1}}), "event a=1\n");
 }
 
 TEST(CtlFormat, AnObjectRefinementIsShown) {

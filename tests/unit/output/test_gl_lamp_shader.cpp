@@ -45,7 +45,7 @@ const Scene& scene() {
     s.weights = *lamps::lampWeights(set);
     for (std::size_t i = 0; i < s.models.size(); ++i)
       s.inputs.push_back({&s.views[i], &s.weights.weight[i], {2.0 + 0.4 * i, Vec3(310, 295, 270)}});
-    s.look.texture = cv::Mat(256, 256, CV_32FC3);
+    s.look.texture = cv::Mat(128, 256, CV_32FC3);  // not square: rows and columns told apart
     cv::RNG rng(7);
     rng.fill(s.look.texture, cv::RNG::UNIFORM, cv::Scalar::all(0.05), cv::Scalar::all(1.0));
     cv::GaussianBlur(s.look.texture, s.look.texture, cv::Size(0, 0), 2);
@@ -103,8 +103,7 @@ TEST_F(ShaderLampGles, FramesMatchTheCpuReferenceForEveryProjectorAndEye) {
   for (std::size_t i = 0; i < s.inputs.size(); ++i) {
     ASSERT_TRUE((*shader)->setView(s.inputs[i]));
     for (const auto& eye : eyes) {
-      lamps::LampFrameStats stats;
-      const cv::Mat cpu = *lamps::lampFrame(s.inputs[i], s.look, s.white, eye, &stats);
+      const cv::Mat cpu = *lamps::lampFrame(s.inputs[i], s.look, s.white, eye);
       ASSERT_TRUE((*shader)->shade(s.white, eye));
       cv::Mat gpu;
       ASSERT_TRUE((*shader)->readFrame(gpu));
@@ -114,7 +113,6 @@ TEST_F(ShaderLampGles, FramesMatchTheCpuReferenceForEveryProjectorAndEye) {
       std::printf("projector %zu, %s: largest difference %.0f, %ld of %ld lit pixels differ\n", i,
                   eye ? "eye" : "no eye", a.largest, a.differing, a.lit);
       // The object covers a good part of each frame: the comparison is not of black.
-      EXPECT_EQ(a.lit, stats.lit_pixels);
       EXPECT_GT(a.lit, 10000);
       EXPECT_LE(a.largest, 1.0);
       EXPECT_LE(a.differing, a.lit / 200);
@@ -150,6 +148,8 @@ TEST_F(ShaderLampGles, BadInputIsRefused) {
   auto shader = GlLampShader::create();
   ASSERT_TRUE(shader);
   EXPECT_EQ((*shader)->shade(1, std::nullopt).error().code, ErrorCode::kInvalidInput);
+  cv::Mat frame;
+  EXPECT_EQ((*shader)->readFrame(frame).error().code, ErrorCode::kInvalidInput);
   lamps::LampFrameInput no_weight{&s.views[0], nullptr, {}};
   EXPECT_EQ((*shader)->setView(no_weight).error().code, ErrorCode::kInvalidInput);
   lamps::LampFrameInput bad_gamma = s.inputs[0];

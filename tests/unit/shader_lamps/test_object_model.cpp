@@ -235,7 +235,9 @@ TEST(ShaderLampRefinement, MeasuredSurfaceFixesAPickedPlacement) {
   EXPECT_LT(shift, 0.0001);
   EXPECT_NEAR(refined->placement.rms_m, 0.0005, 0.0001);
   EXPECT_GT(refined->points, 800);
-  EXPECT_LT(refined->points, static_cast<long>(seen.mesh.vertices.size()) + 1);  // none around it
+  // None of the table's or the wall's: the same pull without them.
+  const geom::TriangleMesh box_only[] = {seen.mesh};
+  EXPECT_EQ(refinePlacement(box_only, model.mesh, start)->points, refined->points);
   EXPECT_NEAR(refined->turned_deg, 1.0, 0.05);
 
   EXPECT_TRUE(refined->free.empty());
@@ -276,6 +278,47 @@ TEST(ShaderLampRefinement, MeasuredSurfaceFixesAPickedPlacement) {
   broken.faces.emplace_back(0, 1, 100000);
   const geom::TriangleMesh bad[] = {broken};
   EXPECT_EQ(refinePlacement(bad, model.mesh, start).error().code, ErrorCode::kInvalidInput);
+}
+
+// A cylinder seen from one side: its turn about its own axis and its slide along it are
+// free, and the turn is reported about that axis (not about the seen points' centroid).
+TEST(ShaderLampRefinement, ACylinderTurnsFreelyAboutItsOwnAxis) {
+  const Vec3 base(0.2, 1.5, 0.7);
+  const double radius = 0.1, height = 0.3;
+  // Side `from`..`to` radians of a cylinder about +Z through `base`, `n` segments.
+  const auto cylinder = [&](double from, double to, int n, int stacks) {
+    geom::TriangleMesh m;
+    for (int j = 0; j <= stacks; ++j)
+      for (int i = 0; i <= n; ++i) {
+        const double a = from + (to - from) * i / n;
+        m.vertices.push_back(base +
+                             Vec3(radius * std::cos(a), radius * std::sin(a), height * j / stacks));
+      }
+    for (int j = 0; j < stacks; ++j)
+      for (int i = 0; i < n; ++i) {
+        const int v = j * (n + 1) + i;
+        m.faces.emplace_back(v, v + 1, v + n + 2);
+        m.faces.emplace_back(v, v + n + 2, v + n + 1);
+      }
+    return m;
+  };
+  const geom::TriangleMesh model = cylinder(0, 2 * std::numbers::pi, 360, 6);
+  // Its front (facing -Y) measured on another grid.
+  const geom::TriangleMesh measured[] = {
+      cylinder(-0.85 * std::numbers::pi, -0.15 * std::numbers::pi, 90, 12)};
+  ObjectPlacement start;
+  start.t = Vec3(0, -0.003, 0);  // 3 mm nearer the projector
+  auto refined = refinePlacement(measured, model, start);
+  ASSERT_TRUE(refined) << refined.error().message;
+  EXPECT_LT(refined->placement.t.norm(), 2e-4);  // the distance found
+  ASSERT_EQ(refined->free.size(), 2u);
+  for (const FreeDirection& f : refined->free) {
+    EXPECT_GT(std::abs(f.axis.z()), 0.999);
+    if (!f.turn) continue;
+    const Vec3 off = f.through - base;
+    EXPECT_LT(Vec2(off.x(), off.y()).norm(), 0.002) << f.through.transpose();
+  }
+  EXPECT_NE(refined->free[0].turn, refined->free[1].turn);
 }
 
 }  // namespace
