@@ -23,6 +23,7 @@
 
 #include "core/units.hpp"
 #include "daemon_harness.hpp"
+#include "object_box_daemon.hpp"
 #include "object_meshes.hpp"
 #include "rig/rig_model.hpp"
 #include "shader_lamps/appearance.hpp"
@@ -32,170 +33,12 @@
 #include "sim/scene_library.hpp"
 #include "sim/truth_rig.hpp"
 #include "true_brightness.hpp"
-#include "truth_rig_file.hpp"
 #include "wave_texture.hpp"
 
 namespace procam::itest {
 namespace {
 
 using namespace std::chrono_literals;
-
-const Vec3 kBoxCentre(0.1, 1.5, 0.875), kBoxSize(0.3, 0.2, 0.25);
-constexpr double kCutoffDeg = 60;
-// Snapshots averaged: the painted box is near 25 DN in this camera (its exposure is the
-// scene's), 1 DN of read noise and shot noise to about 0.3 DN.
-constexpr int kShots = 16;
-
-double luma(const Vec3& rgb) {
-  return 0.2126 * rgb.x() + 0.7152 * rgb.y() + 0.0722 * rgb.z();
-}
-
-// world = kModelR · model + kBoxCentre: the model's own frame, as a modelling tool left it.
-Mat3 modelRotation() {
-  return (Eigen::AngleAxisd(degToRad(25.0), Vec3::UnitZ()) *
-          Eigen::AngleAxisd(degToRad(10.0), Vec3::UnitX()))
-      .toRotationMatrix();
-}
-
-// The mean of `n` snapshots of `camera`, linear camera units (BGR, float).
-cv::Mat meanSnapshot(Connection& c, const std::string& camera, int n) {
-  cv::Mat sum;
-  for (int i = 0; i < n; ++i) {
-    auto shot = c.call({{"cmd", "snapshot"}, {"camera", camera}}, 60s * kSlowdown);
-    if (!shot || (*shot)["class"] != "SNAPSHOT") {
-      ADD_FAILURE() << (shot ? shot->dump() : "no reply");
-      return {};
-    }
-    cv::Mat img = cv::imread((*shot)["path"].get<std::string>(), cv::IMREAD_UNCHANGED), f;
-    img.convertTo(f, CV_32FC3);
-    if (sum.empty())
-      sum = f;
-    else
-      sum += f;
-  }
-  return sum / n;
-}
-
-struct Seen {
-  double mean_rel = 1;  // mean |ratio / median - 1| where a projector faces the box < 60°
-  long judged = 0;
-  double median_dn = 0;  // the seen luminance's median over the judged pixels
-  double spill_px = 0;   // farthest brightened camera pixel off the box from its outline
-  long spilled = 0;      // brightened pixels off the box farther than 2 camera pixels
-};
-
-// What the camera sees of the painted box (lit minus dark), against albedo · texture.
-Seen judge(const sim::Scene& scene, const sim::SceneState& state, const cv::Mat& lit,
-           const cv::Mat& dark, const cv::Mat& texture) {
-  Seen out;
-  const geom::CameraModel* cam = nullptr;
-  for (const auto& c : state.cameras)
-    if (c.spec.name == "cam_colour") cam = &c.model;
-  auto renderer = sim::Renderer::create(scene, state, {});
-  if (!cam || !renderer || lit.empty() || dark.empty()) {
-    ADD_FAILURE() << "no camera, renderer or snapshot";
-    return out;
-  }
-  const ObjectMesh box = boxMesh(kBoxCentre, kBoxSize, 0.01);
-  auto model = lamps::ObjectModel::build(box.mesh, box.uv);
-  EXPECT_TRUE(model);
-  Vec3 albedo = Vec3::Ones();
-  int box_id = -1;
-  for (std::size_t s = 0; s < scene.world().surfaces().size(); ++s) {
-    if (scene.world().surfaces()[s].name != "box") continue;
-    box_id = static_cast<int>(s);
-    const auto& a = scene.world().surfaces()[s].albedo_rgb;
-    albedo = Vec3(a[0], a[1], a[2]);
-  }
-  const int W = cam->width, H = cam->height;
-  cv::Mat group(H, W, CV_32SC1, cv::Scalar(-1)), on_box(H, W, CV_8UC1, cv::Scalar(0));
-  cv::Mat ratio(H, W, CV_64FC1, cv::Scalar(0));
-  const cv::Mat seen = lit - dark;
-  for (int y = 0; y < H; ++y) {
-    for (int x = 0; x < W; ++x) {
-      const sim::PixelTruth t = renderer->truthAt(*cam, Vec2(x, y));
-      if (!t.hit || t.surface != box_id) continue;
-      on_box.at<std::uint8_t>(y, x) = 255;
-      bool facing = false;
-      for (const auto& p : t.projectors)
-        facing |= p.lit && p.cos_incidence >= std::cos(degToRad(kCutoffDeg));
-      const auto ray = cam->backproject(Vec2(x, y));
-      const auto s = ray ? model->intersect(*ray) : std::nullopt;
-      if (!facing || !s) continue;
-      group.at<int>(y, x) = boxSideOf(t.normal);
-      const Vec3 want = albedo.cwiseProduct(lamps::textureAt(texture, s->texcoord));
-      const cv::Vec3f bgr = seen.at<cv::Vec3f>(y, x);
-      ratio.at<double>(y, x) = luma(Vec3(bgr[2], bgr[1], bgr[0])) / luma(want);
-    }
-  }
-  // Judged two pixels in from any face edge, crease or cut-off (a pixel's light and the
-  // camera's supersampling spread over about one pixel).
-  std::vector<double> ratios;
-  std::vector<cv::Point> where;
-  for (int y = 2; y + 2 < H; ++y) {
-    for (int x = 2; x + 2 < W; ++x) {
-      const int g = group.at<int>(y, x);
-      if (g < 0) continue;
-      bool inner = true;
-      for (int dy = -2; dy <= 2 && inner; ++dy)
-        for (int dx = -2; dx <= 2; ++dx) inner &= group.at<int>(y + dy, x + dx) == g;
-      if (!inner) continue;
-      ratios.push_back(ratio.at<double>(y, x));
-      where.emplace_back(x, y);
-    }
-  }
-  out.judged = static_cast<long>(ratios.size());
-  if (ratios.empty()) return out;
-
-  std::vector<double> sorted = ratios;
-  std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2),
-                   sorted.end());
-  const double median = sorted[sorted.size() / 2];
-  double sum = 0;
-  for (double r : ratios) sum += std::abs(r / median - 1);
-  out.mean_rel = sum / static_cast<double>(ratios.size());
-  std::vector<double> dn;
-  for (const cv::Point& p : where) {
-    const cv::Vec3f bgr = seen.at<cv::Vec3f>(p);
-    dn.push_back(luma(Vec3(bgr[2], bgr[1], bgr[0])));
-  }
-  std::nth_element(dn.begin(), dn.begin() + static_cast<long>(dn.size() / 2), dn.end());
-  out.median_dn = dn[dn.size() / 2];
-  // Spill: light on the table, the wall or the floor, away from the box.
-  cv::Mat off_box, distance;
-  cv::bitwise_not(on_box, off_box);
-  cv::distanceTransform(off_box, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-  for (int y = 0; y < H; ++y) {
-    for (int x = 0; x < W; ++x) {
-      if (on_box.at<std::uint8_t>(y, x)) continue;
-      const cv::Vec3f bgr = seen.at<cv::Vec3f>(y, x);
-      // Well over the noise of the difference of two means of 16 captures (0.4 DN).
-      if (luma(Vec3(bgr[2], bgr[1], bgr[0])) < 5.0) continue;
-      const double d = distance.at<float>(y, x);
-      out.spill_px = std::max(out.spill_px, d);
-      out.spilled += d > 2;
-    }
-  }
-  return out;
-}
-
-// The eight corners of the box: in the model's frame and in the world, the world ones
-// off by `pick_m` per axis (normal, seeded).
-json cornerPoints(double pick_m) {
-  const Mat3 R = modelRotation();
-  json points = json::array();
-  std::mt19937 rng(7);
-  std::normal_distribution<double> pick(0, 1);
-  for (int k = 0; k < 8; ++k) {
-    const Vec3 corner =
-        kBoxCentre + 0.5 * Vec3((k & 1 ? 1 : -1) * kBoxSize.x(), (k & 2 ? 1 : -1) * kBoxSize.y(),
-                                (k & 4 ? 1 : -1) * kBoxSize.z());
-    const Vec3 m = R.transpose() * (corner - kBoxCentre);
-    const Vec3 w = corner + pick_m * Vec3(pick(rng), pick(rng), pick(rng));
-    points.push_back({{"model", {m.x(), m.y(), m.z()}}, {"world", {w.x(), w.y(), w.z()}}});
-  }
-  return points;
-}
 
 // object_box's TRUE rig with measured-like photometry as rig.json, the model and the
 // texture in the content root.
@@ -342,15 +185,7 @@ TEST(ShaderLamp, DaemonPaintsAModelPlacedFromPickedCorners) {
   cv::Mat texture_bgr = waveTextureSrgb();
   const cv::Mat texture = lamps::linearTexture(texture_bgr);
   const Seen seen = judge(*scene, state, lit, dark, texture);
-  std::printf(
-      "procamd object content: %ld camera pixels (median %.1f DN), mean relative luminance "
-      "error %.2f %% (up to the white level), brightened pixels off the box: farthest %.1f px from "
-      "its "
-      "outline, %ld beyond 2 px\n",
-      seen.judged, seen.median_dn, 100 * seen.mean_rel, seen.spill_px, seen.spilled);
-  EXPECT_GT(seen.judged, 20000);
-  EXPECT_LT(seen.mean_rel, 0.03);
-  EXPECT_EQ(seen.spilled, 0);
+  expectPaintedBox(seen, "procamd object content");
 
   // The image alone is the placed model's texture: the same frames.
   bad = c.call(
@@ -411,11 +246,7 @@ TEST(ShaderLamp, DaemonReportsWhatAnUnpluggedProjectorLeftUnlit) {
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
   ASSERT_TRUE(c.ok());
-  auto placed = c.call({{"cmd", "object"},
-                        {"action", "place"},
-                        {"model", "box_model.ply"},
-                        {"points", cornerPoints(0)}},
-                       30s);
+  auto placed = placeBox(c, 0);
   ASSERT_TRUE(placed) << d.log();
   ASSERT_EQ((*placed)["class"], "OBJECT") << placed->dump();
   auto loaded = c.call(
@@ -583,135 +414,6 @@ TEST(ShaderLamp, DaemonRefusesARigWhoseObjectModelIsMissing) {
   ASSERT_TRUE(status) << d.log();
   EXPECT_NE(*status, 0);
   EXPECT_NE(d.log().find("missing-model.ply"), std::string::npos) << d.log();
-}
-
-// Route (a): nothing handed over but the cameras' calibration. calibrate triangulates
-// both projectors and their meshes of the scene through the two cameras and measures
-// their responses and brightness; the box's model, placed from corners picked 4 mm off,
-// is refined against the measured surface (`object refine`), and the look painted on it
-// is judged through the colour camera as above.
-TEST(ShaderLamp, DaemonRefinesAPlacementOnTheSurfaceItMeasured) {
-  TempDir dir;
-  auto scene = sim::resolveScene("object_box");
-  ASSERT_TRUE(scene) << scene.error().message;
-  const sim::SceneState state = scene->at(0);
-  const ObjectMesh box = boxMesh(kBoxCentre, kBoxSize, 0.01);
-  writeContent(dir, "box_model.ply", texturedPly(box, modelRotation(), kBoxCentre));
-  ASSERT_TRUE(cv::imwrite(contentFile(dir, "look.png"), waveTextureSrgb()));
-  DaemonProcess d(dir, simWithTruth(dir, "object_box", TruthParts::kCamerasOnly));
-  ASSERT_TRUE(d.started()) << d.log();
-  Connection c(d.socketPath());
-  ASSERT_TRUE(c.ok());
-
-  // Nothing to refine yet: no object, then no measured surface.
-  auto bad = c.call({{"cmd", "object"}, {"action", "refine"}});
-  ASSERT_TRUE(bad);
-  EXPECT_EQ((*bad)["code"], "unavailable") << bad->dump();
-  auto placed = c.call({{"cmd", "object"},
-                        {"action", "place"},
-                        {"model", "box_model.ply"},
-                        {"points", cornerPoints(0.004)}},
-                       30s);
-  ASSERT_TRUE(placed) << d.log();
-  ASSERT_EQ((*placed)["class"], "OBJECT") << placed->dump();
-  bad = c.call({{"cmd", "object"}, {"action", "refine"}}, 30s);
-  ASSERT_TRUE(bad);
-  EXPECT_EQ((*bad)["code"], "unavailable") << bad->dump();
-  bad = c.call({{"cmd", "object"}, {"action", "refine"}, {"max_distance_m", 0.5}});
-  ASSERT_TRUE(bad);
-  EXPECT_EQ((*bad)["code"], "bad-argument") << bad->dump();
-
-  auto started = c.call({{"cmd", "calibrate"},
-                         {"id", 1},
-                         {"projectors", "all"},
-                         {"cameras", {"cam", "cam_colour"}},
-                         {"settle_frames", 0}});
-  ASSERT_TRUE(started);
-  ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
-  auto done = finalReply(c, 1, kSlowdown * 600s);
-  ASSERT_TRUE(done) << d.log();
-  ASSERT_EQ((*done)["class"], "CALIBRATE") << done->dump();
-  ASSERT_EQ((*done)["outputs"].size(), 2u) << done->dump();
-  for (const json& o : (*done)["outputs"]) EXPECT_EQ(o["surface_type"], "mesh") << o.dump();
-
-  // How far a placement is from the truth: the box's turn, and its centre's shift across
-  // the directions the measured surface fixes (`free` slides taken out).
-  const auto offTruth = [&](const json& object, const json& free) {
-    Mat3 R;
-    for (int i = 0; i < 9; ++i) R(i / 3, i % 3) = object["R"][i].get<double>();
-    Vec3 shift = Vec3(object["t"][0].get<double>(), object["t"][1].get<double>(),
-                      object["t"][2].get<double>()) -
-                 kBoxCentre;
-    for (const json& f : free) {
-      if (f["kind"] != "slide") continue;
-      const Vec3 a(f["axis"][0].get<double>(), f["axis"][1].get<double>(),
-                   f["axis"][2].get<double>());
-      shift -= shift.dot(a) * a;
-    }
-    return std::pair{radToDeg(Eigen::AngleAxisd(R * modelRotation().transpose()).angle()),
-                     1000 * shift.norm()};
-  };
-  int status = -1;
-  const json refined = ctlJson(d, {"object", "refine"}, status);
-  ASSERT_EQ(status, 0) << refined.dump();
-  ASSERT_EQ(refined["class"], "OBJECT") << refined.dump();
-  const json& r = refined["refined"];
-  const auto [picked_deg, picked_mm] = offTruth((*placed)["object"], r["free"]);
-  const auto [refined_deg, refined_mm] = offTruth(refined["object"], r["free"]);
-  std::printf(
-      "object refine: from %ld of %ld measured points, %.2f mm RMS, free: %s; the placement from "
-      "corners picked 4 mm off was %.3f deg and %.2f mm off the truth (across the fixed "
-      "directions), refined %.3f deg and %.2f mm\n",
-      r["points"].get<long>(), r["candidates"].get<long>(), 1000 * r["rms_m"].get<double>(),
-      r["free"].dump().c_str(), picked_deg, picked_mm, refined_deg, refined_mm);
-  EXPECT_GT(r["points"].get<long>(), 500);
-  EXPECT_LT(r["points"].get<long>(), r["candidates"].get<long>());  // not the table or the wall
-  // Both cameras see the box's front and top, neither its sides: the slide along their
-  // common edge (x) is the one direction they leave free.
-  ASSERT_EQ(r["free"].size(), 1u) << r.dump();
-  EXPECT_EQ(r["free"][0]["kind"], "slide");
-  EXPECT_GT(std::abs(r["free"][0]["axis"][0].get<double>()), 0.99) << r.dump();
-  // The measured surface to its triangulation noise (about a millimetre here), over
-  // hundreds of points a face: the pose to a tenth of a degree and half a millimetre.
-  EXPECT_LT(refined_deg, 0.1);
-  EXPECT_LT(refined_mm, 0.5);
-  EXPECT_LT(refined_deg, picked_deg);
-  EXPECT_LT(refined_mm, picked_mm);
-  EXPECT_NE(refined["object"]["placed"]["method"].get<std::string>().find("refined from"),
-            std::string::npos);
-
-  ASSERT_EQ((*c.call({{"cmd", "pattern"}, {"name", "off"}}))["pattern"], "off");
-  const cv::Mat dark = meanSnapshot(c, "cam_colour", kShots);
-  auto loaded =
-      c.call({{"cmd", "content"}, {"action", "load"}, {"path", "look.png"}}, 120s * kSlowdown);
-  ASSERT_TRUE(loaded);
-  ASSERT_EQ((*loaded)["class"], "CONTENT") << loaded->dump();
-  for (const auto& p : (*loaded)["content"]["projectors"]) {
-    EXPECT_EQ(p["gain_source"], "brightness map") << p.dump();
-    EXPECT_EQ(p["response"], "measured") << p.dump();
-  }
-  ASSERT_TRUE(eventually(
-      [&] {
-        auto s = c.call({{"cmd", "status"}});
-        if (!s || (*s)["outputs"]["shown"].size() != 2) return false;
-        for (const auto& o : (*s)["outputs"]["shown"])
-          if (o["path"] != "shader-lamps" || !(o["lit_fraction"].get<double>() > 0.02))
-            return false;
-        return true;
-      },
-      20s * kSlowdown))
-      << c.call({{"cmd", "status"}})->dump();
-  const cv::Mat lit = meanSnapshot(c, "cam_colour", kShots);
-  cv::Mat texture_bgr = waveTextureSrgb();
-  const Seen seen = judge(*scene, state, lit, dark, lamps::linearTexture(texture_bgr));
-  std::printf(
-      "painted from the calibrated rig: %ld camera pixels (median %.1f DN), mean relative "
-      "luminance error %.2f %%, brightened pixels off the box: farthest %.1f px from its outline, "
-      "%ld beyond 2 px\n",
-      seen.judged, seen.median_dn, 100 * seen.mean_rel, seen.spill_px, seen.spilled);
-  EXPECT_GT(seen.judged, 20000);
-  EXPECT_LT(seen.mean_rel, 0.03);
-  EXPECT_EQ(seen.spilled, 0);
 }
 
 }  // namespace
