@@ -295,8 +295,15 @@ class Daemon {
   // The wall as two cameras that see the output drift triangulate it, when it stands off
   // the rig's plane; nullopt when it does not or cannot be told.
   std::optional<drift::WallSeen> movedWall(const std::string& output, const std::string& camera);
+  // The wall as the output's projector and its one camera triangulate it, when the
+  // content's shift is a moved wall's (drift::wallFromOneCamera) standing off the rig's
+  // plane; nullopt otherwise.
+  std::optional<drift::WallSeen> movedWallOneCamera(const std::string& output,
+                                                    const std::string& camera);
+  // `seen_by`: what triangulated the wall ("two cameras", ...), for the log and event.
   void correctSurface(const std::string& output, const std::string& camera,
-                      const drift::Misregistration& m, const drift::WallSeen& wall);
+                      const drift::Misregistration& m, const drift::WallSeen& wall,
+                      const std::string& seen_by);
   // Merges a correction into rig.json; `event` (a drift event's body) goes out with
   // `state` when written, "failed" otherwise.
   void writeDriftCorrection(const std::string& output, rig::RigModel update, nlohmann::json event,

@@ -4,9 +4,11 @@
 // corrected with the cheapest step, from the content's own correspondences and with no
 // pattern shown: a camera that sees drift where another camera sees the output
 // registered has moved and gets its pose again (drift/camera_correction.hpp); drift that
-// two cameras see and triangulate off the rig's wall is the wall's, whose plane is
-// measured again (drift/wall_from_views.hpp); other drift that every camera sees is the
-// projector's, whose pose and plane collineation are fitted again
+// two cameras see and triangulate off the rig's wall, or that one camera sees along its
+// epipolar lines with the projector (the rays of both meet off the wall, and the content
+// fits no turned projector), is the wall's, whose plane is measured again
+// (drift/wall_from_views.hpp); other drift that every camera sees is the projector's,
+// whose pose and plane collineation are fitted again
 // (drift/projector_correction.hpp). Written to rig.json atomically; a failed step
 // keeps the last good rig. Loop thread only; the checks run on the compute worker between
 // the outputs' frames.
@@ -282,8 +284,9 @@ void Daemon::onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, Calibr
   if (o.unresolved || secondsSince(*v.above) < config_.drift.settle_s) return;
   // Whose drift: another camera's check captured after this one first saw it tells. One
   // that sees the output registered means this camera moved; drift in every camera is
-  // the projector's. With one camera the two cannot be told apart (on a plane both move
-  // the content by a collineation): the projector is assumed to have moved.
+  // the projector's. With one camera a moved camera and a moved projector cannot be told
+  // apart (on a plane both move the content by a collineation): the projector is assumed
+  // to have moved, unless the content moved as a moved wall moves it.
   bool other_registered = false, other_drifted = false;
   for (const std::string& name : o.cameras) {
     if (name == key.camera) continue;
@@ -324,8 +327,11 @@ void Daemon::onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, Calibr
     // Two cameras that see drift tell a moved wall from a moved projector: where both
     // found the same content, their rays meet on the wall as it stands now.
     if (auto wall = movedWall(key.output, key.camera)) {
-      return correctSurface(key.output, key.camera, m, *wall);
+      return correctSurface(key.output, key.camera, m, *wall, "two cameras");
     }
+  } else if (auto wall = movedWallOneCamera(key.output, key.camera)) {
+    return correctSurface(key.output, key.camera, m, *wall,
+                          "the projector and camera '" + key.camera + "'");
   }
   correctDrift(key.output, key.camera, m);
 }
@@ -375,8 +381,42 @@ std::optional<drift::WallSeen> Daemon::movedWall(const std::string& output,
   return std::nullopt;
 }
 
+std::optional<drift::WallSeen> Daemon::movedWallOneCamera(const std::string& output,
+                                                          const std::string& camera) {
+  DriftRuntime::Output& o = drift_rt_.outputs[output];
+  const rig::RigProjector* p = rig_.projectorForOutput(output);
+  const rig::RigCamera* cam = rig_.camera(camera);
+  auto v = o.views.find(camera);
+  if (!rig_.surface.plane || !p || !p->pose_known || !p->intrinsics_known || !cam ||
+      !cam->pose_known || v == o.views.end() || !v->second.last || !v->second.reference ||
+      v->second.last_generation != rig_generation_ || v->second.last->too_plain) {
+    return std::nullopt;
+  }
+  auto tile = blend::displayTile(*p, rig_.surface);
+  if (!tile) return std::nullopt;
+  const drift::WallView view{&cam->model, &*v->second.last, &v->second.reference->map,
+                             v->second.reference->grid};
+  auto seen = drift::wallFromOneCamera(*p, tile->projector_to_plane, view, *rig_.surface.plane);
+  if (!seen) {
+    logInfo("drift: output '" + output + "': not a moved wall: " + seen.error().message);
+    return std::nullopt;
+  }
+  logInfo("drift: output '" + output + "': the projector and camera '" + camera + "' see " +
+          std::to_string(seen->points) + " content points " + std::to_string(1e3 * seen->offset_m) +
+          " mm from the rig's wall (standard error " + std::to_string(1e3 * seen->offset_se_m) +
+          " mm), turned " + std::to_string(seen->tilt_deg) + " deg; their rays " +
+          std::to_string(1e3 * seen->gap_rms_m) +
+          " mm RMS apart, a moved projector would have "
+          "turned " +
+          std::to_string(seen->projector_turn_deg) +
+          " deg: " + (drift::wallMoved(*seen) ? "the wall moved" : "the wall stands"));
+  if (!drift::wallMoved(*seen)) return std::nullopt;
+  return *seen;
+}
+
 void Daemon::correctSurface(const std::string& output, const std::string& camera,
-                            const drift::Misregistration& m, const drift::WallSeen& wall) {
+                            const drift::Misregistration& m, const drift::WallSeen& wall,
+                            const std::string& seen_by) {
   DriftRuntime::Output& o = drift_rt_.outputs[output];
   const double held = heldFor(o);
   const auto giveUp = [&](const std::string& why) {
@@ -385,7 +425,7 @@ void Daemon::correctSurface(const std::string& output, const std::string& camera
   // Every projector on the wall keeps its pose; those that kept a collineation with the
   // old plane get theirs from the pose and the new plane.
   rig::RigModel update;
-  update.surface.plane = wall.plane;
+  update.surface.plane = drift::wallToKeep(wall);
   update.surface.plane_rms_m = wall.rms_m;
   for (const rig::RigProjector& p : rig_.projectors) {
     if (!p.plane_homography) continue;
@@ -408,14 +448,14 @@ void Daemon::correctSurface(const std::string& output, const std::string& camera
                     {"wall_turned_deg", wall.tilt_deg}};
   logInfo("drift: output '" + output + "': the wall moved " + std::to_string(1e3 * wall.offset_m) +
           " mm (turned " + std::to_string(wall.tilt_deg) +
-          " deg); the rig's plane measured again "
-          "from " +
-          std::to_string(wall.points) + " content points two cameras see");
+          " deg); the rig's plane measured again from " + std::to_string(wall.points) +
+          " content points " + seen_by + " triangulated");
   writeDriftCorrection(output, std::move(update),
                        {{"output", output},
                         {"step", "surface"},
                         {"why", why},
                         {"points", wall.points},
+                        {"triangulated_by", seen_by},
                         {"plane_rms_mm", 1e3 * wall.rms_m}},
                        "corrected-surface");
 }

@@ -373,11 +373,12 @@ std::optional<json> awaitCorrection(Connection& watcher, const std::string& stat
   return corrected;
 }
 
-// procamd with recalibrate = "on-drift" on wall_oblique with a second camera and
-// `events`, a watcher on its events and textured content shown.
-struct TwoCameraRig {
-  TwoCameraRig(const TempDir& dir, const std::string& events)
-      : scene_file(sceneWithEvents(dir, std::string(drift::kSecondCamera) + events)),
+// procamd with recalibrate = "on-drift" on wall_oblique with a second camera (or with
+// its one) and `events`, a watcher on its events and textured content shown.
+struct DriftRig {
+  DriftRig(const TempDir& dir, const std::string& events, bool second_camera = true)
+      : scene_file(sceneWithEvents(
+            dir, (second_camera ? std::string(drift::kSecondCamera) : std::string()) + events)),
         scene(sim::resolveScene(scene_file)),
         d(dir, driftDaemon(dir, "on-drift", scene_file)),
         c(d.socketPath()),
@@ -400,10 +401,10 @@ struct TwoCameraRig {
 // projector bumped, which both cameras see.
 TEST(SimDrift, ABumpedCameraIsReregisteredAndTheProjectorLeftAlone) {
   TempDir dir;
-  TwoCameraRig r(dir, "[[events]]\nt = " + atText(6.0) +
-                          "\ntarget = \"cam\"\nrotate_deg = [0.3, 0.0, 0.0]\n\n"
-                          "[[events]]\nt = " +
-                          atText(16.0) + "\ntarget = \"proj\"\nrotate_deg = [0.5, 0.0, 0.0]\n");
+  DriftRig r(dir, "[[events]]\nt = " + atText(6.0) +
+                      "\ntarget = \"cam\"\nrotate_deg = [0.3, 0.0, 0.0]\n\n"
+                      "[[events]]\nt = " +
+                      atText(16.0) + "\ntarget = \"proj\"\nrotate_deg = [0.5, 0.0, 0.0]\n");
   ASSERT_NO_FATAL_FAILURE(r.start(dir));
   auto [scene, d, c, watcher] = std::tie(r.scene, r.d, r.c, r.watcher);
   const auto projectorOf = [&] {
@@ -472,13 +473,12 @@ TEST(SimDrift, ABumpedCameraIsReregisteredAndTheProjectorLeftAlone) {
   EXPECT_LE(rig_px, 0.5);
 }
 
-// Two fixed cameras, the wall moved 1 cm back: both see the content drift, and where
-// they both found it their rays meet 1 cm behind the rig's wall, so the wall is measured
-// again from the content and the projector left as it is.
-TEST(SimDrift, AMovedWallIsMeasuredAgainFromTheContentAndTheProjectorLeftAlone) {
-  TempDir dir;
-  TwoCameraRig r(
-      dir, "[[events]]\nt = " + atText(6.0) + "\ntarget = \"wall\"\nmove_m = [0.0, 0.01, 0.0]\n");
+// The wall moved 1 cm back (to y = 3.01) while the daemon runs: the surface step measures
+// it again from the content, the projector and cameras left as they are; the plane and
+// where the content lands on it checked against the truth. `triangulated_by`: the
+// correction's event names who triangulated it.
+void expectMovedWallMeasuredAgain(const TempDir& dir, DriftRig& r,
+                                  const std::string& triangulated_by) {
   ASSERT_NO_FATAL_FAILURE(r.start(dir));
   auto [scene, d, c, watcher] = std::tie(r.scene, r.d, r.c, r.watcher);
   auto before = rig::rigFromText(rigText(dir), "rig.json");
@@ -488,6 +488,7 @@ TEST(SimDrift, AMovedWallIsMeasuredAgainFromTheContentAndTheProjectorLeftAlone) 
       awaitCorrection(watcher, "corrected-surface", "corrected-pose", registered);
   ASSERT_TRUE(corrected) << outputDrift(c).dump() << d.log();
   EXPECT_EQ((*corrected)["step"], "surface");
+  EXPECT_EQ((*corrected)["triangulated_by"], triangulated_by);
   EXPECT_TRUE(registered) << outputDrift(c).dump();
   auto after = rig::rigFromText(rigText(dir), "rig.json");
   ASSERT_TRUE(after && after->surface.plane) << rigText(dir);
@@ -517,17 +518,39 @@ TEST(SimDrift, AMovedWallIsMeasuredAgainFromTheContentAndTheProjectorLeftAlone) 
   const json dr = outputDrift(c);
   const json& why = (*corrected)["why"];
   std::printf(
-      "[ figures  ] wall moved 1 cm back: seen at %.2f px, triangulated %.2f mm off the rig's "
-      "wall (standard error %.3f) from %d content points; the wall measured again %.3f mm and "
-      "%.4f deg from the true one, the content on it %.3f projector px from where the rig puts "
-      "it; now %.3f px; projector and cameras unchanged\n",
-      why["misregistration_px"].get<double>(), why["wall_offset_mm"].get<double>(),
-      why["wall_offset_se_mm"].get<double>(), (*corrected)["points"].get<int>(), off_mm, turned,
-      worst_px, dr.value("misregistration_px", -1.0));
+      "[ figures  ] wall moved 1 cm back, triangulated by %s: seen at %.2f px, %.2f mm off "
+      "the rig's wall (standard error %.3f) from %d content points; the wall measured again "
+      "%.3f mm and %.4f deg from the true one, the content on it %.3f projector px from where "
+      "the rig puts it; now %.3f px; projector and cameras unchanged\n",
+      triangulated_by.c_str(), why["misregistration_px"].get<double>(),
+      why["wall_offset_mm"].get<double>(), why["wall_offset_se_mm"].get<double>(),
+      (*corrected)["points"].get<int>(), off_mm, turned, worst_px,
+      dr.value("misregistration_px", -1.0));
   EXPECT_LE(off_mm, 1.0);
   EXPECT_LE(turned, 0.1);
   EXPECT_LE(worst_px, 0.5);
   EXPECT_LE(dr.value("misregistration_px", 1e9), 0.5);
+}
+
+constexpr const char* kWallMovedBack = "\ntarget = \"wall\"\nmove_m = [0.0, 0.01, 0.0]\n";
+
+// Two fixed cameras, the wall moved 1 cm back: both see the content drift, and where
+// they both found it their rays meet 1 cm behind the rig's wall, so the wall is measured
+// again from the content and the projector left as it is.
+TEST(SimDrift, AMovedWallIsMeasuredAgainFromTheContentAndTheProjectorLeftAlone) {
+  TempDir dir;
+  DriftRig r(dir, "[[events]]\nt = " + atText(6.0) + kWallMovedBack);
+  expectMovedWallMeasuredAgain(dir, r, "two cameras");
+}
+
+// One fixed camera, the wall moved 1 cm back: the content moved along the camera's
+// epipolar lines with the projector, so the projector's rays and the camera's meet 1 cm
+// behind the rig's wall, and the pose fitted to the content would not turn the projector:
+// the wall moved, and is measured again from the projector and the camera.
+TEST(SimDrift, AMovedWallIsMeasuredAgainWithOneCamera) {
+  TempDir dir;
+  DriftRig r(dir, "[[events]]\nt = " + atText(6.0) + kWallMovedBack, false);
+  expectMovedWallMeasuredAgain(dir, r, "the projector and camera 'cam'");
 }
 
 }  // namespace

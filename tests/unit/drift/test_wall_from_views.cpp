@@ -1,12 +1,14 @@
-// A moved wall told from a moved projector by two fixed cameras watching the content:
-// wall_oblique with a second camera, the rig model its truth at rest, the cameras' frames
-// rendered by the virtual rig after the wall moved 1 cm back or the projector turned
-// 0.5 degrees. Each camera's drift check measures the misregistration; the two checks'
-// tiles, triangulated, put the wall where it now stands.
+// A moved wall told from a moved projector by two fixed cameras watching the content, or
+// by one camera and the projector: wall_oblique with a second camera, the rig model its
+// truth at rest, the cameras' frames rendered by the virtual rig after the wall moved
+// 1 cm or the projector turned or slid. Each camera's drift check measures the
+// misregistration; the two checks' tiles (or one check's tiles and the projector's
+// pixels drawn), triangulated, put the wall where it now stands.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 
 #include "blend/rig_tiles.hpp"
 #include "drift/misregistration.hpp"
@@ -109,6 +111,88 @@ TEST(WallFromViews, AMovedWallIsToldFromAMovedProjector) {
   }
 }
 
+// One camera: the projector is the second view. Its ray through the pixel drawn meets
+// the camera's ray through where the content was found only while both stand where the
+// rig has them: a moved wall is measured, a turned projector is refused.
+TEST(WallFromViews, OneCameraAndTheProjectorTellAMovedWallFromATurnedProjector) {
+  const cv::Mat content = texturedContent({1920, 1080}, 7, {96, 32, 12});
+  struct Case {
+    const char* what;
+    std::string events;
+    std::optional<double> offset_m;  // nullopt: refused
+  };
+  const Case cases[] = {
+      {"at rest", "", std::nullopt},  // nothing moved: nothing to tell
+      {"wall moved 1 cm back",
+       "[[events]]\nt = 1.0\ntarget = \"wall\"\nmove_m = [0.0, 0.01, 0.0]\n", -0.01},
+      {"wall moved 1 cm forward",
+       "[[events]]\nt = 1.0\ntarget = \"wall\"\nmove_m = [0.0, -0.01, 0.0]\n", 0.01},
+      {"projector turned 0.05 deg",
+       "[[events]]\nt = 1.0\ntarget = \"proj\"\nrotate_deg = [0.05, 0.0, 0.0]\n", std::nullopt},
+      {"projector turned 0.5 deg",
+       "[[events]]\nt = 1.0\ntarget = \"proj\"\nrotate_deg = [0.5, 0.0, 0.0]\n", std::nullopt},
+      {"projector tipped 0.5 deg",
+       "[[events]]\nt = 1.0\ntarget = \"proj\"\nrotate_deg = [0.0, -0.5, 0.0]\n", std::nullopt},
+      {"projector rolled 0.5 deg",
+       "[[events]]\nt = 1.0\ntarget = \"proj\"\nrotate_deg = [0.0, 0.0, 0.5]\n", std::nullopt},
+      {"projector turned and tipped 0.3 deg",
+       "[[events]]\nt = 1.0\ntarget = \"proj\"\nrotate_deg = [0.3, 0.3, 0.0]\n", std::nullopt},
+      {"projector turned and tipped 0.3 deg the other way",
+       "[[events]]\nt = 1.0\ntarget = \"proj\"\nrotate_deg = [0.3, -0.3, 0.0]\n", std::nullopt},
+      {"projector lifted 1 cm",
+       "[[events]]\nt = 1.0\ntarget = \"proj\"\nmove_m = [0.0, 0.0, 0.01]\n", std::nullopt},
+      {"projector slid 1 cm sideways",
+       "[[events]]\nt = 1.0\ntarget = \"proj\"\nmove_m = [0.01, 0.0, 0.0]\n", std::nullopt},
+      {"projector tipped 2 deg",
+       "[[events]]\nt = 1.0\ntarget = \"proj\"\nrotate_deg = [0.0, -2.0, 0.0]\n", std::nullopt},
+  };
+  for (const Case& k : cases) {
+    SCOPED_TRACE(k.what);
+    auto scene = sim::Scene::parse(wallObliqueWithTwoCameras(k.events), "wall2.toml", {});
+    ASSERT_TRUE(scene) << scene.error().message;
+    auto rest = sim::truthRig(*scene, 0.0);
+    ASSERT_TRUE(rest && rest->surface.plane && !rest->projectors.empty());
+    const std::vector<Checked> c = checkBoth(*scene, *rest, content);
+    ASSERT_EQ(c.size(), 2u);
+    auto tile = blend::displayTile(rest->projectors[0], rest->surface);
+    ASSERT_TRUE(tile) << tile.error().message;
+    for (std::size_t i = 0; i < 2; ++i) {
+      const WallView v{&rest->cameras[i].model, &c[i].drift, &c[i].map, c[i].grid};
+      auto seen =
+          wallFromOneCamera(rest->projectors[0], tile->projector_to_plane, v, *rest->surface.plane);
+      if (!seen) {
+        std::printf("[ figures  ] %s, camera %zu alone: misregistration %.2f px; %s\n", k.what,
+                    i + 1, c[i].drift.rms_px, seen.error().message.c_str());
+        EXPECT_FALSE(k.offset_m.has_value()) << seen.error().message;
+        EXPECT_TRUE(seen.error().code == ErrorCode::kTooFewPoints ||
+                    seen.error().code == ErrorCode::kDegenerate)
+            << seen.error().message;
+        continue;
+      }
+      std::printf(
+          "[ figures  ] %s, camera %zu alone: misregistration %.2f px; the rays of %d of %d "
+          "content points met (%.2f mm RMS apart, the content shifted %.2f mm RMS), %.2f mm "
+          "RMS about their plane, %.2f mm (standard error %.2f) from the rig's, tilted %.3f "
+          "deg (a moved projector would have turned %.4f deg): %s\n",
+          k.what, i + 1, c[i].drift.rms_px, seen->points, seen->rays, 1e3 * seen->gap_rms_m,
+          1e3 * seen->shift_rms_m, 1e3 * seen->rms_m, 1e3 * seen->offset_m, 1e3 * seen->offset_se_m,
+          seen->tilt_deg, seen->projector_turn_deg,
+          wallMoved(*seen) ? "the wall moved" : "the wall stands");
+      ASSERT_TRUE(k.offset_m.has_value());
+      EXPECT_GT(seen->points, 50);
+      EXPECT_GE(seen->points, kMinMetShare * seen->rays);
+      EXPECT_LE(seen->gap_rms_m, kMaxGapShare * seen->shift_rms_m);
+      // Within half the 2 mm the decision needs, as with two cameras.
+      EXPECT_NEAR(seen->offset_m, *k.offset_m, 1e-3);
+      EXPECT_EQ(wallMoved(*seen), *k.offset_m != 0.0);
+      // Not turned: the rig's plane moved, through the true wall (y = 3 - offset).
+      const geom::Plane keep = wallToKeep(*seen);
+      EXPECT_EQ(keep.n, rest->surface.plane->n);
+      EXPECT_NEAR(keep.signedDistance(Vec3(0.0, 3.0 - *k.offset_m, 1.5)), 0.0, 1e-3);
+    }
+  }
+}
+
 TEST(WallFromViews, AMoveOrTurnCountsOnlyAboveItsNoise) {
   WallSeen seen;
   seen.offset_m = 0.003;
@@ -125,6 +209,14 @@ TEST(WallFromViews, AMoveOrTurnCountsOnlyAboveItsNoise) {
   seen.tilt_deg = 0.2;  // significant, but under the bound
   seen.tilt_se_deg = 0.01;
   EXPECT_FALSE(wallMoved(seen));
+  // The fitted plane is kept only when it turned; else the rig's plane, shifted.
+  seen.plane = {Vec3(0, 0.6, 0.8), -1};
+  seen.shifted = {Vec3::UnitY(), -3.01};
+  EXPECT_EQ(wallToKeep(seen).n, Vec3::UnitY());
+  seen.tilt_deg = 0.5;
+  EXPECT_EQ(wallToKeep(seen).n, Vec3(0, 0.6, 0.8));
+  seen.tilt_se_deg = 0.1;  // within six standard errors
+  EXPECT_EQ(wallToKeep(seen).d, -3.01);
 }
 
 TEST(WallFromViews, TooFewCommonTilesAndBadViewsAreRefused) {
@@ -141,6 +233,9 @@ TEST(WallFromViews, TooFewCommonTilesAndBadViewsAreRefused) {
   WallView wrong = a;
   wrong.map = &small;
   EXPECT_EQ(wallFromTwoViews(wrong, a, geom::Plane{}).error().code, ErrorCode::kInvalidInput);
+  EXPECT_EQ(wallFromProjectorAndView(cam, a, geom::Plane{}).error().code, ErrorCode::kTooFewPoints);
+  EXPECT_EQ(wallFromProjectorAndView(cam, wrong, geom::Plane{}).error().code,
+            ErrorCode::kInvalidInput);
 }
 
 }  // namespace
