@@ -132,7 +132,7 @@ void parseDaemon(Checker& c, const toml::table& t, Config& cfg) {
 void parsePolicy(Checker& c, const toml::table& t, Config& cfg) {
   c.onlyKnown(t, "policy.",
               {"auto_keystone", "recalibrate", "drift_period_s", "drift_threshold_px",
-               "drift_settle_s", "drift_frames"});
+               "drift_settle_s", "drift_frames", "drift_fiducial_period_s"});
   if (auto* n = t.get("auto_keystone")) c.boolean(*n, "policy.auto_keystone", cfg.auto_keystone);
   if (auto* n = t.get("recalibrate")) {
     std::string s;
@@ -141,8 +141,11 @@ void parsePolicy(Checker& c, const toml::table& t, Config& cfg) {
         cfg.recalibrate = RecalibratePolicy::kOff;
       } else if (s == "on-drift") {
         cfg.recalibrate = RecalibratePolicy::kOnDrift;
+      } else if (s == "on-drift-silent") {
+        cfg.recalibrate = RecalibratePolicy::kOnDriftSilent;
       } else {
-        c.error(n->source(), "policy.recalibrate", "'" + s + "' is not one of: off, on-drift");
+        c.error(n->source(), "policy.recalibrate",
+                "'" + s + "' is not one of: off, on-drift, on-drift-silent");
       }
     }
   }
@@ -157,6 +160,9 @@ void parsePolicy(Checker& c, const toml::table& t, Config& cfg) {
   }
   if (auto* n = t.get("drift_frames"))
     c.integer(*n, "policy.drift_frames", 1, 16, cfg.drift.frames);
+  if (auto* n = t.get("drift_fiducial_period_s")) {
+    c.number(*n, "policy.drift_fiducial_period_s", 0.0, 3600.0, cfg.drift.fiducial_period_s);
+  }
 }
 
 void parseSim(Checker& c, const toml::table& t, Config& cfg) {
@@ -359,7 +365,15 @@ void parseDevices(Checker& c, const toml::node& node, const std::string& section
 }  // namespace
 
 const char* recalibratePolicyName(RecalibratePolicy policy) {
-  return policy == RecalibratePolicy::kOnDrift ? "on-drift" : "off";
+  switch (policy) {
+    case RecalibratePolicy::kOnDrift:
+      return "on-drift";
+    case RecalibratePolicy::kOnDriftSilent:
+      return "on-drift-silent";
+    case RecalibratePolicy::kOff:
+      break;
+  }
+  return "off";
 }
 
 Result<Config> parseConfig(std::string_view text, const std::string& source) {

@@ -26,7 +26,12 @@ struct DeviceConfig {
   int driver_line = 0;  // where `driver` was given
 };
 
-enum class RecalibratePolicy { kOff, kOnDrift };
+// "on-drift-silent" watches and corrects as "on-drift" does, but never shows a frame of
+// its own (no fiducial frame when the content is too plain).
+enum class RecalibratePolicy { kOff, kOnDrift, kOnDriftSilent };
+inline bool watchesDrift(RecalibratePolicy p) {
+  return p == RecalibratePolicy::kOnDrift || p == RecalibratePolicy::kOnDriftSilent;
+}
 
 // [keystone]: the automatic keystone loop (keystone/tilt_tracker.hpp), read by
 // daemon/auto_keystone.hpp.
@@ -68,6 +73,9 @@ struct DriftConfig {
   double threshold_px = 0.5;  // misregistration (RMS, projector pixels) that is drift
   double settle_s = 0.5;      // held this long before a correction
   int frames = 2;             // camera frames averaged per check
+  // "on-drift" with content too plain to register: a fiducial frame at most this often
+  // per output (and at every check while drift it saw is being confirmed); 0: never.
+  double fiducial_period_s = 10.0;
 };
 
 struct Config {

@@ -295,6 +295,12 @@ class Daemon {
   // The wall as two cameras that see the output drift triangulate it, when it stands off
   // the rig's plane; nullopt when it does not or cannot be told.
   std::optional<drift::WallSeen> movedWall(const std::string& output, const std::string& camera);
+  // Whether this check of `view` shows the fiducial frame instead of registering the
+  // content (made here for `framebuffer` when needed).
+  bool fiducialDue(DriftRuntime::Output& o, const DriftRuntime::View& view,
+                   const KeystoneRuntime::OutputState& shown, cv::Size framebuffer);
+  // A check's fiducial frame is over: the content is drawn again.
+  void endFiducialFrame(const std::string& output);
   // The wall as the output's projector and its one camera triangulate it, when the
   // content's shift is a moved wall's (drift::wallFromOneCamera) standing off the rig's
   // plane; nullopt otherwise.

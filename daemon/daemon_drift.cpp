@@ -65,7 +65,7 @@ void Daemon::setupDriftCheck() {
     loop_->removeTimer(d.timer);
     d.timer = -1;
   }
-  if (config_.recalibrate != RecalibratePolicy::kOnDrift) {
+  if (!watchesDrift(config_.recalibrate)) {
     d.outputs.clear();
     return;
   }
@@ -101,8 +101,8 @@ bool Daemon::driftMayRun() const {
   const KeystoneRuntime& k = keystone_rt_;
   // Not while an operation holds the devices, the camera yaw's dot grid is shown or a
   // frame is in flight (what the output shows is about to change).
-  return config_.recalibrate == RecalibratePolicy::kOnDrift && !calibrating() &&
-         calibration_.op.empty() && !k.yaw.measuring && !k.rendering && !k.render_again;
+  return watchesDrift(config_.recalibrate) && !calibrating() && calibration_.op.empty() &&
+         !k.yaw.measuring && !k.rendering && !k.render_again;
 }
 
 void Daemon::checkDrift() {
@@ -155,9 +155,12 @@ void Daemon::checkDrift() {
   // the camera is a few output frames ([calibration] settle_frames, as calibrate waits).
   const double settle = std::max(0.1, (config_.calibration.settle_frames + 2) / 60.0);
   if (secondsSince(st->second.shown_at) < settle) return;
+  // Nor the fiducial frame a check showed before the content came back.
+  if (o.fiducial_at && secondsSince(*o.fiducial_at) < settle) return;
   o.unavailable.clear();
   o.camera = cam->name;
   DeviceEntry* cam_entry = devices_.find(cam->name);
+  const bool fiducial = fiducialDue(o, o.views[cam->name], st->second, {p->width, p->height});
   DriftCheckPlan plan;
   plan.output = out.name;
   plan.camera = {cam->name, cam_entry->device.share()};
@@ -169,6 +172,13 @@ void Daemon::checkDrift() {
   plan.projector_to_plane = tile->projector_to_plane;
   plan.camera_model = cam->model;
   plan.frames = config_.drift.frames;
+  if (fiducial) {
+    // The frames wait while the fiducial frame is up (refreshOutputs).
+    plan.fiducial = d.fiducial;
+    plan.output_device = {out.name, out.device.share()};
+    plan.settle_s = settle;
+    d.fiducial_showing = true;
+  }
   // The device manager keeps off the camera while the check drives it.
   d.camera_in_use = cam->name;
   plan.fence = device_manager_->readFence({cam->name});
@@ -178,13 +188,58 @@ void Daemon::checkDrift() {
   compute_worker_->submit(
       [this, plan = std::move(plan), key] {
         auto r = runDriftCheck(plan);
-        return [this, key, r = std::move(r)]() mutable { onDriftChecked(key, std::move(r)); };
+        return [this, key, r = std::move(r)]() mutable {
+          onDriftChecked(key, std::move(r));
+          endFiducialFrame(key.output);
+        };
       },
       [this, name = out.name](const std::string& what) {
         drift_rt_.checking = false;
         drift_rt_.camera_in_use.clear();
         warn("drift check of output '" + name + "' failed: " + what);
+        endFiducialFrame(name);
       });
+}
+
+bool Daemon::fiducialDue(DriftRuntime::Output& o, const DriftRuntime::View& view,
+                         const KeystoneRuntime::OutputState& shown, cv::Size framebuffer) {
+  DriftRuntime& d = drift_rt_;
+  // Only where the content this camera last looked at was too plain to register, never
+  // with "on-drift-silent"; at the period, and at every check while drift one saw is
+  // confirmed or a correction of it checked.
+  const bool plain = view.plain_setup && view.plain_setup == shown.shown_setup &&
+                     view.plain_image == shown.shown_image;
+  if (!plain || config_.recalibrate != RecalibratePolicy::kOnDrift ||
+      !(config_.drift.fiducial_period_s > 0)) {
+    return false;
+  }
+  const bool due =
+      !o.fiducial_at || secondsSince(*o.fiducial_at) >= config_.drift.fiducial_period_s;
+  if (!due && !view.above && o.passes == 0) return false;
+  if (!d.fiducial || d.fiducial->rgb.size() != framebuffer) {
+    d.fiducial.reset();
+    auto made = makeFiducialFrame(framebuffer);
+    if (!made) {
+      if (d.fiducial_unavailable != made.error()) warn("drift: " + made.error());
+      d.fiducial_unavailable = made.error();
+      return false;
+    }
+    d.fiducial = *made;
+    d.fiducial_unavailable.clear();
+  }
+  return true;
+}
+
+void Daemon::endFiducialFrame(const std::string& output) {
+  DriftRuntime& d = drift_rt_;
+  if (!d.fiducial_showing) return;
+  d.fiducial_showing = false;
+  auto it = d.outputs.find(output);
+  if (it != d.outputs.end()) {
+    it->second.fiducial_at = DriftRuntime::Clock::now();
+    ++it->second.fiducial_checks;
+  }
+  refreshOutputs();  // the content again
 }
 
 namespace {
@@ -216,7 +271,7 @@ void Daemon::onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, Calibr
   d.checking = false;
   d.camera_in_use.clear();
   auto it = d.outputs.find(key.output);
-  if (it == d.outputs.end() || config_.recalibrate != RecalibratePolicy::kOnDrift) return;
+  if (it == d.outputs.end() || !watchesDrift(config_.recalibrate)) return;
   DriftRuntime::Output& o = it->second;
   DriftRuntime::View& v = o.views[key.camera];
   o.camera = key.camera;
@@ -252,6 +307,13 @@ void Daemon::onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, Calibr
   const drift::Misregistration& m = r->misregistration;
   v.last = m;
   v.last_generation = key.rig_generation;
+  v.last_fiducial = r->fiducial;
+  if (r->fiducial && !m.too_plain) o.fiducial_px = m.rms_px;
+  if (!r->fiducial) {
+    // Whether this frame's content can be registered: fiducialDue asks.
+    v.plain_setup = m.too_plain ? key.setup : nullptr;
+    v.plain_image = m.too_plain ? key.image : nullptr;
+  }
   const double threshold = config_.drift.threshold_px;
   if (m.too_plain || m.rms_px <= threshold) {
     v.above.reset();
@@ -588,7 +650,7 @@ void Daemon::writeDriftCorrection(const std::string& output, rig::RigModel updat
 }
 
 json Daemon::driftJson(const std::string& output) const {
-  if (config_.recalibrate != RecalibratePolicy::kOnDrift) return nullptr;
+  if (!watchesDrift(config_.recalibrate)) return nullptr;
   auto it = drift_rt_.outputs.find(output);
   if (it == drift_rt_.outputs.end()) return {{"unavailable", "not checked yet"}};
   const DriftRuntime::Output& o = it->second;
@@ -597,6 +659,13 @@ json Daemon::driftJson(const std::string& output) const {
             {"corrections", o.corrections},
             {"last_correction", o.last_correction}};
   if (!o.error.empty()) j["error"] = o.error;
+  if (config_.recalibrate == RecalibratePolicy::kOnDrift) {
+    json f = {{"frames", o.fiducial_checks}, {"period_s", config_.drift.fiducial_period_s}};
+    if (o.fiducial_at) f["age_s"] = secondsSince(*o.fiducial_at);
+    if (o.fiducial_px) f["misregistration_px"] = *o.fiducial_px;
+    if (!drift_rt_.fiducial_unavailable.empty()) f["unavailable"] = drift_rt_.fiducial_unavailable;
+    j["fiducial"] = std::move(f);
+  }
   if (!o.unavailable.empty()) {
     j["unavailable"] = o.unavailable;
     return j;
@@ -609,18 +678,21 @@ json Daemon::driftJson(const std::string& output) const {
     j.update(v->timing);
   }
   json cameras = json::array();
-  bool checked = false, plain = true;
+  bool checked = false, plain = true, content_plain = false;
   for (const auto& [name, v] : o.views) {
     if (!v.last) continue;
     checked = true;
     plain = plain && v.last->too_plain;
+    content_plain = content_plain || v.plain_image;
     cameras.push_back({{"camera", name},
                        {"misregistration_px", v.last->rms_px},
                        {"too_plain", v.last->too_plain},
+                       {"from", v.last_fiducial ? "fiducial" : "content"},
                        {"drifted", v.above.has_value()},
                        {"age_s", secondsSince(v.checked_at)}});
   }
   j["cameras"] = std::move(cameras);
+  j["content_too_plain"] = content_plain;
   std::string state = "registered";
   if (!checked) {
     state = "checking";

@@ -202,9 +202,10 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done, bool supersede
   }
   auto waiters = std::move(k.frame_waiters);
   k.frame_waiters.clear();
-  // The camera's yaw measurement shows its dot grid for a few seconds: what waits for a
-  // frame is drawn when it ends. A calibration shows its own frames for a long run.
-  if (k.yaw.measuring) {
+  // The camera's yaw measurement shows its dot grid for a few seconds, a drift check its
+  // fiducial frame for a fraction of one: what waits for a frame is drawn when it ends.
+  // A calibration shows its own frames for a long run.
+  if (k.yaw.measuring || drift_rt_.fiducial_showing) {
     k.frame_waiters.insert(k.frame_waiters.end(), std::make_move_iterator(waiters.begin()),
                            std::make_move_iterator(waiters.end()));
     return;

@@ -1,8 +1,13 @@
 #include "drift_check.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <opencv2/imgproc.hpp>
+#include <thread>
+#include <vector>
 
+#include "drift/fiducial_misregistration.hpp"
+#include "output_frames.hpp"
 #include "protocol.hpp"
 #include "render/cpu_renderer.hpp"
 
@@ -74,22 +79,10 @@ bool referenceFits(const DriftCheckPlan& plan) {
          r->rig_generation == plan.rig_generation && r->camera == plan.camera.name;
 }
 
-tl::expected<DriftCheck, CalibrationFailure> runDriftCheck(const DriftCheckPlan& plan) {
-  using Clock = std::chrono::steady_clock;
-  const auto since = [](Clock::time_point t) {
-    return std::chrono::duration<double>(Clock::now() - t).count();
-  };
-  const auto start = Clock::now();
-  DriftCheck out;
-  if (referenceFits(plan)) {
-    out.reference = plan.reference;
-  } else {
-    auto ref = makeReference(plan);
-    if (!ref) return tl::unexpected(ref.error());
-    out.reference = *ref;
-    out.reference_s = since(start);
-  }
-  const auto capture = Clock::now();
+namespace {
+
+// `frames` of the camera, averaged (CV_32F).
+tl::expected<cv::Mat, CalibrationFailure> captureMean(const DriftCheckPlan& plan) {
   plan.fence.wait();
   cv::Mat sum;
   for (int i = 0; i < std::max(1, plan.frames); ++i) {
@@ -106,10 +99,98 @@ tl::expected<DriftCheck, CalibrationFailure> runDriftCheck(const DriftCheckPlan&
     cv::accumulate(*grey, sum);
   }
   sum /= std::max(1, plan.frames);
+  return sum;
+}
+
+using Clock = std::chrono::steady_clock;
+
+double since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+// The check's reference, made again when it does not fit (a fiducial check makes it too:
+// the corrections read the camera's map from it).
+tl::expected<void, CalibrationFailure> reference(const DriftCheckPlan& plan, DriftCheck& out,
+                                                 Clock::time_point start) {
+  if (referenceFits(plan)) {
+    out.reference = plan.reference;
+    return {};
+  }
+  auto ref = makeReference(plan);
+  if (!ref) return tl::unexpected(ref.error());
+  out.reference = *ref;
+  out.reference_s = since(start);
+  return {};
+}
+
+tl::expected<DriftCheck, CalibrationFailure> runFiducialCheck(const DriftCheckPlan& plan) {
+  const auto start = Clock::now();
+  DriftCheck out;
+  out.fiducial = true;
+  if (auto ok = reference(plan, out, start); !ok) return tl::unexpected(ok.error());
+  const FiducialFrame& f = *plan.fiducial;
+  const auto failed = [&](const std::string& why) {
+    return tl::unexpected(
+        CalibrationFailure{code::kFailed, "drift check of output '" + plan.output + "': " + why});
+  };
+  if (f.rgb.size() != plan.framebuffer || !plan.output_device.device) {
+    return failed("the fiducial frame is not the framebuffer's size");
+  }
+  procam_image frame = rgbImage(f.rgb);
+  char err[256] = {0};
+  const auto& raw = plan.output_device.device->raw();
+  if (int rc = raw.ops.output->show(raw.self, &frame, err, sizeof err - 1); rc != PROCAM_OK) {
+    return tl::unexpected(
+        deviceFailure("output", plan.output_device.name, rc, "show the fiducial frame", err));
+  }
+  std::this_thread::sleep_for(std::chrono::duration<double>(plan.settle_s));
+  const auto capture = Clock::now();
+  auto mean = captureMean(plan);
+  if (!mean) return tl::unexpected(mean.error());
+  out.capture_s = since(capture);
+  const auto measure = Clock::now();
+  cv::Mat grey;
+  mean->convertTo(grey, CV_8U);
+  auto found = findFiducials(f, grey);
+  if (!found) return failed(found.error());
+  // As with content: only corners this projector alone lights (a neighbour's light adds
+  // to the tags in a blended overlap).
+  const DriftReference& ref = *out.reference;
+  const auto alone = [&](const Vec2& drawn) {
+    if (ref.usable.empty()) return true;
+    const Vec2 w = ref.grid.toWork(drawn);
+    const int x = static_cast<int>(std::lround(w.x())), y = static_cast<int>(std::lround(w.y()));
+    return x >= 0 && y >= 0 && x < ref.usable.cols && y < ref.usable.rows &&
+           ref.usable.at<uint8_t>(y, x) != 0;
+  };
+  std::vector<Vec2> shown;
+  for (const Vec2& c : f.corners) {
+    if (alone(c)) shown.push_back(c);
+  }
+  std::erase_if(*found, [&](const drift::FiducialCorner& c) { return !alone(c.drawn); });
+  auto m =
+      drift::fiducialMisregistration(shown, *found, plan.projector_to_plane, plan.camera_model);
+  if (!m) return failed(m.error().message);
+  out.misregistration = std::move(*m);
+  out.measure_s = since(measure);
+  out.seconds = since(start);
+  return out;
+}
+
+}  // namespace
+
+tl::expected<DriftCheck, CalibrationFailure> runDriftCheck(const DriftCheckPlan& plan) {
+  if (plan.fiducial) return runFiducialCheck(plan);
+  const auto start = Clock::now();
+  DriftCheck out;
+  if (auto ok = reference(plan, out, start); !ok) return tl::unexpected(ok.error());
+  const auto capture = Clock::now();
+  auto sum = captureMean(plan);
+  if (!sum) return tl::unexpected(sum.error());
   out.capture_s = since(capture);
   const auto measure = Clock::now();
   const DriftReference& ref = *out.reference;
-  auto m = drift::measureMisregistration(ref.shown, sum, ref.map, ref.grid, {}, ref.usable);
+  auto m = drift::measureMisregistration(ref.shown, *sum, ref.map, ref.grid, {}, ref.usable);
   out.measure_s = since(measure);
   if (!m) {
     return tl::unexpected(CalibrationFailure{

@@ -2,7 +2,9 @@
 // One drift check of a fixed rig, on a worker: what the camera should see of the frame an
 // output shows (the frame drawn again on the CPU, resampled onto a framebuffer grid; the
 // grid's camera pixels from the rig model) against a few averaged camera frames
-// (drift/misregistration.hpp). Never touches daemon state.
+// (drift/misregistration.hpp); or, for content too plain to register, a fiducial frame
+// shown on the output and its tag corners found (drift/fiducial_misregistration.hpp).
+// Never touches daemon state.
 #include <memory>
 #include <opencv2/core.hpp>
 #include <tl/expected.hpp>
@@ -10,6 +12,7 @@
 #include "calibration_job.hpp"
 #include "drift/misregistration.hpp"
 #include "drift/projector_camera_map.hpp"
+#include "drift_fiducial.hpp"
 #include "read_fence.hpp"
 #include "render/render_setup.hpp"
 
@@ -43,6 +46,12 @@ struct DriftCheckPlan {
   int frames = 2;  // camera frames averaged
   // Waited on before the first capture: the device manager's reads of the camera end.
   ReadFence fence;
+  // Set: a fiducial check. The frame is shown on `output_device` (its size the framebuffer's)
+  // and the capture starts `settle_s` later; the output keeps showing it (the daemon
+  // draws the content again). The reference is then not made, nor needed.
+  std::shared_ptr<const FiducialFrame> fiducial;
+  CalibrationDevice output_device;
+  double settle_s = 0.1;
 };
 
 struct DriftCheck {
@@ -52,14 +61,16 @@ struct DriftCheck {
   double reference_s = 0;  // making the reference (0: reused)
   double capture_s = 0;    // the camera frames
   double measure_s = 0;    // the registration
+  bool fiducial = false;   // measured from a fiducial frame
 };
 
 // The plan's reference when it still fits (same setup, content, rig and camera).
 bool referenceFits(const DriftCheckPlan& plan);
 
-// The camera's failures (kIo, kNoDevice, ...); kFailed when the frame cannot be drawn
-// again, it is not the rig model's framebuffer size, the camera's frames have another size
-// than the rig model's or it sees too little of the frame (under 10 %).
+// The camera's failures (kIo, kNoDevice, ...); the output's, showing a fiducial frame;
+// kFailed when the frame cannot be drawn again, it is not the rig model's framebuffer
+// size, the camera's frames have another size than the rig model's, it sees too little
+// of the frame (under 10 %) or a fiducial frame's tags cannot be looked for.
 tl::expected<DriftCheck, CalibrationFailure> runDriftCheck(const DriftCheckPlan& plan);
 
 }  // namespace procam::daemon

@@ -36,7 +36,11 @@ struct DriftRuntime {
     Clock::time_point checked_at;
     std::optional<Clock::time_point> above;  // drift seen by this camera since
     nlohmann::json timing =
-        nullptr;  // the last check's: {check_s, reference_s, capture_s, measure_s}
+        nullptr;                 // the last check's: {check_s, reference_s, capture_s, measure_s}
+    bool last_fiducial = false;  // `last` came from a fiducial frame
+    // The frame the last content check found too plain to register (null: none was).
+    std::shared_ptr<const render::RenderSetup> plain_setup;
+    std::shared_ptr<const cv::Mat> plain_image;
   };
   struct Output {
     std::vector<std::string> cameras;  // the fixed cameras that see it
@@ -54,6 +58,10 @@ struct DriftRuntime {
     // The projector, cameras mounted on it or a camera re-registered, before the
     // corrections since it was last registered: restored when they do not converge.
     std::optional<rig::RigModel> before;
+    // Fiducial frames shown for this output, and when the last one was taken off.
+    uint64_t fiducial_checks = 0;
+    std::optional<Clock::time_point> fiducial_at;
+    std::optional<double> fiducial_px;  // the last fiducial check's misregistration
     const View* lastView() const {
       auto it = views.find(camera);
       return it == views.end() ? nullptr : &it->second;
@@ -66,10 +74,14 @@ struct DriftRuntime {
     }
   };
   int timer = -1;
-  bool checking = false;      // a check on the compute worker
-  std::string camera_in_use;  // the camera it drives: the device manager keeps off it
-  bool writing = false;       // a corrected rig model on its way to rig.json
-  uint64_t next = 0;          // round robin over the outputs
+  bool checking = false;          // a check on the compute worker
+  std::string camera_in_use;      // the camera it drives: the device manager keeps off it
+  bool writing = false;           // a corrected rig model on its way to rig.json
+  bool fiducial_showing = false;  // a fiducial frame is on an output: frames wait
+  // The fiducial frame, made once per framebuffer size; why there is none.
+  std::shared_ptr<const FiducialFrame> fiducial;
+  std::string fiducial_unavailable;
+  uint64_t next = 0;  // round robin over the outputs
   std::map<std::string, Output> outputs;
 };
 

@@ -289,6 +289,12 @@ static std::string driftText(json status) {
                     d.contains("tiles") ? scalar(d["tiles"]["used"]).c_str() : "no",
                     scalar(val(d, "corrections", json(0))).c_str());
       text = line;
+      const json f = val(d, "fiducial", json());
+      if (f.is_object() && val(f, "frames", 0.0) > 0) {
+        std::snprintf(line, sizeof line, "; %s fiducial frame(s), the last %.3f px",
+                      scalar(val(f, "frames", json(0))).c_str(), val(f, "misregistration_px", 0.0));
+        text += line;
+      }
     }
     out += field(("drift " + scalar(val(o, "name", json()))).c_str(), text);
   }

@@ -93,6 +93,55 @@ Vec2 globalShift(const cv::Mat& shown, const cv::Mat& seen, const cv::Mat& seen_
 
 }  // namespace
 
+void fitShiftField(std::vector<TileShift> tiles, const MisregistrationOptions& options,
+                   Misregistration& m) {
+  if (tiles.size() >= 4) {
+    std::vector<cv::Point2f> from, to;
+    for (const TileShift& t : tiles) {
+      from.emplace_back(static_cast<float>(t.drawn.x()), static_cast<float>(t.drawn.y()));
+      to.emplace_back(static_cast<float>(t.seen_at.x()), static_cast<float>(t.seen_at.y()));
+    }
+    std::vector<unsigned char> inliers;
+    const cv::Mat H = cv::findHomography(from, to, cv::RANSAC, options.ransac_px, inliers);
+    // No consensus: no tile is trusted (the check then reports too little to tell).
+    for (std::size_t i = 0; i < tiles.size(); ++i) {
+      tiles[i].inlier = !H.empty() && i < inliers.size() && inliers[i] != 0;
+    }
+  }
+  // The misregistration is the collineation's over the inlier tiles: each tile's own
+  // shift scatters by about 0.2 px on a camera with 1 DN of noise, their fit by a
+  // tenth of that.
+  std::vector<Vec2> drawn, seen_at;
+  double response = 0;
+  for (const TileShift& t : tiles) {
+    if (!t.inlier) continue;
+    drawn.push_back(t.drawn);
+    seen_at.push_back(t.seen_at);
+    response += std::min(1.0, t.response);  // the peak's sum can pass 1 by rounding
+  }
+  m.tiles_used = static_cast<int>(drawn.size());
+  if (m.tiles_used < options.min_tiles) m.too_plain = true;
+  auto field = m.tiles_used >= 4 ? geom::fitHomography(drawn, seen_at)
+                                 : Result<geom::HomographyFit>(fail(ErrorCode::kTooFewPoints, ""));
+  if (!field || !field->H.allFinite()) {
+    m.too_plain = true;
+  } else {
+    m.drawn_to_seen = field->H / field->H(2, 2);
+    m.tile_rms_px = field->rms;
+    double sum_sq = 0;
+    for (const Vec2& p : drawn) {
+      const Vec3 q = m.drawn_to_seen * Vec3(p.x(), p.y(), 1.0);
+      const double len = (q.head<2>() / q.z() - p).norm();
+      sum_sq += len * len;
+      m.max_px = std::max(m.max_px, len);
+    }
+    const double n = static_cast<double>(drawn.size());
+    m.rms_px = std::sqrt(sum_sq / n);
+    m.confidence = (n / std::max(1, m.tiles_textured)) * (response / n);
+  }
+  m.tiles = std::move(tiles);
+}
+
 Result<Misregistration> measureMisregistration(const cv::Mat& shown, const cv::Mat& camera,
                                                const cv::Mat& map, const WorkGrid& grid,
                                                const MisregistrationOptions& options,
@@ -167,51 +216,7 @@ Result<Misregistration> measureMisregistration(const cv::Mat& shown, const cv::M
     }
   }
   m.too_plain = m.tiles_textured < options.min_textured_share * m.tiles_seen;
-  if (tiles.size() >= 4) {
-    std::vector<cv::Point2f> from, to;
-    for (const TileShift& t : tiles) {
-      from.emplace_back(static_cast<float>(t.drawn.x()), static_cast<float>(t.drawn.y()));
-      to.emplace_back(static_cast<float>(t.seen_at.x()), static_cast<float>(t.seen_at.y()));
-    }
-    std::vector<unsigned char> inliers;
-    const cv::Mat H = cv::findHomography(from, to, cv::RANSAC, options.ransac_px, inliers);
-    // No consensus: no tile is trusted (the check then reports too little to tell).
-    for (std::size_t i = 0; i < tiles.size(); ++i) {
-      tiles[i].inlier = !H.empty() && i < inliers.size() && inliers[i] != 0;
-    }
-  }
-  // The misregistration is the collineation's over the inlier tiles: each tile's own
-  // shift scatters by about 0.2 px on a camera with 1 DN of noise, their fit by a
-  // tenth of that.
-  std::vector<Vec2> drawn, seen_at;
-  double response = 0;
-  for (const TileShift& t : tiles) {
-    if (!t.inlier) continue;
-    drawn.push_back(t.drawn);
-    seen_at.push_back(t.seen_at);
-    response += std::min(1.0, t.response);  // the peak's sum can pass 1 by rounding
-  }
-  m.tiles_used = static_cast<int>(drawn.size());
-  if (m.tiles_used < options.min_tiles) m.too_plain = true;
-  auto field = m.tiles_used >= 4 ? geom::fitHomography(drawn, seen_at)
-                                 : Result<geom::HomographyFit>(fail(ErrorCode::kTooFewPoints, ""));
-  if (!field || !field->H.allFinite()) {
-    m.too_plain = true;
-  } else {
-    m.drawn_to_seen = field->H / field->H(2, 2);
-    m.tile_rms_px = field->rms;
-    double sum_sq = 0;
-    for (const Vec2& p : drawn) {
-      const Vec3 q = m.drawn_to_seen * Vec3(p.x(), p.y(), 1.0);
-      const double len = (q.head<2>() / q.z() - p).norm();
-      sum_sq += len * len;
-      m.max_px = std::max(m.max_px, len);
-    }
-    const double n = static_cast<double>(drawn.size());
-    m.rms_px = std::sqrt(sum_sq / n);
-    m.confidence = (n / std::max(1, m.tiles_textured)) * (response / n);
-  }
-  m.tiles = std::move(tiles);
+  fitShiftField(std::move(tiles), options, m);
   return m;
 }
 

@@ -59,6 +59,13 @@ struct Misregistration {
   std::vector<TileShift> tiles;  // every registered tile, inliers marked
 };
 
+// Marks the tiles that one collineation of the framebuffer explains (RANSAC within
+// options.ransac_px) and sets `m`'s shift field from them: drawn_to_seen, rms_px, max_px,
+// tile_rms_px, tiles_used, confidence (over m.tiles_textured) and the tiles; too_plain
+// also when fewer than options.min_tiles agree.
+void fitShiftField(std::vector<TileShift> tiles, const MisregistrationOptions& options,
+                   Misregistration& m);
+
 // `shown`: the frame on the output at the grid's work size (CV_32F, code values
 // 0..255); `camera`: the camera's frame (CV_32F, any scale); `map`: from
 // projectorCameraMap for the same grid; `usable` (optional, CV_8U of the grid): tiles

@@ -69,5 +69,22 @@ TEST(CtlFormat, AnObjectRefinementIsShown) {
   EXPECT_NE(text.find("slide along 1 0 0 (as placed)"), std::string::npos) << text;
 }
 
+TEST(CtlFormat, DriftShowsItsFiducialFrames) {
+  json drift = {
+      {"state", "registered"},     {"misregistration_px", 0.0},
+      {"camera", "cam"},           {"corrections", 0},
+      {"content_too_plain", true}, {"fiducial", {{"frames", 3}, {"misregistration_px", 0.026}}}};
+  const json r = {{"class", "STATUS"},
+                  {"drift", {{"policy", "on-drift"}}},
+                  {"outputs", {{"shown", {{{"name", "proj"}, {"drift", drift}}}}}}};
+  std::string text = formatReply(r);
+  EXPECT_NE(text.find("3 fiducial frame(s), the last 0.026 px"), std::string::npos) << text;
+  drift["fiducial"] = "three";  // another type: not shown, nothing thrown
+  const json odd = {{"class", "STATUS"},
+                    {"outputs", {{"shown", {{{"name", "p"}, {"drift", drift}}}}}}};
+  text = formatReply(odd);
+  EXPECT_EQ(text.find("fiducial"), std::string::npos) << text;
+}
+
 }  // namespace
 }  // namespace procam::ctl
