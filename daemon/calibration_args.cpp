@@ -83,11 +83,22 @@ tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const json& requ
   }
   std::string error;
   if (auto it = request.find("mode"); it != request.end()) {
-    auto mode = it->is_string() ? sl::parseMode(it->get<std::string>()) : Result<sl::Mode>{};
-    if (!it->is_string() || !mode) {
-      return tl::unexpected(std::string("\"mode\" must be \"gray\" or \"gray+phase\""));
+    if (*it == "apriltag") {
+      a.tags = true;
+      for (const char* gray_only : {"step", "phase_steps", "grid"}) {
+        if (request.contains(gray_only)) {
+          return tl::unexpected("\"" + std::string(gray_only) +
+                                "\" is for Gray-code scans, not \"mode\": \"apriltag\"");
+        }
+      }
+    } else {
+      auto mode = it->is_string() ? sl::parseMode(it->get<std::string>()) : Result<sl::Mode>{};
+      if (!it->is_string() || !mode) {
+        return tl::unexpected(
+            std::string("\"mode\" must be \"gray\", \"gray+phase\" or \"apriltag\""));
+      }
+      a.mode = *mode;
     }
-    a.mode = *mode;
   }
   if (!integerArg(request, "step", 1, 256, a.step, error) ||
       !integerArg(request, "phase_steps", 3, 64, a.phase_steps, error) ||
@@ -129,7 +140,13 @@ tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const json& requ
   if (auto it = request.find("response"); it != request.end()) {
     if (!it->is_boolean()) return tl::unexpected(std::string("\"response\" must be true or false"));
     a.response = it->get<bool>();
+    if (a.tags && *a.response) {
+      return tl::unexpected(std::string(
+          "\"response\" measures the projector over the pixels a Gray-code scan decoded: not "
+          "with \"mode\": \"apriltag\""));
+    }
   }
+  if (a.tags) a.response = false;
   if (auto it = request.find("cameras"); it != request.end()) {
     auto names = distinctNames(*it, kMaxCalibrationCameras);
     if (!names) {

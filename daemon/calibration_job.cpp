@@ -210,6 +210,31 @@ tl::expected<CalibrationOutcome, CalibrationFailure> runCalibration(const Calibr
   return std::move(outcomes->front());
 }
 
+tl::expected<double, CalibrationFailure> settleFor(const CalibrationPlan& plan,
+                                                   const CalibrationHooks& hooks,
+                                                   CalibrationOutcome& outcome) {
+  outcome.settle_frames = plan.settle_frames;
+  if (!plan.auto_settle) return 0.0;
+  // Settle by the measured display-to-capture latency of these cameras.
+  LatencyPlan probe{plan.output,
+                    static_cast<uint32_t>(plan.set.options.width),
+                    static_cast<uint32_t>(plan.set.options.height),
+                    plan.refresh_hz,
+                    {},
+                    plan.latency.latency_repeats,
+                    plan.latency.latency_timeout_s,
+                    plan.latency.margin_frames};
+  for (const auto& c : plan.cameras) probe.cameras.push_back(c.device);
+  CalibrationHooks probe_hooks{hooks.cancelled, [&](const CalibrationProgress& p) {
+                                 hooks.progress({0.1 * p.fraction, "latency", 0});
+                               }};
+  auto measured = runLatencyProbe(probe, probe_hooks);
+  if (!measured) return tl::unexpected(measured.error());
+  outcome.settle_frames = measured->settle_frames;
+  outcome.latency = latencyJson(*measured, probe);
+  return 0.1;
+}
+
 tl::expected<std::vector<CalibrationOutcome>, CalibrationFailure> runBatchCalibration(
     std::span<const CalibrationPlan* const> members,
     const std::vector<std::vector<cv::Mat>>& footprints, const CalibrationHooks& hooks) {
@@ -221,6 +246,17 @@ tl::expected<std::vector<CalibrationOutcome>, CalibrationFailure> runBatchCalibr
                                              "its members' footprints"});
   }
   const CalibrationPlan& plan = *members.front();
+  if (plan.tags) {
+    if (members.size() > 1) {
+      return tl::unexpected(CalibrationFailure{
+          code::kFailed, "internal: a tag frame calibrates one projector at a time"});
+    }
+    auto one = runTagCalibration(plan, hooks);
+    if (!one) return tl::unexpected(one.error());
+    std::vector<CalibrationOutcome> outcomes;
+    outcomes.push_back(std::move(*one));
+    return outcomes;
+  }
   for (const CalibrationPlan* m : members) {
     if (members.size() > 1 && m->board) {
       return tl::unexpected(CalibrationFailure{
@@ -230,28 +266,9 @@ tl::expected<std::vector<CalibrationOutcome>, CalibrationFailure> runBatchCalibr
   const int total = plan.captures();
   std::vector<CalibrationOutcome> outcomes(members.size());
   CalibrationOutcome& outcome = outcomes.front();
-  outcome.settle_frames = plan.settle_frames;
-  double start = 0;  // progress fraction where the captures start
-  if (plan.auto_settle) {
-    // Settle by the measured display-to-capture latency of these cameras.
-    LatencyPlan probe{plan.output,
-                      static_cast<uint32_t>(plan.set.options.width),
-                      static_cast<uint32_t>(plan.set.options.height),
-                      plan.refresh_hz,
-                      {},
-                      plan.latency.latency_repeats,
-                      plan.latency.latency_timeout_s,
-                      plan.latency.margin_frames};
-    for (const auto& c : plan.cameras) probe.cameras.push_back(c.device);
-    CalibrationHooks probe_hooks{hooks.cancelled, [&](const CalibrationProgress& p) {
-                                   hooks.progress({0.1 * p.fraction, "latency", 0});
-                                 }};
-    auto measured = runLatencyProbe(probe, probe_hooks);
-    if (!measured) return tl::unexpected(measured.error());
-    outcome.settle_frames = measured->settle_frames;
-    outcome.latency = latencyJson(*measured, probe);
-    start = 0.1;
-  }
+  auto settled = settleFor(plan, hooks, outcome);
+  if (!settled) return tl::unexpected(settled.error());
+  const double start = *settled;  // progress fraction where the captures start
   std::vector<std::vector<cv::Mat>> captures(plan.cameras.size());
   int done = 0;
   for (std::size_t f = 0; f < plan.set.frames.size(); ++f) {
@@ -448,7 +465,7 @@ cv::Mat litPixels(const cv::Mat& white, const cv::Mat& light) {
 
 // Whether two plans can share a batch: the same frames on the same cameras, one route.
 bool batchable(const CalibrationPlan& a, const CalibrationPlan& b) {
-  if (a.board || b.board || a.set.frames.size() != b.set.frames.size() ||
+  if (a.board || b.board || a.tags || b.tags || a.set.frames.size() != b.set.frames.size() ||
       a.set.options.width != b.set.options.width || a.set.options.height != b.set.options.height ||
       a.set.options.mode != b.set.options.mode || a.response != b.response || a.auto_settle ||
       b.auto_settle || a.settle_frames != b.settle_frames || a.cameras.size() != b.cameras.size() ||

@@ -20,6 +20,7 @@
 #include "calibration/plane_homography_route.hpp"
 #include "calibration/stereo_route.hpp"
 #include "config.hpp"
+#include "drift_fiducial.hpp"
 #include "driver.hpp"
 #include "geometry/camera_model.hpp"
 #include "structured_light/pattern_set.hpp"
@@ -33,6 +34,8 @@ inline constexpr std::size_t kMaxCalibrationCameras = 8;
 // The calibrate request's arguments (PROTOCOL.md).
 struct CalibrationArgs {
   sl::Mode mode = sl::Mode::kGrayPhase;
+  // mode "apriltag": one frame of tags instead of the Gray sequence (route (b′) only).
+  bool tags = false;
   int step = 1;  // one code per `step` projector pixels
   int phase_steps = 8;
   int grid = 8;              // projector pixels between solved nodes
@@ -80,6 +83,10 @@ struct CalibrationCamera {
 
 struct CalibrationPlan {
   sl::PatternSet set;
+  // Set: the single-frame path, one frame of AprilTags over the framebuffer and one
+  // capture per camera; its corners are the nodes of route (b′) ([Raskar02] §4.2.4:
+  // on a plane a collineation needs only four). `set` then only sizes the frame.
+  std::shared_ptr<const FiducialFrame> tags;
   int grid = 8;
   int settle_frames = 2;
   bool auto_settle = false;   // measure the latency (latency_probe.hpp) and settle by it
@@ -105,8 +112,9 @@ struct CalibrationPlan {
   // together (calib::solveWallViews) after the last scan.
   bool wallViews() const { return plane && !board && cameras.size() > 1; }
 
+  int frames() const { return tags ? 1 : static_cast<int>(set.frames.size()); }
   int captures() const {
-    return static_cast<int>(set.frames.size() * cameras.size()) +
+    return static_cast<int>(frames() * cameras.size()) +
            (response ? static_cast<int>(kRampLevels.size()) : 0);
   }
   // The grey levels of the response ramp.
@@ -175,6 +183,19 @@ tl::expected<void, CalibrationFailure> blankOutput(const IdleOutput& idle);
 // Runs on a worker: blocks on the devices; never touches daemon state.
 tl::expected<CalibrationOutcome, CalibrationFailure> runCalibration(const CalibrationPlan& plan,
                                                                     const CalibrationHooks& hooks);
+
+// The frames to wait after showing a frame: the plan's, or with auto_settle measured by
+// the latency probe (outcome.settle_frames and .latency set either way). The progress
+// fraction the captures then start at (0, or 0.1 after the probe).
+tl::expected<double, CalibrationFailure> settleFor(const CalibrationPlan& plan,
+                                                   const CalibrationHooks& hooks,
+                                                   CalibrationOutcome& outcome);
+
+// The single-frame path (plan.tags, route (b′) with one camera and the plan's plane):
+// the tag frame shown, one capture per camera, the first camera's corners fitted and
+// solved as calib::solvePlaneFromNodes (tag_calibration_job.cpp).
+tl::expected<CalibrationOutcome, CalibrationFailure> runTagCalibration(
+    const CalibrationPlan& plan, const CalibrationHooks& hooks);
 
 // Several projectors whose images do not overlap scanned at once: every member shows
 // the same pattern frames (the same pattern set and cameras; no board), the captures are

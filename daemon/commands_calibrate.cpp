@@ -121,10 +121,21 @@ tl::expected<CalibrationPlan, Failure> makePlan(DeviceSet& devices, const Calibr
                       "\"aprilgrid:6x4:0.15\"), or put surface.plane in the rig model"});
     }
   }
+  if (args.tags && (!planar || several || args.board)) {
+    return tl::unexpected(Failure{
+        code::kBadArgument,
+        "\"mode\": \"apriltag\" is route (b′) with one camera and the display plane (\"plane\" "
+        "or the rig model's surface plane), not with a board or several cameras"});
+  }
   uint32_t w = 0, h = 0;
   const auto& raw = out->device.raw();
   if (raw.ops.output->get_mode(raw.self, &w, &h, &plan.refresh_hz) != PROCAM_OK || w < 2 || h < 2) {
     return tl::unexpected(Failure{code::kUnavailable, "output '" + out->name + "' has no mode"});
+  }
+  if (args.tags) {
+    auto tags = makeFiducialFrame({static_cast<int>(w), static_cast<int>(h)});
+    if (!tags) return tl::unexpected(Failure{code::kUnavailable, tags.error()});
+    plan.tags = *tags;
   }
   if (!(plan.refresh_hz > 0)) plan.refresh_hz = 60;
   sl::PatternOptions po;
@@ -451,16 +462,17 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
                   {"output", plan->output.name},
                   {"cameras", cameras},
                   {"route", plan->planar() ? "b'" : "a"},
-                  {"mode", sl::toString(plan->set.options.mode)},
-                  {"frames", plan->set.frames.size()},
+                  {"mode", plan->tags ? std::string("apriltag")
+                                      : std::string(sl::toString(plan->set.options.mode))},
+                  {"frames", plan->frames()},
                   {"captures", captures},
                   {"settle_frames", plan->auto_settle ? json("auto") : json(plan->settle_frames)}};
   if (plans.size() > 1 || !args->outputs.empty() || args->all_outputs) {
     started["outputs"] = output_names;
   }
   replyTo(client, req, "CALIBRATE", started);
-  logInfo("calibration " + op_id + ": " + std::to_string(plan->set.frames.size()) +
-          " pattern frames on " + output_names.dump());
+  logInfo("calibration " + op_id + ": " + std::to_string(plan->frames()) + " pattern frame(s) on " +
+          output_names.dump());
   auto progress = [op_id, captures](const CalibrationProgress& p) {
     return json{{"operation", op_id}, {"kind", "calibrate"},  {"fraction", p.fraction},
                 {"stage", p.stage},   {"capture", p.capture}, {"captures", captures}};

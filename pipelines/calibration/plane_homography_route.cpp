@@ -49,16 +49,29 @@ Result<CollineationNodes> collineationNodes(const sl::PatternSet& set, const Dec
   auto samples = surface::sampleProjectorGrid(view.decoded, pw, ph,
                                               {.step = o.step, .radius = sampleRadius(set)});
   if (!samples) return tl::unexpected(samples.error());
+  return collineationOfPoints(samples->projector, samples->camera, camera, view.name, o);
+}
+
+Result<CollineationNodes> collineationOfPoints(const Points2& projector, const Points2& seen_px,
+                                               const geom::CameraModel& camera,
+                                               const std::string& name,
+                                               const PlaneHomographyOptions& o) {
+  if (projector.size() != seen_px.size()) {
+    return fail(ErrorCode::kInvalidInput, "projector and camera points differ in number");
+  }
   Points2 proj, cam;
-  for (std::size_t i = 0; i < samples->camera.size(); ++i) {
-    const Vec2& seen = samples->camera[i];
+  for (std::size_t i = 0; i < seen_px.size(); ++i) {
+    const Vec2& seen = seen_px[i];
+    if (!seen.allFinite() || !projector[i].allFinite()) {
+      return fail(ErrorCode::kInvalidInput, "a point seen by camera '" + name + "' is not finite");
+    }
     const double m = o.edge_margin_px;
     if (seen.x() < m || seen.y() < m || seen.x() > camera.width - 1 - m ||
         seen.y() > camera.height - 1 - m)
       continue;
     auto ideal = camera.undistortPixel(seen);
     if (!ideal) continue;
-    proj.push_back(samples->projector[i]);
+    proj.push_back(projector[i]);
     cam.push_back(*ideal);
   }
   CollineationNodes out;
@@ -67,7 +80,7 @@ Result<CollineationNodes> collineationNodes(const sl::PatternSet& set, const Dec
   const std::size_t min_points = std::max<std::size_t>(o.min_points, 4);
   if (proj.size() < min_points)
     return fail(ErrorCode::kTooFewPoints,
-                "camera '" + view.name + "' saw only " + std::to_string(proj.size()) +
+                "camera '" + name + "' saw only " + std::to_string(proj.size()) +
                     " projector nodes (need " + std::to_string(min_points) + ")");
 
   // Robust support (RANSAC); the caller fits the inliers alone.
@@ -76,7 +89,7 @@ Result<CollineationNodes> collineationNodes(const sl::PatternSet& set, const Dec
                                         o.ransac_threshold_px, mask, 2000, 0.999);
   if (H0.empty())
     return fail(ErrorCode::kDegenerate,
-                "camera '" + view.name + "': no collineation fits the projector nodes it saw");
+                "camera '" + name + "': no collineation fits the projector nodes it saw");
   for (std::size_t i = 0; i < proj.size(); ++i) {
     if (!mask[i]) continue;
     out.projector.push_back(proj[i]);
@@ -129,19 +142,30 @@ Result<PlaneHomographyResult> solvePlaneHomographyRoute(const sl::PatternSet& se
   const double n_norm = plane_in.n.norm();
   if (!plane_in.n.allFinite() || !std::isfinite(plane_in.d) || !(n_norm > 1e-9))
     return fail(ErrorCode::kInvalidInput, "the display plane must be finite with a normal");
-  const geom::Plane plane{plane_in.n / n_norm, plane_in.d / n_norm};
-  const int pw = set.options.width, ph = set.options.height;
   auto nodes = collineationNodes(set, view, o);
   if (!nodes) return tl::unexpected(nodes.error());
-  const Points2& proj_in = nodes->projector;
-  const Points2& cam_in = nodes->camera;
+  return solvePlaneFromNodes(*nodes, camera, view.name, plane_in, set.options.width,
+                             set.options.height, o);
+}
+
+Result<PlaneHomographyResult> solvePlaneFromNodes(const CollineationNodes& nodes,
+                                                  const geom::CameraModel& camera,
+                                                  const std::string& name,
+                                                  const geom::Plane& plane_in, int pw, int ph,
+                                                  const PlaneHomographyOptions& o) {
+  const double n_norm = plane_in.n.norm();
+  if (!plane_in.n.allFinite() || !std::isfinite(plane_in.d) || !(n_norm > 1e-9))
+    return fail(ErrorCode::kInvalidInput, "the display plane must be finite with a normal");
+  const geom::Plane plane{plane_in.n / n_norm, plane_in.d / n_norm};
+  const Points2& proj_in = nodes.projector;
+  const Points2& cam_in = nodes.camera;
   PlaneHomographyResult out;
-  out.samples = nodes->samples;
+  out.samples = nodes.samples;
   out.inliers = proj_in.size();
   out.coverage = coverageOf(proj_in, pw, ph);
   if (out.coverage < o.min_coverage)
     return fail(ErrorCode::kDegenerate,
-                "camera '" + view.name + "' sees " + std::to_string(100 * out.coverage) +
+                "camera '" + name + "' sees " + std::to_string(100 * out.coverage) +
                     " % of the projector's image; the collineation would be extrapolated "
                     "(aim the camera at the projection)");
   auto fit = geom::fitHomography(proj_in, cam_in);
@@ -158,7 +182,7 @@ Result<PlaneHomographyResult> solvePlaneHomographyRoute(const sl::PatternSet& se
   }
   out.rms_projector_px = std::sqrt(sum / double(proj_in.size()));
 
-  auto on_plane = planeFromCamera(camera, plane, cam_in, view.name);
+  auto on_plane = planeFromCamera(camera, plane, cam_in, name);
   if (!on_plane) return tl::unexpected(on_plane.error());
   Mat3 H = on_plane->H * fit->H;  // [Raskar02] §4.2.4: A_wp = A_wc^-1 A_cp
   H /= H.norm();

@@ -62,6 +62,15 @@ struct CollineationNodes {
 Result<CollineationNodes> collineationNodes(const sl::PatternSet& set, const DecodedView& view,
                                             const PlaneHomographyOptions& options = {});
 
+// The same from points found otherwise (a fiducial frame's corners): `projector`
+// pixels and the (distorted) camera pixels `seen` that saw them, one to one; the edge
+// margin and RANSAC as above. kInvalidInput for lists of different lengths or a
+// non-finite point.
+Result<CollineationNodes> collineationOfPoints(const Points2& projector, const Points2& seen,
+                                               const geom::CameraModel& camera,
+                                               const std::string& name,
+                                               const PlaneHomographyOptions& options = {});
+
 // The convex hull of `points` (projector pixels) over the w x h frame: how much of a
 // projector's image its nodes span.
 double coverageOf(const Points2& points, int w, int h);
@@ -84,5 +93,13 @@ Result<PlaneHomographyResult> solvePlaneHomographyRoute(const sl::PatternSet& se
                                                         const DecodedView& view,
                                                         const geom::Plane& plane,
                                                         const PlaneHomographyOptions& options = {});
+
+// The route's solve from nodes already found (collineationNodes, collineationOfPoints)
+// by `camera` (named `name`) of a `width` x `height` projector; its errors as above.
+Result<PlaneHomographyResult> solvePlaneFromNodes(const CollineationNodes& nodes,
+                                                  const geom::CameraModel& camera,
+                                                  const std::string& name, const geom::Plane& plane,
+                                                  int width, int height,
+                                                  const PlaneHomographyOptions& options = {});
 
 }  // namespace procam::calib

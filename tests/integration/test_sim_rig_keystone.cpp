@@ -191,6 +191,55 @@ TEST(SimRigKeystone, CalibratedPlanarWallKeystonesFromTheRig) {
   EXPECT_EQ((*manual)["rig"], false);
 }
 
+// The single-frame path: one frame of AprilTags and one capture instead of the Gray-code
+// sequence, with the camera's calibration and the wall's plane as above; the tag corners
+// fix the projector's collineation with the wall, and the keystone from it is judged
+// with the true projector against the same bounds.
+TEST(SimRigKeystone, OneTagFrameCalibratesThePlanarWall) {
+  auto scene = sim::resolveScene("wall_oblique");
+  ASSERT_TRUE(scene) << scene.error().message;
+  const geom::CameraModel truth = scene->at(0).projectors.at(0).model;
+  TempDir dir;
+  DaemonProcess d(dir, simWithTruth(dir, "wall_oblique", TruthParts::kCamerasOnly));
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  // Gray-code arguments and a response ramp have no meaning for one tag frame.
+  for (const json& bad : {json{{"cmd", "calibrate"}, {"mode", "apriltag"}, {"step", 4}},
+                          json{{"cmd", "calibrate"}, {"mode", "apriltag"}, {"response", true}},
+                          json{{"cmd", "calibrate"}, {"mode", "apriltags"}}}) {
+    auto r = c.call(bad);
+    ASSERT_TRUE(r);
+    EXPECT_EQ((*r)["code"], "bad-argument") << r->dump();
+  }
+  const json request = {{"cmd", "calibrate"},
+                        {"id", 1},
+                        {"mode", "apriltag"},
+                        {"plane", kWallPlane},
+                        {"settle_frames", 0}};
+  const auto t0 = std::chrono::steady_clock::now();
+  auto started = c.call(request);
+  ASSERT_TRUE(started);
+  ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
+  EXPECT_EQ((*started)["route"], "b'");
+  EXPECT_EQ((*started)["mode"], "apriltag");
+  EXPECT_EQ((*started)["frames"], 1);
+  EXPECT_EQ((*started)["captures"], 1);
+  auto done = finalReply(c, 1, 120s);
+  ASSERT_TRUE(done) << d.log();
+  ASSERT_EQ((*done)["class"], "CALIBRATE") << done->dump();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const json& fit = (*done)["homography"];
+  std::printf(
+      "[ figures  ] one tag frame: calibrate %.2f s, %d tag corners found, collineation RMS "
+      "%.4f camera px / %.4f projector px, %d of %d corners, coverage %.1f %%\n",
+      seconds, (*done)["decoded"][0].get<int>(), fit["rms_camera_px"].get<double>(),
+      fit["rms_projector_px"].get<double>(), fit["inliers"].get<int>(), fit["samples"].get<int>(),
+      100 * fit["coverage"].get<double>());
+  EXPECT_EQ(fit["inliers"], fit["samples"]);
+  ASSERT_NO_FATAL_FAILURE(keystoneFromTheRigMatchesTruth(c, dir, truth));
+}
+
 // Nothing from truth but the camera's calibration: the wall is found from a board
 // fixed on it (wall_oblique_board: a checkerboard of 9x6 inner corners, 12 cm squares,
 // lit by the white frame of the calibration sequence; [Raskar02] §4.2.4 needs the

@@ -1,0 +1,93 @@
+// The calibrate operation's single-frame path ("mode": "apriltag"): one frame of
+// tag36h11 AprilTags over the projector's framebuffer, one capture per camera, and the
+// tag corners the first camera finds as the nodes of route (b′) ([Raskar02] §4.2.4: on a
+// plane one collineation maps the projector's pixels to the camera's, and four points
+// fix it; 32 tags give 128). On a worker; never touches daemon state.
+#include <opencv2/core.hpp>
+
+#include "calibration/plane_homography_route.hpp"
+#include "calibration_job.hpp"
+#include "output_frames.hpp"
+#include "protocol.hpp"
+
+namespace procam::daemon {
+
+namespace code = proto::code;
+
+namespace {
+
+// The capture as 8 bits for the tag detector (deeper cameras stretched to their range).
+cv::Mat eightBit(const cv::Mat& grey) {
+  if (grey.depth() == CV_8U) return grey;
+  cv::Mat out;
+  cv::normalize(grey, out, 0, 255, cv::NORM_MINMAX, CV_8U);
+  return out;
+}
+
+}  // namespace
+
+tl::expected<CalibrationOutcome, CalibrationFailure> runTagCalibration(
+    const CalibrationPlan& plan, const CalibrationHooks& hooks) {
+  const CalibrationFailure cancelled{code::kCancelled, "calibration cancelled"};
+  const auto failed = [&](const std::string& why) {
+    return tl::unexpected(CalibrationFailure{code::kFailed, why});
+  };
+  if (!plan.tags || !plan.plane || plan.cameras.empty()) {
+    return failed("internal: the tag frame is route (b′) with a camera and a plane");
+  }
+  CalibrationOutcome out;
+  auto settled = settleFor(plan, hooks, out);
+  if (!settled) return tl::unexpected(settled.error());
+  const double start = *settled;
+  if (hooks.cancelled()) return tl::unexpected(cancelled);
+  procam_image frame = rgbImage(plan.tags->rgb);
+  char err[256] = {0};
+  const auto& raw = plan.output.device->raw();
+  if (int rc = raw.ops.output->show(raw.self, &frame, err, sizeof err - 1); rc != PROCAM_OK) {
+    return tl::unexpected(deviceFailure("output", plan.output.name, rc, "show the tag frame", err));
+  }
+  if (!waitCancellable(out.settle_frames / plan.refresh_hz, hooks)) {
+    return tl::unexpected(cancelled);
+  }
+  std::vector<cv::Mat> captures;
+  for (std::size_t c = 0; c < plan.cameras.size(); ++c) {
+    auto grey = captureGray(plan.cameras[c].device);
+    if (!grey) return tl::unexpected(grey.error());
+    captures.push_back(std::move(*grey));
+    const int done = static_cast<int>(c + 1);
+    hooks.progress({start + (0.9 - start) * done / static_cast<double>(plan.cameras.size()),
+                    "capturing", done});
+    if (hooks.cancelled()) return tl::unexpected(cancelled);
+  }
+  const int total = plan.captures();
+  hooks.progress({0.9, "decoding", total});
+  const CalibrationCamera& cam = plan.cameras.front();
+  const cv::Mat& seen = captures.front();
+  if (seen.cols != cam.model.width || seen.rows != cam.model.height) {
+    return failed("captures of camera '" + cam.device.name + "' are " + std::to_string(seen.cols) +
+                  "x" + std::to_string(seen.rows) + " but its calibration is " +
+                  std::to_string(cam.model.width) + "x" + std::to_string(cam.model.height));
+  }
+  auto found = findFiducials(*plan.tags, eightBit(seen));
+  if (!found) return failed("camera '" + cam.device.name + "': " + found.error());
+  out.decoded.push_back(static_cast<int>(found->size()));
+  if (found->empty()) {
+    return failed("camera '" + cam.device.name + "' found no tag of output '" + plan.output.name +
+                  "': it does not see the projected tags");
+  }
+  hooks.progress({0.95, "solving", total});
+  Points2 projector, camera;
+  for (const drift::FiducialCorner& c : *found) {
+    projector.push_back(c.drawn);
+    camera.push_back(c.camera);
+  }
+  auto nodes = calib::collineationOfPoints(projector, camera, cam.model, cam.device.name);
+  if (!nodes) return failed(nodes.error().message);
+  auto planar = calib::solvePlaneFromNodes(*nodes, cam.model, cam.device.name, *plan.plane,
+                                           plan.set.options.width, plan.set.options.height);
+  if (!planar) return failed(planar.error().message);
+  out.planar = std::move(*planar);
+  return out;
+}
+
+}  // namespace procam::daemon
