@@ -288,7 +288,7 @@ class Daemon {
   void correctDrift(const std::string& output, const std::string& camera,
                     const drift::Misregistration& m);
   // The output left alone until a check finds it registered: `step` could not be made.
-  void unresolveDrift(const std::string& output, const std::string& camera, const char* step,
+  void unresolveDrift(const std::string& output, const std::string& camera, const std::string& step,
                       const std::string& why, const drift::Misregistration& m);
   void correctCamera(const std::string& output, const std::string& camera,
                      const drift::Misregistration& m);

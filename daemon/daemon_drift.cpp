@@ -360,8 +360,13 @@ void Daemon::onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, Calibr
     (ov->second.last->rms_px <= threshold ? other_registered : other_drifted) = true;
   }
   if (!other_registered && o.cameras.size() > 1 && !other_drifted) return;  // not looked since
-  const char* step = other_registered ? "camera-pose" : "projector-pose";
   if (o.passes >= kMaxPasses) {
+    // Named by the last correction made (a surface step too), else by whose drift it is.
+    std::string step = other_registered ? "camera-pose" : "projector-pose";
+    if (o.last_correction.is_object() && o.last_correction.contains("step") &&
+        o.last_correction["step"].is_string()) {
+      step = o.last_correction["step"].get<std::string>();
+    }
     // Corrections that do not converge are not kept: the devices as they were before
     // them (the last state a check confirmed) go back into rig.json.
     unresolveDrift(key.output, key.camera, step,
@@ -522,8 +527,9 @@ void Daemon::correctSurface(const std::string& output, const std::string& camera
                        "corrected-surface");
 }
 
-void Daemon::unresolveDrift(const std::string& output, const std::string& camera, const char* step,
-                            const std::string& why, const drift::Misregistration& m) {
+void Daemon::unresolveDrift(const std::string& output, const std::string& camera,
+                            const std::string& step, const std::string& why,
+                            const drift::Misregistration& m) {
   DriftRuntime::Output& o = drift_rt_.outputs[output];
   o.unresolved = true;
   o.last_correction = {{"step", step}, {"camera", camera}, {"ok", false}, {"why", why}};
