@@ -247,7 +247,8 @@ Learnt learntByPlaneRoute(const CalibrationPlan& plan, const CalibrationOutcome&
     }
   }
   projector.calibrated = {
-      "structured light, route (b′): " + cameras + ", plane from the " +
+      std::string(plan.tags ? "one AprilTag frame" : "structured light") +
+          ", route (b′): " + cameras + ", plane from the " +
           (result.board                ? "board " + plan.board_text
            : result.triangulated_plane ? "cameras " + plan.cameras.at(0).device.name + " and " +
                                              plan.cameras.at(1).device.name + " (a planar scene)"

@@ -34,6 +34,11 @@ namespace {
 // which no pose explains).
 constexpr int kMaxPasses = 3;
 
+// Fiducial frames an output may show between two at drift_fiducial_period_s, to confirm
+// drift and check corrections: the bump on wall_oblique under grey content took 4 (a
+// settle of 0.5 s, one correction); three more passes, room to spare.
+constexpr int kQuickFiducials = 12;
+
 double secondsSince(DriftRuntime::Clock::time_point t) {
   return std::chrono::duration<double>(DriftRuntime::Clock::now() - t).count();
 }
@@ -174,7 +179,7 @@ void Daemon::checkDrift() {
   plan.frames = config_.drift.frames;
   if (fiducial) {
     // The frames wait while the fiducial frame is up (refreshOutputs).
-    plan.fiducial = d.fiducial;
+    plan.fiducial = d.fiducial.at({p->width, p->height});
     plan.output_device = {out.name, out.device.share()};
     plan.settle_s = settle;
     d.fiducial_showing = true;
@@ -205,8 +210,9 @@ bool Daemon::fiducialDue(DriftRuntime::Output& o, const DriftRuntime::View& view
                          const KeystoneRuntime::OutputState& shown, cv::Size framebuffer) {
   DriftRuntime& d = drift_rt_;
   // Only where the content this camera last looked at was too plain to register, never
-  // with "on-drift-silent"; at the period, and at every check while drift one saw is
-  // confirmed or a correction of it checked.
+  // with "on-drift-silent"; at the period, and sooner (every camera's check) while drift
+  // a camera saw is confirmed or a correction of it checked: at most kQuickFiducials
+  // frames between two at the period, none while the output is unresolved.
   const bool plain = view.plain_setup && view.plain_setup == shown.shown_setup &&
                      view.plain_image == shown.shown_image;
   if (!plain || config_.recalibrate != RecalibratePolicy::kOnDrift ||
@@ -215,18 +221,21 @@ bool Daemon::fiducialDue(DriftRuntime::Output& o, const DriftRuntime::View& view
   }
   const bool due =
       !o.fiducial_at || secondsSince(*o.fiducial_at) >= config_.drift.fiducial_period_s;
-  if (!due && !view.above && o.passes == 0) return false;
-  if (!d.fiducial || d.fiducial->rgb.size() != framebuffer) {
-    d.fiducial.reset();
+  const bool quick =
+      !o.unresolved && (o.drifted() || o.passes > 0) && o.quick_fiducials < kQuickFiducials;
+  if (!due && !quick) return false;
+  const std::pair<int, int> size{framebuffer.width, framebuffer.height};
+  if (!d.fiducial.count(size)) {
     auto made = makeFiducialFrame(framebuffer);
     if (!made) {
       if (d.fiducial_unavailable != made.error()) warn("drift: " + made.error());
       d.fiducial_unavailable = made.error();
       return false;
     }
-    d.fiducial = *made;
+    d.fiducial[size] = *made;
     d.fiducial_unavailable.clear();
   }
+  o.quick_fiducials = due ? 0 : o.quick_fiducials + 1;
   return true;
 }
 
@@ -512,7 +521,8 @@ void Daemon::correctSurface(const std::string& output, const std::string& camera
                     {"threshold_px", config_.drift.threshold_px},
                     {"wall_offset_mm", 1e3 * wall.offset_m},
                     {"wall_offset_se_mm", 1e3 * wall.offset_se_m},
-                    {"wall_turned_deg", wall.tilt_deg}};
+                    {"wall_turned_deg", wall.tilt_deg},
+                    {"plane_kept", drift::wallTurned(wall) ? "fitted" : "shifted"}};
   logInfo("drift: output '" + output + "': the wall moved " + std::to_string(1e3 * wall.offset_m) +
           " mm (turned " + std::to_string(wall.tilt_deg) +
           " deg); the rig's plane measured again from " + std::to_string(wall.points) +

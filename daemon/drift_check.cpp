@@ -133,7 +133,9 @@ tl::expected<DriftCheck, CalibrationFailure> runFiducialCheck(const DriftCheckPl
     return tl::unexpected(
         CalibrationFailure{code::kFailed, "drift check of output '" + plan.output + "': " + why});
   };
-  if (f.rgb.size() != plan.framebuffer || !plan.output_device.device) {
+  if (!plan.output_device.device)
+    return failed("internal: no output to show the fiducial frame on");
+  if (f.rgb.size() != plan.framebuffer) {
     return failed("the fiducial frame is not the framebuffer's size");
   }
   procam_image frame = rgbImage(f.rgb);
@@ -149,9 +151,7 @@ tl::expected<DriftCheck, CalibrationFailure> runFiducialCheck(const DriftCheckPl
   if (!mean) return tl::unexpected(mean.error());
   out.capture_s = since(capture);
   const auto measure = Clock::now();
-  cv::Mat grey;
-  mean->convertTo(grey, CV_8U);
-  auto found = findFiducials(f, grey);
+  auto found = findFiducials(f, *mean);
   if (!found) return failed(found.error());
   // As with content: only corners this projector alone lights (a neighbour's light adds
   // to the tags in a blended overlap).

@@ -46,9 +46,10 @@ struct DriftCheckPlan {
   int frames = 2;  // camera frames averaged
   // Waited on before the first capture: the device manager's reads of the camera end.
   ReadFence fence;
-  // Set: a fiducial check. The frame is shown on `output_device` (its size the framebuffer's)
-  // and the capture starts `settle_s` later; the output keeps showing it (the daemon
-  // draws the content again). The reference is then not made, nor needed.
+  // Set: a fiducial check. The frame is shown on `output_device` (its size the
+  // framebuffer's) and the capture starts `settle_s` later; the output keeps showing it
+  // (the daemon draws the content again). The reference is made all the same, before
+  // the frame is shown: the corrections read the camera's map from it.
   std::shared_ptr<const FiducialFrame> fiducial;
   CalibrationDevice output_device;
   double settle_s = 0.1;

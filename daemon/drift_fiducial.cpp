@@ -4,6 +4,25 @@
 
 namespace procam::daemon {
 
+namespace {
+
+// The camera's image as 8 bits for the detector: 8-bit values as they are, deeper ones
+// (a 16-bit camera, or a mean of frames beyond 255) stretched over their range.
+cv::Mat eightBit(const cv::Mat& grey) {
+  if (grey.type() == CV_8UC1) return grey;
+  double lo = 0, hi = 0;
+  cv::minMaxLoc(grey, &lo, &hi);
+  cv::Mat out;
+  if (lo >= 0 && hi <= 255) {
+    grey.convertTo(out, CV_8U);
+  } else {
+    cv::normalize(grey, out, 0, 255, cv::NORM_MINMAX, CV_8U);
+  }
+  return out;
+}
+
+}  // namespace
+
 tl::expected<std::shared_ptr<const FiducialFrame>, std::string> makeFiducialFrame(cv::Size size) {
   auto grid = sl::makeTagGrid({.width = size.width, .height = size.height});
   if (!grid) return tl::unexpected("the fiducial frame: " + grid.error().message);
@@ -20,7 +39,10 @@ tl::expected<std::shared_ptr<const FiducialFrame>, std::string> makeFiducialFram
 
 tl::expected<std::vector<drift::FiducialCorner>, std::string> findFiducials(
     const FiducialFrame& frame, const cv::Mat& grey) {
-  auto found = sl::detectTagGrid(frame.grid, grey);
+  if (grey.empty() || grey.channels() != 1) {
+    return tl::unexpected(std::string("the fiducial frame's tags: not a grey image"));
+  }
+  auto found = sl::detectTagGrid(frame.grid, eightBit(grey));
   if (!found) return tl::unexpected("the fiducial frame's tags: " + found.error().message);
   std::vector<drift::FiducialCorner> out;
   out.reserve(found->size());

@@ -23,8 +23,8 @@ struct FiducialFrame {
 // For a framebuffer of `size`; the reason when none can be made.
 tl::expected<std::shared_ptr<const FiducialFrame>, std::string> makeFiducialFrame(cv::Size size);
 
-// The tag corners found in `grey` (CV_8UC1), each with the framebuffer pixel it was
-// drawn at.
+// The tag corners found in `grey` (one channel, any depth: deeper than 8 bits it is
+// stretched over its range), each with the framebuffer pixel it was drawn at.
 tl::expected<std::vector<drift::FiducialCorner>, std::string> findFiducials(
     const FiducialFrame& frame, const cv::Mat& grey);
 

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "drift_check.hpp"
@@ -62,6 +63,7 @@ struct DriftRuntime {
     uint64_t fiducial_checks = 0;
     std::optional<Clock::time_point> fiducial_at;
     std::optional<double> fiducial_px;  // the last fiducial check's misregistration
+    int quick_fiducials = 0;            // shown since the last one at the period
     const View* lastView() const {
       auto it = views.find(camera);
       return it == views.end() ? nullptr : &it->second;
@@ -78,8 +80,8 @@ struct DriftRuntime {
   std::string camera_in_use;      // the camera it drives: the device manager keeps off it
   bool writing = false;           // a corrected rig model on its way to rig.json
   bool fiducial_showing = false;  // a fiducial frame is on an output: frames wait
-  // The fiducial frame, made once per framebuffer size; why there is none.
-  std::shared_ptr<const FiducialFrame> fiducial;
+  // The fiducial frames, made once per framebuffer size; why there is none.
+  std::map<std::pair<int, int>, std::shared_ptr<const FiducialFrame>> fiducial;
   std::string fiducial_unavailable;
   uint64_t next = 0;  // round robin over the outputs
   std::map<std::string, Output> outputs;

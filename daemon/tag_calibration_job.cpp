@@ -14,18 +14,6 @@ namespace procam::daemon {
 
 namespace code = proto::code;
 
-namespace {
-
-// The capture as 8 bits for the tag detector (deeper cameras stretched to their range).
-cv::Mat eightBit(const cv::Mat& grey) {
-  if (grey.depth() == CV_8U) return grey;
-  cv::Mat out;
-  cv::normalize(grey, out, 0, 255, cv::NORM_MINMAX, CV_8U);
-  return out;
-}
-
-}  // namespace
-
 tl::expected<CalibrationOutcome, CalibrationFailure> runTagCalibration(
     const CalibrationPlan& plan, const CalibrationHooks& hooks) {
   const CalibrationFailure cancelled{code::kCancelled, "calibration cancelled"};
@@ -68,7 +56,7 @@ tl::expected<CalibrationOutcome, CalibrationFailure> runTagCalibration(
                   "x" + std::to_string(seen.rows) + " but its calibration is " +
                   std::to_string(cam.model.width) + "x" + std::to_string(cam.model.height));
   }
-  auto found = findFiducials(*plan.tags, eightBit(seen));
+  auto found = findFiducials(*plan.tags, seen);
   if (!found) return failed("camera '" + cam.device.name + "': " + found.error());
   out.decoded.push_back(static_cast<int>(found->size()));
   if (found->empty()) {

@@ -1,6 +1,7 @@
 #include "fiducial_misregistration.hpp"
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <vector>
 
 #include "geometry/intersect.hpp"
@@ -49,6 +50,9 @@ Result<Misregistration> fiducialMisregistration(std::span<const Vec2> shown,
     t.response = 1.0;  // a decoded marker: no correlation peak to weigh it by
     tiles.push_back(t);
   }
+  // A projector that moved may bring corners into view the rig model puts outside it.
+  m.tiles_seen = std::max(m.tiles_seen, static_cast<int>(tiles.size()));
+  m.tiles_textured = m.tiles_seen;
   fitShiftField(std::move(tiles), options, m);
   return m;
 }

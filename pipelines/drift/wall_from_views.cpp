@@ -78,9 +78,12 @@ bool wallMoved(const WallSeen& seen, double min_offset_m, double min_tilt_deg) {
          (seen.tilt_deg > min_tilt_deg && seen.tilt_deg > 6 * seen.tilt_se_deg);
 }
 
-geom::Plane wallToKeep(const WallSeen& seen, double min_tilt_deg) {
-  const bool turned = seen.tilt_deg > min_tilt_deg && seen.tilt_deg > 6 * seen.tilt_se_deg;
-  return turned ? seen.plane : seen.shifted;
+bool wallTurned(const WallSeen& seen) {
+  return seen.tilt_deg > 6 * seen.tilt_se_deg && seen.tilt_deg > seen.tilt_floor_deg;
+}
+
+geom::Plane wallToKeep(const WallSeen& seen) {
+  return wallTurned(seen) ? seen.plane : seen.shifted;
 }
 
 Result<WallSeen> wallFromTwoViews(const WallView& a, const WallView& b,
@@ -180,7 +183,10 @@ Result<WallSeen> wallFromOneCamera(const rig::RigProjector& projector,
                     std::to_string(turn_deg) + " deg");
   }
   auto seen = wallFromProjectorAndView(projector.model(), camera, rig_plane);
-  if (seen) seen->projector_turn_deg = turn_deg;
+  if (seen) {
+    seen->projector_turn_deg = turn_deg;
+    seen->tilt_floor_deg = kOneCameraTiltFloorDeg;
+  }
   return seen;
 }
 

@@ -39,6 +39,8 @@ struct WallSeen {
   double gap_rms_m = 0, shift_rms_m = 0;
   // wallFromOneCamera: how far the projector would have turned had it moved instead.
   double projector_turn_deg = 0;
+  // A turn under this is not kept (wallTurned); wallFromOneCamera sets it.
+  double tilt_floor_deg = 0;
   double offset_m = 0;     // the points' mean signed distance from the rig's plane
   double offset_se_m = 0;  // its standard error
   double tilt_deg = 0;     // between the fitted plane and the rig's
@@ -53,11 +55,19 @@ inline constexpr double kMaxRayGapM = 0.005;
 // than six of its standard errors.
 bool wallMoved(const WallSeen& seen, double min_offset_m = 0.002, double min_tilt_deg = 0.3);
 
-// The wall to keep: the fitted plane when it turned (by wallMoved's tilt test), else the
-// rig's plane shifted by the points' mean distance from it. A tilt within its noise is
-// not fitted: one camera's points tilt by their noise (0.0175 deg on wall_oblique, which
-// moves the content 0.4 projector px at the wall's far edge).
-geom::Plane wallToKeep(const WallSeen& seen, double min_tilt_deg = 0.3);
+// Whether the fitted plane turned from the rig's by more than six of its standard errors
+// and more than seen.tilt_floor_deg.
+bool wallTurned(const WallSeen& seen);
+
+// The wall to keep: the fitted plane when it turned (wallTurned), else the rig's plane
+// shifted by the points' mean distance from it.
+geom::Plane wallToKeep(const WallSeen& seen);
+
+// One camera's points tilt the plane beyond what their scatter says (their errors share
+// the one view's geometry): 0.0178 deg, 7 of its standard errors, for the wall moved
+// 1 cm on wall_oblique, which moves the content 0.37 projector px at the wall's far
+// edge. A turn under this is not kept from one camera.
+inline constexpr double kOneCameraTiltFloorDeg = 0.1;
 
 // kTooFewPoints under 8 content points both cameras registered (inlier tiles of the same
 // framebuffer point whose rays meet within kMaxRayGapM); kInvalidInput for a missing or

@@ -444,19 +444,21 @@ TEST(SimDrift, ACameraUnpluggedAfterDriftWasSeenLeavesTheRigUntilItIsBack) {
 // procamd with recalibrate = "on-drift" on wall_oblique with a second camera (or with
 // its one) and `events`, a watcher on its events and textured content shown.
 struct DriftRig {
-  DriftRig(const TempDir& dir, const std::string& events, bool second_camera = true)
+  DriftRig(const TempDir& dir, const std::string& events, bool second_camera = true,
+           const std::string& more_policy = "")
       : scene_file(sceneWithEvents(
             dir, (second_camera ? std::string(drift::kSecondCamera) : std::string()) + events)),
         scene(sim::resolveScene(scene_file)),
-        d(dir, driftDaemon(dir, "on-drift", scene_file)),
+        d(dir, driftDaemon(dir, "on-drift", scene_file, {}, more_policy)),
         c(d.socketPath()),
         watcher(d.socketPath()) {}
-  // Fatal failures of the set-up; call first.
-  void start(const TempDir& dir) {
+  // Fatal failures of the set-up; call first. `png`: the content (default: textured).
+  void start(const TempDir& dir, std::string png = "") {
     ASSERT_TRUE(scene) << scene.error().message;
     ASSERT_TRUE(d.started()) << d.log();
     ASSERT_TRUE(watcher.call({{"cmd", "watch"}}));
-    ASSERT_NO_FATAL_FAILURE(showContent(c, texturedContent(dir)));
+    if (png.empty()) png = texturedContent(dir);
+    ASSERT_NO_FATAL_FAILURE(showContent(c, png));
   }
   std::string scene_file;
   Result<sim::Scene> scene;
@@ -619,6 +621,33 @@ TEST(SimDrift, AMovedWallIsMeasuredAgainWithOneCamera) {
   TempDir dir;
   DriftRig r(dir, "[[events]]\nt = " + atText(6.0) + kWallMovedBack, false);
   expectMovedWallMeasuredAgain(dir, r, "the projector and camera 'cam'");
+}
+
+// Two fixed cameras and uniform grey content: the projector bumped 1 degree is found in a
+// fiducial frame by one camera, and every camera's next check shows one too, so the
+// other confirms it and the projector is corrected from the tag corners.
+TEST(SimDrift, PlainContentWithTwoCamerasIsCorrectedFromFiducialFrames) {
+  TempDir dir;
+  DriftRig r(
+      dir, "[[events]]\nt = " + atText(6.0) + "\ntarget = \"proj\"\nrotate_deg = [1.0, 0.0, 0.0]\n",
+      true, "drift_fiducial_period_s = 2\n");
+  const std::string png = contentFile(dir, "grey.png");
+  cv::imwrite(png, cv::Mat(900, 1600, CV_8UC3, cv::Scalar(128, 128, 128)));
+  ASSERT_NO_FATAL_FAILURE(r.start(dir, png));
+  bool registered = false;
+  const std::optional<json> corrected =
+      awaitCorrection(r.watcher, "corrected-pose", "corrected-surface", registered);
+  ASSERT_TRUE(corrected) << outputDrift(r.c).dump() << r.d.log();
+  EXPECT_TRUE(registered) << outputDrift(r.c).dump();
+  const json dr = outputDrift(r.c);
+  const double rig_px = rigAgainstTruth(dir, r.scene->at(at(7.0)).projectors.at(0).model);
+  std::printf(
+      "[ figures  ] two cameras, grey content, projector bumped 1 deg: corrected from %d tag "
+      "corners, the rig against the true projector %.3f px; %d fiducial frames\n",
+      (*corrected)["tiles"].get<int>(), rig_px, dr["fiducial"].value("frames", 0));
+  EXPECT_LE(rig_px, 0.5);
+  // A handful of frames, not one at every check.
+  EXPECT_LE(dr["fiducial"].value("frames", 0), 20) << dr.dump();
 }
 
 }  // namespace

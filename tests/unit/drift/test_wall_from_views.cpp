@@ -209,14 +209,22 @@ TEST(WallFromViews, AMoveOrTurnCountsOnlyAboveItsNoise) {
   seen.tilt_deg = 0.2;  // significant, but under the bound
   seen.tilt_se_deg = 0.01;
   EXPECT_FALSE(wallMoved(seen));
-  // The fitted plane is kept only when it turned; else the rig's plane, shifted.
+  // The fitted plane is kept when it turned beyond its noise (a turn under wallMoved's
+  // bound too, once the wall moved); else the rig's plane, shifted.
   seen.plane = {Vec3(0, 0.6, 0.8), -1};
   seen.shifted = {Vec3::UnitY(), -3.01};
-  EXPECT_EQ(wallToKeep(seen).n, Vec3::UnitY());
-  seen.tilt_deg = 0.5;
+  EXPECT_TRUE(wallTurned(seen));
   EXPECT_EQ(wallToKeep(seen).n, Vec3(0, 0.6, 0.8));
-  seen.tilt_se_deg = 0.1;  // within six standard errors
+  seen.tilt_se_deg = 0.05;  // within six standard errors
+  EXPECT_FALSE(wallTurned(seen));
+  EXPECT_EQ(wallToKeep(seen).n, Vec3::UnitY());
   EXPECT_EQ(wallToKeep(seen).d, -3.01);
+  seen.tilt_se_deg = 0.01;  // significant, but from one camera under its floor
+  seen.tilt_floor_deg = kOneCameraTiltFloorDeg;
+  seen.tilt_deg = 0.08;
+  EXPECT_FALSE(wallTurned(seen));
+  seen.tilt_deg = 0.2;
+  EXPECT_TRUE(wallTurned(seen));
 }
 
 TEST(WallFromViews, TooFewCommonTilesAndBadViewsAreRefused) {
