@@ -52,6 +52,17 @@ cv::Mat grayImage(const procam_image& img) {
   return {};
 }
 
+tl::expected<void, CalibrationFailure> showFrame(const CalibrationDevice& output,
+                                                 const cv::Mat& rgb, const char* what) {
+  procam_image frame = rgbImage(rgb);
+  char err[256] = {0};
+  const auto& raw = output.device->raw();
+  if (int rc = raw.ops.output->show(raw.self, &frame, err, sizeof err - 1); rc != PROCAM_OK) {
+    return tl::unexpected(deviceFailure("output", output.name, rc, what, err));
+  }
+  return {};
+}
+
 bool waitCancellable(double seconds, const CalibrationHooks& hooks) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   while (std::chrono::steady_clock::now() < end) {
@@ -107,12 +118,7 @@ tl::expected<bool, CalibrationFailure> showAndSettle(const CalibrationPlan& plan
                                                      const cv::Mat& rgb, const char* what,
                                                      int settle_frames,
                                                      const CalibrationHooks& hooks) {
-  procam_image frame = rgbImage(rgb);
-  char err[256] = {0};
-  const auto& raw = plan.output.device->raw();
-  if (int rc = raw.ops.output->show(raw.self, &frame, err, sizeof err - 1); rc != PROCAM_OK) {
-    return tl::unexpected(deviceFailure("output", plan.output.name, rc, what, err));
-  }
+  if (auto shown = showFrame(plan.output, rgb, what); !shown) return tl::unexpected(shown.error());
   return waitCancellable(settle_frames / plan.refresh_hz, hooks);
 }
 
@@ -160,13 +166,7 @@ tl::expected<void, CalibrationFailure> blankOutput(const CalibrationPlan& plan) 
 
 tl::expected<void, CalibrationFailure> blankOutput(const IdleOutput& idle) {
   const cv::Mat black(idle.height, idle.width, CV_8UC3, cv::Scalar::all(0));
-  procam_image frame = rgbImage(black);
-  char err[256] = {0};
-  const auto& raw = idle.output.device->raw();
-  if (int rc = raw.ops.output->show(raw.self, &frame, err, sizeof err - 1); rc != PROCAM_OK) {
-    return tl::unexpected(deviceFailure("output", idle.output.name, rc, "show black", err));
-  }
-  return {};
+  return showFrame(idle.output, black, "show black");
 }
 
 namespace {

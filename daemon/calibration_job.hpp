@@ -165,6 +165,10 @@ CalibrationFailure deviceFailure(const char* family, const std::string& name, in
 cv::Mat grayImage(const procam_image& img);
 // One frame of the camera as a single-channel image (5 s at most).
 tl::expected<cv::Mat, CalibrationFailure> captureGray(const CalibrationDevice& camera);
+// Shows `rgb` (CV_8UC3, the output's mode) 1:1 on `output`; the failure says `what` it
+// was doing.
+tl::expected<void, CalibrationFailure> showFrame(const CalibrationDevice& output,
+                                                 const cv::Mat& rgb, const char* what);
 // Waits `seconds`, waking every 20 ms to honour a cancel; false when cancelled.
 bool waitCancellable(double seconds, const CalibrationHooks& hooks);
 

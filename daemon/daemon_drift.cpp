@@ -9,16 +9,12 @@
 // fits no turned projector), is the wall's, whose plane is measured again
 // (drift/wall_from_views.hpp); other drift that every camera sees is the projector's,
 // whose pose and plane collineation are fitted again
-// (drift/projector_correction.hpp). Written to rig.json atomically; a failed step
-// keeps the last good rig. Loop thread only; the checks run on the compute worker between
-// the outputs' frames.
+// (drift/projector_correction.hpp); the steps themselves are in drift_corrections.cpp.
+// Loop thread only; the checks run on the compute worker between the outputs' frames.
 #include <cmath>
 
 #include "blend/rig_tiles.hpp"
 #include "daemon.hpp"
-#include "drift/camera_correction.hpp"
-#include "drift/projector_correction.hpp"
-#include "drift/wall_from_views.hpp"
 #include "log.hpp"
 #include "protocol.hpp"
 #include "rig_store.hpp"
@@ -38,29 +34,6 @@ constexpr int kMaxPasses = 3;
 // drift and check corrections: the bump on wall_oblique under grey content took 4 (a
 // settle of 0.5 s, one correction); three more passes, room to spare.
 constexpr int kQuickFiducials = 12;
-
-double secondsSince(DriftRuntime::Clock::time_point t) {
-  return std::chrono::duration<double>(DriftRuntime::Clock::now() - t).count();
-}
-
-// How long the output's drift has been seen (by the camera that saw it first).
-double heldFor(const DriftRuntime::Output& o) {
-  double held = 0;
-  for (const auto& [name, v] : o.views) {
-    if (v.above) held = std::max(held, secondsSince(*v.above));
-  }
-  return held;
-}
-
-json misregistrationJson(const drift::Misregistration& m) {
-  return {
-      {"misregistration_px", m.rms_px},
-      {"max_px", m.max_px},
-      {"confidence", m.confidence},
-      {"tiles", {{"seen", m.tiles_seen}, {"textured", m.tiles_textured}, {"used", m.tiles_used}}},
-      {"tile_rms_px", m.tile_rms_px},
-      {"too_plain", m.too_plain}};
-}
 
 }  // namespace
 
@@ -251,30 +224,6 @@ void Daemon::endFiducialFrame(const std::string& output) {
   refreshOutputs();  // the content again
 }
 
-namespace {
-
-// Keeps `projector` (or, given, `camera`) as it was before the first of the corrections
-// since the output was last registered: restored when they do not converge.
-void keepBefore(DriftRuntime::Output& o, const rig::RigProjector& projector,
-                const rig::RigCamera* camera) {
-  if (!o.before) o.before.emplace();
-  rig::RigModel& b = *o.before;
-  if (camera) {
-    if (!b.camera(camera->name)) b.cameras.push_back(*camera);
-  } else if (!b.projector(projector.name)) {
-    b.projectors.push_back(projector);
-  }
-}
-
-// `camera` (world -> camera) rigidly mounted on a projector that moved from `from` to `to`
-// (world -> projector): the camera-from-projector pose stays.
-geom::Pose carried(const geom::Pose& camera, const geom::Pose& from, const geom::Pose& to) {
-  const geom::Pose rel = camera.relativeTo(from);
-  return {rel.R * to.R, rel.R * to.t + rel.t};
-}
-
-}  // namespace
-
 void Daemon::onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, CalibrationFailure> r) {
   DriftRuntime& d = drift_rt_;
   d.checking = false;
@@ -410,259 +359,6 @@ void Daemon::onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, Calibr
                           "the projector and camera '" + key.camera + "'");
   }
   correctDrift(key.output, key.camera, m);
-}
-
-std::optional<drift::WallSeen> Daemon::movedWall(const std::string& output,
-                                                 const std::string& camera) {
-  DriftRuntime::Output& o = drift_rt_.outputs[output];
-  if (!rig_.surface.plane) return std::nullopt;
-  const auto viewOf = [&](const std::string& name) -> std::optional<drift::WallView> {
-    const rig::RigCamera* cam = rig_.camera(name);
-    auto v = o.views.find(name);
-    // Both checks against this rig model; so then is the reference, which a check sets
-    // before its result may be dropped and so is never older than `last`.
-    if (!cam || !cam->pose_known || v == o.views.end() || !v->second.last || !v->second.reference ||
-        v->second.last_generation != rig_generation_ || v->second.last->too_plain) {
-      return std::nullopt;
-    }
-    return drift::WallView{&cam->model, &*v->second.last, &v->second.reference->map,
-                           v->second.reference->grid};
-  };
-  const auto here = viewOf(camera);
-  const auto& above = o.views[camera].above;
-  if (!here || !above) return std::nullopt;
-  for (const std::string& name : o.cameras) {
-    if (name == camera) continue;
-    // Another camera that saw the drift too, checked since this one first saw it.
-    const auto there = viewOf(name);
-    if (!there || there->drift->rms_px <= config_.drift.threshold_px ||
-        o.views[name].checked_at <= *above) {
-      continue;
-    }
-    auto seen = drift::wallFromTwoViews(*here, *there, *rig_.surface.plane);
-    if (!seen) {
-      logInfo("drift: output '" + output + "': the wall from cameras '" + camera + "' and '" +
-              name + "': " + seen.error().message);
-      continue;
-    }
-    logInfo("drift: output '" + output + "': cameras '" + camera + "' and '" + name + "' see " +
-            std::to_string(seen->points) + " content points " +
-            std::to_string(1e3 * seen->offset_m) + " mm from the rig's wall (standard error " +
-            std::to_string(1e3 * seen->offset_se_m) + " mm), turned " +
-            std::to_string(seen->tilt_deg) +
-            " deg: " + (drift::wallMoved(*seen) ? "the wall moved" : "the wall stands"));
-    if (drift::wallMoved(*seen)) return *seen;
-    return std::nullopt;
-  }
-  return std::nullopt;
-}
-
-std::optional<drift::WallSeen> Daemon::movedWallOneCamera(const std::string& output,
-                                                          const std::string& camera) {
-  DriftRuntime::Output& o = drift_rt_.outputs[output];
-  const rig::RigProjector* p = rig_.projectorForOutput(output);
-  const rig::RigCamera* cam = rig_.camera(camera);
-  auto v = o.views.find(camera);
-  if (!rig_.surface.plane || !p || !p->pose_known || !p->intrinsics_known || !cam ||
-      !cam->pose_known || v == o.views.end() || !v->second.last || !v->second.reference ||
-      v->second.last_generation != rig_generation_ || v->second.last->too_plain) {
-    return std::nullopt;
-  }
-  auto tile = blend::displayTile(*p, rig_.surface);
-  if (!tile) return std::nullopt;
-  const drift::WallView view{&cam->model, &*v->second.last, &v->second.reference->map,
-                             v->second.reference->grid};
-  auto seen = drift::wallFromOneCamera(*p, tile->projector_to_plane, view, *rig_.surface.plane);
-  if (!seen) {
-    logInfo("drift: output '" + output + "': not a moved wall: " + seen.error().message);
-    return std::nullopt;
-  }
-  logInfo("drift: output '" + output + "': the projector and camera '" + camera + "' see " +
-          std::to_string(seen->points) + " content points " + std::to_string(1e3 * seen->offset_m) +
-          " mm from the rig's wall (standard error " + std::to_string(1e3 * seen->offset_se_m) +
-          " mm), turned " + std::to_string(seen->tilt_deg) + " deg; their rays " +
-          std::to_string(1e3 * seen->gap_rms_m) +
-          " mm RMS apart, a moved projector would have "
-          "turned " +
-          std::to_string(seen->projector_turn_deg) +
-          " deg: " + (drift::wallMoved(*seen) ? "the wall moved" : "the wall stands"));
-  if (!drift::wallMoved(*seen)) return std::nullopt;
-  return *seen;
-}
-
-void Daemon::correctSurface(const std::string& output, const std::string& camera,
-                            const drift::Misregistration& m, const drift::WallSeen& wall,
-                            const std::string& seen_by) {
-  DriftRuntime::Output& o = drift_rt_.outputs[output];
-  const double held = heldFor(o);
-  const auto giveUp = [&](const std::string& why) {
-    unresolveDrift(output, camera, "surface", why + "; the rig model stays as it was", m);
-  };
-  // Every projector on the wall keeps its pose; those that kept a collineation with the
-  // old plane get theirs from the pose and the new plane.
-  rig::RigModel update;
-  update.surface.plane = drift::wallToKeep(wall);
-  update.surface.plane_rms_m = wall.rms_m;
-  for (const rig::RigProjector& p : rig_.projectors) {
-    if (!p.plane_homography) continue;
-    if (!p.pose_known || !p.intrinsics_known || !p.scale_known) {
-      return giveUp("projector '" + p.name +
-                    "' is known only by its collineation with the old wall, which the moved "
-                    "wall does not carry");
-    }
-    update.projectors.push_back(p);
-    update.projectors.back().plane_homography.reset();
-  }
-  // The wall is measured, not fitted by passes: what was kept to restore after
-  // corrections that do not converge belonged to the old wall and cannot come back.
-  o.before.reset();
-  const json why = {{"misregistration_px", m.rms_px},
-                    {"held_s", held},
-                    {"threshold_px", config_.drift.threshold_px},
-                    {"wall_offset_mm", 1e3 * wall.offset_m},
-                    {"wall_offset_se_mm", 1e3 * wall.offset_se_m},
-                    {"wall_turned_deg", wall.tilt_deg},
-                    {"plane_kept", drift::wallTurned(wall) ? "fitted" : "shifted"}};
-  logInfo("drift: output '" + output + "': the wall moved " + std::to_string(1e3 * wall.offset_m) +
-          " mm (turned " + std::to_string(wall.tilt_deg) +
-          " deg); the rig's plane measured again from " + std::to_string(wall.points) +
-          " content points " + seen_by + " triangulated");
-  writeDriftCorrection(output, std::move(update),
-                       {{"output", output},
-                        {"step", "surface"},
-                        {"why", why},
-                        {"points", wall.points},
-                        {"triangulated_by", seen_by},
-                        {"plane_rms_mm", 1e3 * wall.rms_m}},
-                       "corrected-surface");
-}
-
-void Daemon::unresolveDrift(const std::string& output, const std::string& camera,
-                            const std::string& step, const std::string& why,
-                            const drift::Misregistration& m) {
-  DriftRuntime::Output& o = drift_rt_.outputs[output];
-  o.unresolved = true;
-  o.last_correction = {{"step", step}, {"camera", camera}, {"ok", false}, {"why", why}};
-  warn("drift: output '" + output + "' (camera '" + camera + "'): " + why);
-  broadcast("drift", {{"output", output},
-                      {"camera", camera},
-                      {"state", "unresolved"},
-                      {"step", step},
-                      {"why", why},
-                      {"check", misregistrationJson(m)}});
-}
-
-void Daemon::correctDrift(const std::string& output, const std::string& camera,
-                          const drift::Misregistration& m) {
-  DriftRuntime::Output& o = drift_rt_.outputs[output];
-  const rig::RigProjector* p = rig_.projectorForOutput(output);
-  if (!p) return;
-  const double held = heldFor(o);
-  const auto giveUp = [&](const std::string& why) {
-    unresolveDrift(output, camera, "projector-pose", why + "; the rig model stays as it was", m);
-  };
-  auto tile = blend::displayTile(*p, rig_.surface);
-  if (!tile) return giveUp(tile.error().message);
-  auto c = drift::correctProjector(*p, tile->projector_to_plane, m);
-  if (!c) return giveUp("the projector's pose from the content: " + c.error().message);
-  rig::RigModel update;
-  update.projectors.push_back(c->projector);
-  update.projectors.back().calibrated = {
-      "drift correction: pose from content (" + std::to_string(c->tiles) + " tiles)", utcNow()};
-  keepBefore(o, *p, nullptr);
-  // Cameras mounted on the projector moved with it.
-  for (const rig::RigCamera& cam : rig_.cameras) {
-    if (cam.attached_to != p->name || !cam.pose_known || !p->pose_known) continue;
-    keepBefore(o, *p, &cam);
-    update.cameras.push_back(cam);
-    update.cameras.back().model.pose = carried(cam.model.pose, p->pose, c->projector.pose);
-  }
-  const json why = {{"misregistration_px", m.rms_px},
-                    {"held_s", held},
-                    {"threshold_px", config_.drift.threshold_px}};
-  logInfo("drift: output '" + output + "': correcting projector '" + p->name +
-          "' from the content (" + std::to_string(m.rms_px) + " px held " + std::to_string(held) +
-          " s; " + std::to_string(c->tiles) + " tiles, pose fit " + std::to_string(c->pose_rms_px) +
-          " px)");
-  writeDriftCorrection(output, std::move(update),
-                       {{"output", output},
-                        {"projector", p->name},
-                        {"step", "projector-pose"},
-                        {"why", why},
-                        {"tiles", c->tiles},
-                        {"pose_fit_px", c->pose_rms_px}},
-                       "corrected-pose");
-}
-
-void Daemon::correctCamera(const std::string& output, const std::string& camera,
-                           const drift::Misregistration& m) {
-  DriftRuntime& d = drift_rt_;
-  DriftRuntime::Output& o = d.outputs[output];
-  const rig::RigProjector* p = rig_.projectorForOutput(output);
-  const rig::RigCamera* cam = rig_.camera(camera);
-  const DriftRuntime::View& v = o.views[camera];
-  if (!p || !cam || !v.reference) return;
-  const double held = heldFor(o);
-  const auto giveUp = [&](const std::string& why) {
-    unresolveDrift(output, camera, "camera-pose", why + "; the rig model stays as it was", m);
-  };
-  auto tile = blend::displayTile(*p, rig_.surface);
-  if (!tile) return giveUp(tile.error().message);
-  auto c =
-      drift::correctCamera(*cam, tile->projector_to_plane, m, v.reference->map, v.reference->grid);
-  if (!c) return giveUp("the camera's pose from the content: " + c.error().message);
-  rig::RigModel update;
-  update.cameras.push_back(c->camera);
-  update.cameras.back().calibrated = {
-      "drift correction: pose from content (" + std::to_string(c->tiles) + " tiles)", utcNow()};
-  keepBefore(o, *p, cam);
-  const json why = {{"misregistration_px", m.rms_px},
-                    {"held_s", held},
-                    {"threshold_px", config_.drift.threshold_px},
-                    {"registered_in", "another camera sees the output registered"}};
-  logInfo("drift: output '" + output + "' misregistered in camera '" + camera +
-          "' only: re-registering the camera from the content (" + std::to_string(m.rms_px) +
-          " px held " + std::to_string(held) + " s; " + std::to_string(c->tiles) +
-          " tiles, pose fit " + std::to_string(c->pose_rms_px) + " camera px)");
-  writeDriftCorrection(output, std::move(update),
-                       {{"output", output},
-                        {"camera", camera},
-                        {"step", "camera-pose"},
-                        {"why", why},
-                        {"tiles", c->tiles},
-                        {"pose_fit_px", c->pose_rms_px}},
-                       "corrected-camera");
-}
-
-void Daemon::writeDriftCorrection(const std::string& output, rig::RigModel update, json event,
-                                  const char* state) {
-  drift_rt_.writing = true;
-  writeRig(
-      std::move(update), {},
-      [this, output, event = std::move(event), state](const Result<std::string>& written) mutable {
-        DriftRuntime& d = drift_rt_;
-        d.writing = false;
-        auto it = d.outputs.find(output);
-        if (it == d.outputs.end()) return;  // the output went away meanwhile
-        DriftRuntime::Output& o = it->second;
-        o.forgetDrift();
-        if (!written) {
-          event["state"] = "failed";
-          event["error"] = written.error().message;
-          o.last_correction = event;
-          warn("drift: " + written.error().message + "; the rig model stays as it was");
-          broadcast("drift", event);
-          return;
-        }
-        ++o.passes;
-        ++o.corrections;
-        event["pass"] = o.passes;
-        event["state"] = state;
-        event["time"] = utcNow();
-        o.last_correction = event;
-        broadcast("drift", event);
-        refreshOutputs();  // a new projector mapping moves the keystone
-      });
 }
 
 json Daemon::driftJson(const std::string& output) const {

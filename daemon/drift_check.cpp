@@ -7,7 +7,6 @@
 #include <vector>
 
 #include "drift/fiducial_misregistration.hpp"
-#include "output_frames.hpp"
 #include "protocol.hpp"
 #include "render/cpu_renderer.hpp"
 
@@ -138,12 +137,8 @@ tl::expected<DriftCheck, CalibrationFailure> runFiducialCheck(const DriftCheckPl
   if (f.rgb.size() != plan.framebuffer) {
     return failed("the fiducial frame is not the framebuffer's size");
   }
-  procam_image frame = rgbImage(f.rgb);
-  char err[256] = {0};
-  const auto& raw = plan.output_device.device->raw();
-  if (int rc = raw.ops.output->show(raw.self, &frame, err, sizeof err - 1); rc != PROCAM_OK) {
-    return tl::unexpected(
-        deviceFailure("output", plan.output_device.name, rc, "show the fiducial frame", err));
+  if (auto shown = showFrame(plan.output_device, f.rgb, "show the fiducial frame"); !shown) {
+    return tl::unexpected(shown.error());
   }
   std::this_thread::sleep_for(std::chrono::duration<double>(plan.settle_s));
   const auto capture = Clock::now();

@@ -87,4 +87,29 @@ struct DriftRuntime {
   std::map<std::string, Output> outputs;
 };
 
+// Seconds since `t`, by the drift runtime's clock.
+inline double secondsSince(DriftRuntime::Clock::time_point t) {
+  return std::chrono::duration<double>(DriftRuntime::Clock::now() - t).count();
+}
+
+// How long the output's drift has been seen (by the camera that saw it first).
+inline double heldFor(const DriftRuntime::Output& o) {
+  double held = 0;
+  for (const auto& [name, v] : o.views) {
+    if (v.above) held = std::max(held, secondsSince(*v.above));
+  }
+  return held;
+}
+
+// A check's figures, as status and the drift events give them.
+inline nlohmann::json misregistrationJson(const drift::Misregistration& m) {
+  return {
+      {"misregistration_px", m.rms_px},
+      {"max_px", m.max_px},
+      {"confidence", m.confidence},
+      {"tiles", {{"seen", m.tiles_seen}, {"textured", m.tiles_textured}, {"used", m.tiles_used}}},
+      {"tile_rms_px", m.tile_rms_px},
+      {"too_plain", m.too_plain}};
+}
+
 }  // namespace procam::daemon

@@ -7,7 +7,6 @@
 
 #include "calibration/plane_homography_route.hpp"
 #include "calibration_job.hpp"
-#include "output_frames.hpp"
 #include "protocol.hpp"
 
 namespace procam::daemon {
@@ -28,11 +27,8 @@ tl::expected<CalibrationOutcome, CalibrationFailure> runTagCalibration(
   if (!settled) return tl::unexpected(settled.error());
   const double start = *settled;
   if (hooks.cancelled()) return tl::unexpected(cancelled);
-  procam_image frame = rgbImage(plan.tags->rgb);
-  char err[256] = {0};
-  const auto& raw = plan.output.device->raw();
-  if (int rc = raw.ops.output->show(raw.self, &frame, err, sizeof err - 1); rc != PROCAM_OK) {
-    return tl::unexpected(deviceFailure("output", plan.output.name, rc, "show the tag frame", err));
+  if (auto shown = showFrame(plan.output, plan.tags->rgb, "show the tag frame"); !shown) {
+    return tl::unexpected(shown.error());
   }
   if (!waitCancellable(out.settle_frames / plan.refresh_hz, hooks)) {
     return tl::unexpected(cancelled);

@@ -14,6 +14,13 @@ std::vector<std::string> builtinSceneNames() {
   return names;
 }
 
+std::optional<std::string_view> builtinSceneText(std::string_view name) {
+  for (std::size_t i = 0; i < detail::kEmbeddedSceneCount; ++i) {
+    if (detail::kEmbeddedScenes[i].name == name) return detail::kEmbeddedScenes[i].text;
+  }
+  return std::nullopt;
+}
+
 Result<Scene> resolveScene(std::string_view name_or_path) {
   const std::filesystem::path path(name_or_path);
   std::error_code ec;
@@ -21,9 +28,8 @@ Result<Scene> resolveScene(std::string_view name_or_path) {
 
   std::string_view name = name_or_path;
   if (name.ends_with(".toml")) name.remove_suffix(5);
-  for (std::size_t i = 0; i < detail::kEmbeddedSceneCount; ++i) {
-    const auto& s = detail::kEmbeddedScenes[i];
-    if (s.name == name) return Scene::parse(s.text, std::string(s.name) + ".toml", {});
+  if (auto text = builtinSceneText(name)) {
+    return Scene::parse(*text, std::string(name) + ".toml", {});
   }
   std::string known;
   for (const auto& n : builtinSceneNames()) known += (known.empty() ? "" : ", ") + n;

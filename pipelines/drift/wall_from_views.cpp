@@ -62,8 +62,7 @@ Result<WallSeen> wallFromPoints(const std::vector<Vec3>& points, int rays,
 }
 
 // The rays' meeting point when they meet in front of both views within kMaxRayGapM.
-std::optional<Vec3> meeting(const geom::Ray& a, const geom::Ray& b) {
-  auto x = geom::triangulateRays(a, b);
+std::optional<Vec3> meeting(const Result<geom::RayRayPoint>& x) {
   if (x && x->t1 > 0 && x->t2 > 0 && x->point.allFinite() && x->gap <= kMaxRayGapM) {
     return x->point;
   }
@@ -104,7 +103,7 @@ Result<WallSeen> wallFromTwoViews(const WallView& a, const WallView& b,
       if (!ra || !rb) break;
       ++rays;
       // Rays that pass apart saw different points (the content moved between the checks).
-      if (auto x = meeting(*ra, *rb)) points.push_back(*x);
+      if (auto x = meeting(geom::triangulateRays(*ra, *rb))) points.push_back(*x);
       break;
     }
   }
@@ -136,7 +135,7 @@ Result<WallSeen> wallFromProjectorAndView(const geom::CameraModel& projector,
     ++rays;
     gap_sq += x->gap * x->gap;
     shift_sq += (on->point - was->point).squaredNorm();
-    if (auto m = meeting(*rp, *rf)) points.push_back(*m);
+    if (auto m = meeting(x)) points.push_back(*m);
   }
   if (rays == 0) {
     return fail(ErrorCode::kTooFewPoints,

@@ -11,8 +11,8 @@
 #include "blend/rig_tiles.hpp"
 #include "drift/fiducial_misregistration.hpp"
 #include "drift/projector_correction.hpp"
-#include "sim/embedded_scenes.hpp"
 #include "sim/renderer.hpp"
+#include "sim/scene_library.hpp"
 #include "sim/truth_rig.hpp"
 #include "structured_light/apriltag_grid.hpp"
 
@@ -20,13 +20,9 @@ namespace procam::drift {
 namespace {
 
 std::string wallOblique(const std::string& events) {
-  for (std::size_t i = 0; i < sim::detail::kEmbeddedSceneCount; ++i) {
-    if (sim::detail::kEmbeddedScenes[i].name == "wall_oblique") {
-      return std::string(sim::detail::kEmbeddedScenes[i].text) + "\n" + events;
-    }
-  }
-  ADD_FAILURE() << "no built-in wall_oblique";
-  return "";
+  const auto text = sim::builtinSceneText("wall_oblique");
+  EXPECT_TRUE(text) << "no built-in wall_oblique";
+  return std::string(text.value_or("")) + "\n" + events;
 }
 
 // The largest distance, in the true projector's pixels, between a framebuffer pixel and

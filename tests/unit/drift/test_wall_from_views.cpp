@@ -15,8 +15,8 @@
 #include "drift/projector_camera_map.hpp"
 #include "drift/wall_from_views.hpp"
 #include "second_camera.hpp"
-#include "sim/embedded_scenes.hpp"
 #include "sim/renderer.hpp"
+#include "sim/scene_library.hpp"
 #include "sim/truth_rig.hpp"
 #include "textured_content.hpp"
 
@@ -24,13 +24,9 @@ namespace procam::drift {
 namespace {
 
 std::string wallObliqueWithTwoCameras(const std::string& events) {
-  for (std::size_t i = 0; i < sim::detail::kEmbeddedSceneCount; ++i) {
-    if (sim::detail::kEmbeddedScenes[i].name == "wall_oblique") {
-      return std::string(sim::detail::kEmbeddedScenes[i].text) + "\n" + kSecondCamera + events;
-    }
-  }
-  ADD_FAILURE() << "no built-in wall_oblique";
-  return "";
+  const auto text = sim::builtinSceneText("wall_oblique");
+  EXPECT_TRUE(text) << "no built-in wall_oblique";
+  return std::string(text.value_or("")) + "\n" + kSecondCamera + events;
 }
 
 struct Checked {

@@ -1,0 +1,296 @@
+// recalibrate = "on-drift": the correction steps a drift check decides on
+// (daemon_drift.cpp): a camera re-registered (drift/camera_correction.hpp), the wall
+// measured again from two cameras or one camera and the projector
+// (drift/wall_from_views.hpp), the projector's pose and collineation fitted again
+// (drift/projector_correction.hpp); each merged into rig.json atomically, a failed step
+// keeping the last good rig. Loop thread only.
+#include "blend/rig_tiles.hpp"
+#include "daemon.hpp"
+#include "drift/camera_correction.hpp"
+#include "drift/projector_correction.hpp"
+#include "drift/wall_from_views.hpp"
+#include "log.hpp"
+#include "protocol.hpp"
+#include "rig_store.hpp"
+
+namespace procam::daemon {
+
+using nlohmann::json;
+
+namespace {
+
+// Keeps `projector` (or, given, `camera`) as it was before the first of the corrections
+// since the output was last registered: restored when they do not converge.
+void keepBefore(DriftRuntime::Output& o, const rig::RigProjector& projector,
+                const rig::RigCamera* camera) {
+  if (!o.before) o.before.emplace();
+  rig::RigModel& b = *o.before;
+  if (camera) {
+    if (!b.camera(camera->name)) b.cameras.push_back(*camera);
+  } else if (!b.projector(projector.name)) {
+    b.projectors.push_back(projector);
+  }
+}
+
+// `camera` (world -> camera) rigidly mounted on a projector that moved from `from` to `to`
+// (world -> projector): the camera-from-projector pose stays.
+geom::Pose carried(const geom::Pose& camera, const geom::Pose& from, const geom::Pose& to) {
+  const geom::Pose rel = camera.relativeTo(from);
+  return {rel.R * to.R, rel.R * to.t + rel.t};
+}
+
+// `camera`'s last check of the output as a view of the wall: its calibration, its
+// misregistration and the map it used; nullopt unless the check is against this rig
+// model (`generation`; so then is the reference, which a check sets before its result
+// may be dropped and so is never older than `last`) and not too plain.
+std::optional<drift::WallView> wallView(const rig::RigModel& rig, uint64_t generation,
+                                        const DriftRuntime::Output& o, const std::string& camera) {
+  const rig::RigCamera* cam = rig.camera(camera);
+  auto v = o.views.find(camera);
+  if (!cam || !cam->pose_known || v == o.views.end() || !v->second.last || !v->second.reference ||
+      v->second.last_generation != generation || v->second.last->too_plain) {
+    return std::nullopt;
+  }
+  return drift::WallView{&cam->model, &*v->second.last, &v->second.reference->map,
+                         v->second.reference->grid};
+}
+
+}  // namespace
+
+std::optional<drift::WallSeen> Daemon::movedWall(const std::string& output,
+                                                 const std::string& camera) {
+  DriftRuntime::Output& o = drift_rt_.outputs[output];
+  if (!rig_.surface.plane) return std::nullopt;
+  const auto here = wallView(rig_, rig_generation_, o, camera);
+  const auto& above = o.views[camera].above;
+  if (!here || !above) return std::nullopt;
+  for (const std::string& name : o.cameras) {
+    if (name == camera) continue;
+    // Another camera that saw the drift too, checked since this one first saw it.
+    const auto there = wallView(rig_, rig_generation_, o, name);
+    if (!there || there->drift->rms_px <= config_.drift.threshold_px ||
+        o.views[name].checked_at <= *above) {
+      continue;
+    }
+    auto seen = drift::wallFromTwoViews(*here, *there, *rig_.surface.plane);
+    if (!seen) {
+      logInfo("drift: output '" + output + "': the wall from cameras '" + camera + "' and '" +
+              name + "': " + seen.error().message);
+      continue;
+    }
+    logInfo("drift: output '" + output + "': cameras '" + camera + "' and '" + name + "' see " +
+            std::to_string(seen->points) + " content points " +
+            std::to_string(1e3 * seen->offset_m) + " mm from the rig's wall (standard error " +
+            std::to_string(1e3 * seen->offset_se_m) + " mm), turned " +
+            std::to_string(seen->tilt_deg) +
+            " deg: " + (drift::wallMoved(*seen) ? "the wall moved" : "the wall stands"));
+    if (drift::wallMoved(*seen)) return *seen;
+    return std::nullopt;
+  }
+  return std::nullopt;
+}
+
+std::optional<drift::WallSeen> Daemon::movedWallOneCamera(const std::string& output,
+                                                          const std::string& camera) {
+  DriftRuntime::Output& o = drift_rt_.outputs[output];
+  const rig::RigProjector* p = rig_.projectorForOutput(output);
+  const auto view = wallView(rig_, rig_generation_, o, camera);
+  if (!rig_.surface.plane || !p || !p->pose_known || !p->intrinsics_known || !view) {
+    return std::nullopt;
+  }
+  auto tile = blend::displayTile(*p, rig_.surface);
+  if (!tile) return std::nullopt;
+  auto seen = drift::wallFromOneCamera(*p, tile->projector_to_plane, *view, *rig_.surface.plane);
+  if (!seen) {
+    logInfo("drift: output '" + output + "': not a moved wall: " + seen.error().message);
+    return std::nullopt;
+  }
+  logInfo("drift: output '" + output + "': the projector and camera '" + camera + "' see " +
+          std::to_string(seen->points) + " content points " + std::to_string(1e3 * seen->offset_m) +
+          " mm from the rig's wall (standard error " + std::to_string(1e3 * seen->offset_se_m) +
+          " mm), turned " + std::to_string(seen->tilt_deg) + " deg; their rays " +
+          std::to_string(1e3 * seen->gap_rms_m) +
+          " mm RMS apart, a moved projector would have "
+          "turned " +
+          std::to_string(seen->projector_turn_deg) +
+          " deg: " + (drift::wallMoved(*seen) ? "the wall moved" : "the wall stands"));
+  if (!drift::wallMoved(*seen)) return std::nullopt;
+  return *seen;
+}
+
+void Daemon::correctSurface(const std::string& output, const std::string& camera,
+                            const drift::Misregistration& m, const drift::WallSeen& wall,
+                            const std::string& seen_by) {
+  DriftRuntime::Output& o = drift_rt_.outputs[output];
+  const double held = heldFor(o);
+  const auto giveUp = [&](const std::string& why) {
+    unresolveDrift(output, camera, "surface", why + "; the rig model stays as it was", m);
+  };
+  // Every projector on the wall keeps its pose; those that kept a collineation with the
+  // old plane get theirs from the pose and the new plane.
+  rig::RigModel update;
+  update.surface.plane = drift::wallToKeep(wall);
+  update.surface.plane_rms_m = wall.rms_m;
+  for (const rig::RigProjector& p : rig_.projectors) {
+    if (!p.plane_homography) continue;
+    if (!p.pose_known || !p.intrinsics_known || !p.scale_known) {
+      return giveUp("projector '" + p.name +
+                    "' is known only by its collineation with the old wall, which the moved "
+                    "wall does not carry");
+    }
+    update.projectors.push_back(p);
+    update.projectors.back().plane_homography.reset();
+  }
+  // The wall is measured, not fitted by passes: what was kept to restore after
+  // corrections that do not converge belonged to the old wall and cannot come back.
+  o.before.reset();
+  const json why = {{"misregistration_px", m.rms_px},
+                    {"held_s", held},
+                    {"threshold_px", config_.drift.threshold_px},
+                    {"wall_offset_mm", 1e3 * wall.offset_m},
+                    {"wall_offset_se_mm", 1e3 * wall.offset_se_m},
+                    {"wall_turned_deg", wall.tilt_deg},
+                    {"plane_kept", drift::wallTurned(wall) ? "fitted" : "shifted"}};
+  logInfo("drift: output '" + output + "': the wall moved " + std::to_string(1e3 * wall.offset_m) +
+          " mm (turned " + std::to_string(wall.tilt_deg) +
+          " deg); the rig's plane measured again from " + std::to_string(wall.points) +
+          " content points " + seen_by + " triangulated");
+  writeDriftCorrection(output, std::move(update),
+                       {{"output", output},
+                        {"step", "surface"},
+                        {"why", why},
+                        {"points", wall.points},
+                        {"triangulated_by", seen_by},
+                        {"plane_rms_mm", 1e3 * wall.rms_m}},
+                       "corrected-surface");
+}
+
+void Daemon::unresolveDrift(const std::string& output, const std::string& camera,
+                            const std::string& step, const std::string& why,
+                            const drift::Misregistration& m) {
+  DriftRuntime::Output& o = drift_rt_.outputs[output];
+  o.unresolved = true;
+  o.last_correction = {{"step", step}, {"camera", camera}, {"ok", false}, {"why", why}};
+  warn("drift: output '" + output + "' (camera '" + camera + "'): " + why);
+  broadcast("drift", {{"output", output},
+                      {"camera", camera},
+                      {"state", "unresolved"},
+                      {"step", step},
+                      {"why", why},
+                      {"check", misregistrationJson(m)}});
+}
+
+void Daemon::correctDrift(const std::string& output, const std::string& camera,
+                          const drift::Misregistration& m) {
+  DriftRuntime::Output& o = drift_rt_.outputs[output];
+  const rig::RigProjector* p = rig_.projectorForOutput(output);
+  if (!p) return;
+  const double held = heldFor(o);
+  const auto giveUp = [&](const std::string& why) {
+    unresolveDrift(output, camera, "projector-pose", why + "; the rig model stays as it was", m);
+  };
+  auto tile = blend::displayTile(*p, rig_.surface);
+  if (!tile) return giveUp(tile.error().message);
+  auto c = drift::correctProjector(*p, tile->projector_to_plane, m);
+  if (!c) return giveUp("the projector's pose from the content: " + c.error().message);
+  rig::RigModel update;
+  update.projectors.push_back(c->projector);
+  update.projectors.back().calibrated = {
+      "drift correction: pose from content (" + std::to_string(c->tiles) + " tiles)", utcNow()};
+  keepBefore(o, *p, nullptr);
+  // Cameras mounted on the projector moved with it.
+  for (const rig::RigCamera& cam : rig_.cameras) {
+    if (cam.attached_to != p->name || !cam.pose_known || !p->pose_known) continue;
+    keepBefore(o, *p, &cam);
+    update.cameras.push_back(cam);
+    update.cameras.back().model.pose = carried(cam.model.pose, p->pose, c->projector.pose);
+  }
+  const json why = {{"misregistration_px", m.rms_px},
+                    {"held_s", held},
+                    {"threshold_px", config_.drift.threshold_px}};
+  logInfo("drift: output '" + output + "': correcting projector '" + p->name +
+          "' from the content (" + std::to_string(m.rms_px) + " px held " + std::to_string(held) +
+          " s; " + std::to_string(c->tiles) + " tiles, pose fit " + std::to_string(c->pose_rms_px) +
+          " px)");
+  writeDriftCorrection(output, std::move(update),
+                       {{"output", output},
+                        {"projector", p->name},
+                        {"step", "projector-pose"},
+                        {"why", why},
+                        {"tiles", c->tiles},
+                        {"pose_fit_px", c->pose_rms_px}},
+                       "corrected-pose");
+}
+
+void Daemon::correctCamera(const std::string& output, const std::string& camera,
+                           const drift::Misregistration& m) {
+  DriftRuntime& d = drift_rt_;
+  DriftRuntime::Output& o = d.outputs[output];
+  const rig::RigProjector* p = rig_.projectorForOutput(output);
+  const rig::RigCamera* cam = rig_.camera(camera);
+  const DriftRuntime::View& v = o.views[camera];
+  if (!p || !cam || !v.reference) return;
+  const double held = heldFor(o);
+  const auto giveUp = [&](const std::string& why) {
+    unresolveDrift(output, camera, "camera-pose", why + "; the rig model stays as it was", m);
+  };
+  auto tile = blend::displayTile(*p, rig_.surface);
+  if (!tile) return giveUp(tile.error().message);
+  auto c =
+      drift::correctCamera(*cam, tile->projector_to_plane, m, v.reference->map, v.reference->grid);
+  if (!c) return giveUp("the camera's pose from the content: " + c.error().message);
+  rig::RigModel update;
+  update.cameras.push_back(c->camera);
+  update.cameras.back().calibrated = {
+      "drift correction: pose from content (" + std::to_string(c->tiles) + " tiles)", utcNow()};
+  keepBefore(o, *p, cam);
+  const json why = {{"misregistration_px", m.rms_px},
+                    {"held_s", held},
+                    {"threshold_px", config_.drift.threshold_px},
+                    {"registered_in", "another camera sees the output registered"}};
+  logInfo("drift: output '" + output + "' misregistered in camera '" + camera +
+          "' only: re-registering the camera from the content (" + std::to_string(m.rms_px) +
+          " px held " + std::to_string(held) + " s; " + std::to_string(c->tiles) +
+          " tiles, pose fit " + std::to_string(c->pose_rms_px) + " camera px)");
+  writeDriftCorrection(output, std::move(update),
+                       {{"output", output},
+                        {"camera", camera},
+                        {"step", "camera-pose"},
+                        {"why", why},
+                        {"tiles", c->tiles},
+                        {"pose_fit_px", c->pose_rms_px}},
+                       "corrected-camera");
+}
+
+void Daemon::writeDriftCorrection(const std::string& output, rig::RigModel update, json event,
+                                  const char* state) {
+  drift_rt_.writing = true;
+  writeRig(
+      std::move(update), {},
+      [this, output, event = std::move(event), state](const Result<std::string>& written) mutable {
+        DriftRuntime& d = drift_rt_;
+        d.writing = false;
+        auto it = d.outputs.find(output);
+        if (it == d.outputs.end()) return;  // the output went away meanwhile
+        DriftRuntime::Output& o = it->second;
+        o.forgetDrift();
+        if (!written) {
+          event["state"] = "failed";
+          event["error"] = written.error().message;
+          o.last_correction = event;
+          warn("drift: " + written.error().message + "; the rig model stays as it was");
+          broadcast("drift", event);
+          return;
+        }
+        ++o.passes;
+        ++o.corrections;
+        event["pass"] = o.passes;
+        event["state"] = state;
+        event["time"] = utcNow();
+        o.last_correction = event;
+        broadcast("drift", event);
+        refreshOutputs();  // a new projector mapping moves the keystone
+      });
+}
+
+}  // namespace procam::daemon
