@@ -311,9 +311,21 @@ class Daemon {
                       const drift::Misregistration& m, const drift::WallSeen& wall,
                       const std::string& seen_by);
   // Merges a correction into rig.json; `event` (a drift event's body) goes out with
-  // `state` when written, "failed" otherwise.
+  // `state` when written, "failed" otherwise; `after` first hears how the write went.
   void writeDriftCorrection(const std::string& output, rig::RigModel update, nlohmann::json event,
-                            const char* state);
+                            const char* state, std::map<std::string, std::string> meshes = {},
+                            std::function<void(const Result<std::string>&)> after = {});
+  // The projector and cameras as they were before corrections that did not converge
+  // (o.before) written back into rig.json.
+  void restoreBeforeDrift(DriftRuntime::Output& o);
+  // drift_scan.cpp: `step` failed (`why`): the next scan (nextDriftScan), or the output
+  // unresolved when none is left.
+  void escalateDrift(const std::string& output, const std::string& camera, const std::string& step,
+                     const std::string& why, const drift::Misregistration& m);
+  // The output's projector scanned as calibrate scans it (a calibrate operation without a
+  // client), the result merged into rig.json as a correction.
+  void scanForDrift(const std::string& output, const std::string& camera, DriftScan which,
+                    const std::string& why, const drift::Misregistration& m);
   // The cameras that check `projector` (mapped onto the plane by `tile`).
   std::vector<const rig::RigCamera*> driftCameras(const rig::RigProjector& projector,
                                                   const geom::PlaneHomography& tile) const;

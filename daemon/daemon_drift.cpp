@@ -10,7 +10,9 @@
 // (drift/wall_from_views.hpp); other drift that every camera sees is the projector's,
 // whose pose and plane collineation are fitted again
 // (drift/projector_correction.hpp); the steps themselves are in drift_corrections.cpp.
-// Loop thread only; the checks run on the compute worker between the outputs' frames.
+// Where those fail their check, the projector is scanned: a coarse Gray pass, then the
+// full scan (drift_scan.cpp). Loop thread only; the checks run on the compute worker
+// between the outputs' frames.
 #include <cmath>
 
 #include "blend/rig_tiles.hpp"
@@ -24,11 +26,6 @@ namespace procam::daemon {
 using nlohmann::json;
 
 namespace {
-
-// Corrections in a row that did not bring the misregistration under the threshold
-// before the daemon stops trying (the projector keeps moving, or the surface moved,
-// which no pose explains).
-constexpr int kMaxPasses = 3;
 
 // Fiducial frames an output may show between two at drift_fiducial_period_s, to confirm
 // drift and check corrections: the bump on wall_oblique under grey content took 4 (a
@@ -275,19 +272,23 @@ void Daemon::onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, Calibr
   const double threshold = config_.drift.threshold_px;
   if (m.too_plain || m.rms_px <= threshold) {
     v.above.reset();
-    if (!m.too_plain && o.passes > 0 && !o.drifted()) {
+    if (!m.too_plain && (o.passes > 0 || o.scan != DriftScan::kNone) && !o.drifted()) {
       logInfo("drift: output '" + key.output + "' registered again (camera '" + key.camera +
-              "'): " + std::to_string(m.rms_px) + " px after " + std::to_string(o.passes) +
-              " correction(s)");
-      broadcast("drift", {{"output", key.output},
-                          {"camera", key.camera},
-                          {"state", "corrected"},
-                          {"passes", o.passes},
-                          {"check", misregistrationJson(m)},
-                          {"timing", v.timing}});
+              "'): " + std::to_string(m.rms_px) + " px after " +
+              (o.scan != DriftScan::kNone ? std::string("the ") + driftScanName(o.scan)
+                                          : std::to_string(o.passes) + " correction(s)"));
+      json event = {{"output", key.output},
+                    {"camera", key.camera},
+                    {"state", "corrected"},
+                    {"passes", o.passes},
+                    {"check", misregistrationJson(m)},
+                    {"timing", v.timing}};
+      if (o.scan != DriftScan::kNone) event["scan"] = driftScanName(o.scan);
+      broadcast("drift", event);
       o.passes = 0;
       o.before.reset();
     }
+    if (!m.too_plain && !o.drifted()) o.scan = DriftScan::kNone;
     if (!m.too_plain) o.unresolved = false;
     return;
   }
@@ -318,32 +319,43 @@ void Daemon::onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, Calibr
     (ov->second.last->rms_px <= threshold ? other_registered : other_drifted) = true;
   }
   if (!other_registered && o.cameras.size() > 1 && !other_drifted) return;  // not looked since
-  if (o.passes >= kMaxPasses) {
+  if (o.passes >= kMaxDriftPasses || o.scan != DriftScan::kNone) {
     // Named by the last correction made (a surface step too), else by whose drift it is.
     std::string step = other_registered ? "camera-pose" : "projector-pose";
     if (o.last_correction.is_object() && o.last_correction.contains("step") &&
         o.last_correction["step"].is_string()) {
       step = o.last_correction["step"].get<std::string>();
     }
+    // A scan when the content's corrections of the projector (or the last scan) did not
+    // register the output: not for a camera that moved (scanning a projector does not
+    // find it) nor a wall (one projector's scan would leave the others on the old one).
+    const auto next = step == "projector-pose" || o.scan != DriftScan::kNone
+                          ? nextDriftScan(o.scan, config_.recalibrate)
+                          : std::nullopt;
+    if (next) {
+      const std::string why =
+          o.scan == DriftScan::kNone
+              ? "corrections from the content left " + std::to_string(m.rms_px) + " px after " +
+                    std::to_string(kMaxDriftPasses) + " passes"
+              : "the output is still " + std::to_string(m.rms_px) + " px off after the scan";
+      o.passes = 0;
+      return scanForDrift(key.output, key.camera, *next, step + ": " + why, m);
+    }
     // Corrections that do not converge are not kept: the devices as they were before
     // them (the last state a check confirmed) go back into rig.json.
-    unresolveDrift(key.output, key.camera, step,
-                   "corrections from the content did not bring the misregistration under " +
-                       std::to_string(threshold) + " px in " + std::to_string(kMaxPasses) +
-                       " passes (the surface may have moved); calibrate again",
-                   m);
-    if (o.before) {
-      d.writing = true;
-      writeRig(*o.before, {}, [this](const Result<std::string>& written) {
-        drift_rt_.writing = false;
-        if (!written) {
-          warn("drift: the rig model before the corrections: " + written.error().message);
-        } else {
-          refreshOutputs();
-        }
-      });
-      o.before.reset();
+    std::string why =
+        o.scan != DriftScan::kNone
+            ? "the full scan did not bring the misregistration under " + std::to_string(threshold) +
+                  " px; calibrate again"
+            : "corrections from the content did not bring the misregistration under " +
+                  std::to_string(threshold) + " px in " + std::to_string(kMaxDriftPasses) +
+                  " passes (the surface may have moved); calibrate again";
+    if (config_.recalibrate != RecalibratePolicy::kOnDrift && step == "projector-pose") {
+      why += " (recalibrate = \"" + std::string(recalibratePolicyName(config_.recalibrate)) +
+             "\" shows no scan)";
     }
+    unresolveDrift(key.output, key.camera, step, why, m);
+    restoreBeforeDrift(o);
     o.passes = 0;
     return;
   }
@@ -406,8 +418,10 @@ json Daemon::driftJson(const std::string& output) const {
   j["cameras"] = std::move(cameras);
   j["content_too_plain"] = content_plain;
   std::string state = "registered";
-  if (!checked) {
+  if (!checked && !o.scanning) {
     state = "checking";
+  } else if (o.scanning) {
+    state = "scanning";
   } else if (plain) {
     state = "too plain to tell";
   } else if (o.unresolved) {

@@ -3,7 +3,7 @@
 // measured again from two cameras or one camera and the projector
 // (drift/wall_from_views.hpp), the projector's pose and collineation fitted again
 // (drift/projector_correction.hpp); each merged into rig.json atomically, a failed step
-// keeping the last good rig. Loop thread only.
+// escalating to a scan (drift_scan.cpp) or keeping the last good rig. Loop thread only.
 #include "blend/rig_tiles.hpp"
 #include "daemon.hpp"
 #include "drift/camera_correction.hpp"
@@ -170,6 +170,7 @@ void Daemon::unresolveDrift(const std::string& output, const std::string& camera
                             const drift::Misregistration& m) {
   DriftRuntime::Output& o = drift_rt_.outputs[output];
   o.unresolved = true;
+  o.scan = DriftScan::kNone;  // a later drift climbs the steps from the cheapest again
   o.last_correction = {{"step", step}, {"camera", camera}, {"ok", false}, {"why", why}};
   warn("drift: output '" + output + "' (camera '" + camera + "'): " + why);
   broadcast("drift", {{"output", output},
@@ -187,7 +188,7 @@ void Daemon::correctDrift(const std::string& output, const std::string& camera,
   if (!p) return;
   const double held = heldFor(o);
   const auto giveUp = [&](const std::string& why) {
-    unresolveDrift(output, camera, "projector-pose", why + "; the rig model stays as it was", m);
+    escalateDrift(output, camera, "projector-pose", why, m);
   };
   auto tile = blend::displayTile(*p, rig_.surface);
   if (!tile) return giveUp(tile.error().message);
@@ -262,35 +263,52 @@ void Daemon::correctCamera(const std::string& output, const std::string& camera,
                        "corrected-camera");
 }
 
-void Daemon::writeDriftCorrection(const std::string& output, rig::RigModel update, json event,
-                                  const char* state) {
+void Daemon::restoreBeforeDrift(DriftRuntime::Output& o) {
+  if (!o.before) return;
   drift_rt_.writing = true;
-  writeRig(
-      std::move(update), {},
-      [this, output, event = std::move(event), state](const Result<std::string>& written) mutable {
-        DriftRuntime& d = drift_rt_;
-        d.writing = false;
-        auto it = d.outputs.find(output);
-        if (it == d.outputs.end()) return;  // the output went away meanwhile
-        DriftRuntime::Output& o = it->second;
-        o.forgetDrift();
-        if (!written) {
-          event["state"] = "failed";
-          event["error"] = written.error().message;
-          o.last_correction = event;
-          warn("drift: " + written.error().message + "; the rig model stays as it was");
-          broadcast("drift", event);
-          return;
-        }
-        ++o.passes;
-        ++o.corrections;
-        event["pass"] = o.passes;
-        event["state"] = state;
-        event["time"] = utcNow();
-        o.last_correction = event;
-        broadcast("drift", event);
-        refreshOutputs();  // a new projector mapping moves the keystone
-      });
+  writeRig(*o.before, {}, [this](const Result<std::string>& written) {
+    drift_rt_.writing = false;
+    if (!written) {
+      warn("drift: the rig model before the corrections: " + written.error().message);
+    } else {
+      refreshOutputs();
+    }
+  });
+  o.before.reset();
+}
+
+void Daemon::writeDriftCorrection(const std::string& output, rig::RigModel update, json event,
+                                  const char* state, std::map<std::string, std::string> meshes,
+                                  std::function<void(const Result<std::string>&)> after) {
+  drift_rt_.writing = true;
+  writeRig(std::move(update), std::move(meshes),
+           [this, output, event = std::move(event), state,
+            after = std::move(after)](const Result<std::string>& written) mutable {
+             DriftRuntime& d = drift_rt_;
+             d.writing = false;
+             if (after) after(written);
+             auto it = d.outputs.find(output);
+             if (it == d.outputs.end()) return;  // the output went away meanwhile
+             DriftRuntime::Output& o = it->second;
+             o.forgetDrift();
+             if (!written) {
+               o.scan = DriftScan::kNone;  // a scan that was not kept is not a step made
+               event["state"] = "failed";
+               event["error"] = written.error().message;
+               o.last_correction = event;
+               warn("drift: " + written.error().message + "; the rig model stays as it was");
+               broadcast("drift", event);
+               return;
+             }
+             ++o.passes;
+             ++o.corrections;
+             event["pass"] = o.passes;
+             event["state"] = state;
+             event["time"] = utcNow();
+             o.last_correction = event;
+             broadcast("drift", event);
+             refreshOutputs();  // a new projector mapping moves the keystone
+           });
 }
 
 }  // namespace procam::daemon

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "drift_check.hpp"
+#include "drift_ladder.hpp"
 #include "rig/rig_model.hpp"
 
 namespace procam::daemon {
@@ -64,6 +65,10 @@ struct DriftRuntime {
     std::optional<Clock::time_point> fiducial_at;
     std::optional<double> fiducial_px;  // the last fiducial check's misregistration
     int quick_fiducials = 0;            // shown since the last one at the period
+    // The scan made since the output was last registered (kNone: none); a check that
+    // still finds it drifted escalates at once. Cleared when registered or unresolved.
+    DriftScan scan = DriftScan::kNone;
+    bool scanning = false;  // its scan is running now
     const View* lastView() const {
       auto it = views.find(camera);
       return it == views.end() ? nullptr : &it->second;

@@ -75,6 +75,17 @@ geom::Pose Scene::withEvents(geom::Pose pose, SceneEvent::Target target, std::st
   return pose;
 }
 
+geom::Intrinsics Scene::zoomed(geom::Intrinsics K, std::string_view name, double time) const {
+  for (const SceneEvent& e : events_) {
+    if (e.time > time) break;
+    if (e.target != SceneEvent::Target::kProjector || e.name != name) continue;
+    K.fx *= e.zoom;
+    K.fy *= e.zoom;
+    K.skew *= e.zoom;
+  }
+  return K;
+}
+
 Vec3 Scene::viewerPosition(double time) const {
   return placementPose(viewer_.placement, time).center();
 }
@@ -84,7 +95,7 @@ SceneState Scene::at(double time) const {
   state.time = time;
   for (const auto& spec : projectors_) {
     geom::CameraModel m;
-    m.K = spec.K;
+    m.K = zoomed(spec.K, spec.name, time);
     m.dist = spec.dist;
     m.pose = withEvents(placementPose(spec.placement, time), SceneEvent::Target::kProjector,
                         spec.name, time);

@@ -96,8 +96,9 @@ struct ViewerSpec {
 
 // A step change of the rig at `time` (a scene's [[events]]): a projector or camera
 // turned about its own centre (yaw, pitch, roll in its own frame: positive yaw turns the
-// optical axis right, pitch up, roll clockwise seen from behind) and moved; a surface
-// moved. Devices attached to a turned projector turn with it.
+// optical axis right, pitch up, roll clockwise seen from behind) and moved; a projector's
+// zoom ring turned (its focal lengths scaled about the principal point); a surface moved.
+// Devices attached to a turned projector turn with it.
 struct SceneEvent {
   enum class Target { kProjector, kCamera, kSurface };
   double time = 0;
@@ -105,6 +106,7 @@ struct SceneEvent {
   std::string name;
   Vec3 rotate_deg = Vec3::Zero();  // yaw, pitch, roll
   Vec3 move_m = Vec3::Zero();      // world metres
+  double zoom = 1;                 // projectors: fx and fy times this
 };
 
 // True state of every device at one time.
@@ -164,6 +166,8 @@ class Scene {
  private:
   friend class SceneBuilder;
   geom::Pose placementPose(const Placement& p, double time) const;
+  // A projector's intrinsics with the zoom events on it up to `time` applied.
+  geom::Intrinsics zoomed(geom::Intrinsics K, std::string_view name, double time) const;
   // A device's pose with the events on it up to `time` applied.
   geom::Pose withEvents(geom::Pose pose, SceneEvent::Target target, std::string_view name,
                         double time) const;

@@ -283,8 +283,8 @@ class Reader {
     return s;
   }
 
-  // [[events]]: `t`, `target` (a projector, camera or surface), `rotate_deg` (devices)
-  // and/or `move_m`.
+  // [[events]]: `t`, `target` (a projector, camera or surface), `rotate_deg` (devices),
+  // `move_m` and/or `zoom` (projectors).
   SceneEvent event(const Fields& f) {
     SceneEvent e;
     e.time = f.requiredIn("t", 0, 1e6);
@@ -304,7 +304,12 @@ class Reader {
     }
     const auto rotate = f.optionalVec3("rotate_deg");
     const auto move = f.optionalVec3("move_m");
-    if (!rotate && !move) f.errorHere("an event turns or moves its target: rotate_deg or move_m");
+    const bool zoom = f.has("zoom");
+    if (!rotate && !move && !zoom)
+      f.errorHere("an event turns, moves or zooms its target: rotate_deg, move_m or zoom");
+    if (zoom && e.target != SceneEvent::Target::kProjector)
+      f.error("zoom", "only a projector has a zoom ring");
+    e.zoom = zoom ? f.numberIn("zoom", 1, 0.5, 2) : 1.0;
     if (rotate && rotate->cwiseAbs().maxCoeff() > 180)
       f.error("rotate_deg", "each angle must lie in [-180, 180]");
     if (move && move->cwiseAbs().maxCoeff() > 100)

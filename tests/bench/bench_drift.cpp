@@ -13,8 +13,13 @@
 //    frames averaged) at rest on natural content: the largest misregistration seen and
 //    whether any run of checks over the 0.5 px threshold lasted the 0.5 s settle time (a
 //    false recalibration);
-//  - the pose correction's compute time.
-// Writes drift.csv (and drift_soak.csv) to --out DIR.
+//  - the pose correction's compute time;
+//  - the scans a correction escalates to when the content's steps fail their check (a
+//    projector zoomed 2 %: no pose with the old intrinsics explains it): the coarse Gray
+//    pass (Gray code alone, one code per 8 px) against the full scan (Gray code and
+//    phase shift): frames, decode and solve time (route (b′) on the wall), and the
+//    collineation's error against the true zoomed projector.
+// Writes drift.csv, drift_scans.csv (and drift_soak.csv) to --out DIR.
 //
 //   bench_drift [--out DIR] [--runs N]
 #include <algorithm>
@@ -29,6 +34,7 @@
 
 #include "bench_timing.hpp"
 #include "blend/rig_tiles.hpp"
+#include "calibration/plane_homography_route.hpp"
 #include "core/units.hpp"
 #include "drift/misregistration.hpp"
 #include "drift/projector_camera_map.hpp"
@@ -39,6 +45,8 @@
 #include "sim/renderer.hpp"
 #include "sim/scene_library.hpp"
 #include "sim/truth_rig.hpp"
+#include "structured_light/decoder.hpp"
+#include "structured_light/pattern_set.hpp"
 #include "unit/drift/textured_content.hpp"
 
 namespace {
@@ -180,6 +188,59 @@ double eccError(const Setup& s, const cv::Mat& shown, const cv::Mat& camera,
 
 }  // namespace
 
+// A scan of the projector `state` holds (route (b′) on the rig's wall): the camera's
+// captures of every frame of `set` (rendered once, new noise each), then decode and solve
+// timed; the error is the largest distance, in the true projector's pixels, between a
+// framebuffer pixel and where the true projector puts the wall point the collineation
+// gives it (every 40 px).
+struct ScanFigures {
+  int frames = 0;
+  double decode_ms = 0, solve_ms = 0, error_px = 0;
+  std::string failed;
+};
+ScanFigures scanFigures(const Setup& s, const sim::SceneState& state, const sl::PatternSet& set,
+                        int runs) {
+  ScanFigures f;
+  f.frames = static_cast<int>(set.frames.size());
+  std::vector<cv::Mat> captures;
+  for (std::size_t i = 0; i < set.frames.size(); ++i) {
+    auto r = sim::Renderer::create(s.scene, state, {{"proj", sl::renderFrame(set, i)}});
+    sim::RenderOptions o;
+    o.seed = 500 + i;
+    captures.push_back(
+        sim::Renderer::cameraImage(s.scene.cameras().at(0), *r->cameraRadiance("cam"), o));
+  }
+  const geom::CameraModel cam = s.rig.cameras.at(0).model;
+  Result<sl::Decoded> decoded = fail(ErrorCode::kInvalidInput, "not decoded");
+  f.decode_ms = bench::measure(runs, [&] { decoded = sl::decode(set, captures); }).median_ms;
+  if (!decoded) {
+    f.failed = decoded.error().message;
+    return f;
+  }
+  const calib::DecodedView view{"cam", cam, *decoded};
+  calib::PlaneHomographyOptions options;
+  options.step = set.options.mode == sl::Mode::kGray ? 16 : 8;  // the daemon's grids
+  Result<calib::PlaneHomographyResult> solved = fail(ErrorCode::kInvalidInput, "not solved");
+  f.solve_ms = bench::measure(runs, [&] {
+                 solved =
+                     calib::solvePlaneHomographyRoute(set, view, *s.rig.surface.plane, options);
+               }).median_ms;
+  if (!solved) {
+    f.failed = solved.error().message;
+    return f;
+  }
+  const geom::CameraModel& truth = state.projectors.at(0).model;
+  const geom::PlaneHomography& h = solved->projector_to_plane;
+  for (int y = 0; y < truth.height; y += 40) {
+    for (int x = 0; x < truth.width; x += 40) {
+      const Vec3 ab = h.H * Vec3(x, y, 1.0);
+      auto back = truth.project(h.basis.toWorld({ab.x() / ab.z(), ab.y() / ab.z()}));
+      f.error_px = std::max(f.error_px, back ? (*back - Vec2(x, y)).norm() : 1e9);
+    }
+  }
+  return f;
+}
+
 int main(int argc, char** argv) {
   std::filesystem::path out = "bench-out/bench_drift";
   int runs = 20;
@@ -265,6 +326,39 @@ int main(int argc, char** argv) {
       csv << c.name << "," << ref.median_ms << "," << meas.median_ms << "," << ecc.median_ms
           << ",33.3," << p99 << "," << bump << "," << truth << "," << measured << "," << ecc_err
           << "," << correct_ms << std::endl;
+    }
+  }
+
+  // The scans, of the projector zoomed 2 %.
+  {
+    sim::SceneState zoomed = s.scene.at(0);
+    geom::Intrinsics& K = zoomed.projectors.at(0).model.K;
+    K.fx *= 1.02;
+    K.fy *= 1.02;
+    std::ofstream scans(out / "drift_scans.csv");
+    scans << "scan,frames,decode_ms,solve_ms,error_px\n";
+    std::printf("Scans of the projector zoomed 2 %% (route (b') on the wall, %d runs):\n",
+                std::max(3, runs / 4));
+    struct Scan {
+      const char* name;
+      sl::Mode mode;
+      int step;
+    };
+    for (const Scan& sc :
+         {Scan{"coarse", sl::Mode::kGray, 8}, Scan{"full", sl::Mode::kGrayPhase, 1}}) {
+      sl::PatternOptions po;
+      po.width = 1920;
+      po.height = 1080;
+      po.mode = sc.mode;
+      po.step = sc.step;
+      const ScanFigures f = scanFigures(s, zoomed, *sl::makePatternSet(po), std::max(3, runs / 4));
+      std::printf(
+          "  %-6s %d frames (%.2f s at 60 Hz with 2 settle frames and one capture each), decode "
+          "%.0f ms, solve %.0f ms; the collineation %.3f px from the true projector (max)%s\n",
+          sc.name, f.frames, f.frames * 4 / 60.0, f.decode_ms, f.solve_ms, f.error_px,
+          f.failed.empty() ? "" : (": failed: " + f.failed).c_str());
+      scans << sc.name << "," << f.frames << "," << f.decode_ms << "," << f.solve_ms << ","
+            << f.error_px << std::endl;
     }
   }
 

@@ -106,19 +106,30 @@ json outputDrift(Connection& c) {
 
 // The rig model's projector (rig.json as the daemon wrote it) against the true one:
 // the largest distance, in the true projector's pixels, between a framebuffer pixel
-// and where the true projector puts the wall point the rig gives that pixel.
+// and where the true projector puts the wall point the rig gives that pixel (by its
+// pose, or by its collineation with the wall when the rig knows only that).
 double rigAgainstTruth(const TempDir& dir, const geom::CameraModel& truth) {
   auto rig = rig::rigFromText(rigText(dir), "rig.json");
   EXPECT_TRUE(rig) << rig.error().message;
   if (!rig) return 1e9;
   const rig::RigProjector& p = rig->projectors.at(0);
   const geom::CameraModel model = p.model();
+  const bool posed = p.pose_known && p.intrinsics_known;
+  if (!posed && !p.plane_homography) return 1e9;
+  const auto wallPoint = [&](int x, int y) -> std::optional<Vec3> {
+    if (!posed) {
+      const Vec3 ab = p.plane_homography->H * Vec3(x, y, 1.0);
+      return p.plane_homography->basis.toWorld({ab.x() / ab.z(), ab.y() / ab.z()});
+    }
+    auto ray = model.backproject({x, y});
+    auto hit = ray ? geom::intersectPlane(*ray, *rig->surface.plane) : std::nullopt;
+    return hit ? std::optional<Vec3>(hit->point) : std::nullopt;
+  };
   double worst = 0;
   for (int y = 0; y < p.height; y += 40) {
     for (int x = 0; x < p.width; x += 40) {
-      auto ray = model.backproject({x, y});
-      auto hit = ray ? geom::intersectPlane(*ray, *rig->surface.plane) : std::nullopt;
-      auto back = hit ? truth.project(hit->point) : std::nullopt;
+      auto hit = wallPoint(x, y);
+      auto back = hit ? truth.project(*hit) : std::nullopt;
       if (!back) return 1e9;
       worst = std::max(worst, (*back - Vec2(x, y)).norm());
     }
@@ -331,7 +342,9 @@ TEST(SimDrift, PlainContentIsReportedWhenSilentAndOffDoesNothing) {
 // the next fiducial frame and corrected from the tag corners.
 TEST(SimDrift, PlainContentIsCheckedWithFiducialFramesAndABumpCorrected) {
   TempDir dir;
-  const double bump_t = at(8.0);
+  // The first fiducial frame comes 3 to 4 s after the daemon starts on two busy cores
+  // (start, content, the first checks); then one every 2 s.
+  const double bump_t = at(10.0);
   const std::string scene_file =
       sceneWithEvents(dir, "[[events]]\nt = " + std::to_string(bump_t) +
                                "\ntarget = \"proj\"\nrotate_deg = [1.0, 0.0, 0.0]\n");
@@ -648,6 +661,83 @@ TEST(SimDrift, PlainContentWithTwoCamerasIsCorrectedFromFiducialFrames) {
   EXPECT_LE(rig_px, 0.5);
   // A handful of frames, not one at every check.
   EXPECT_LE(dr["fiducial"].value("frames", 0), 20) << dr.dump();
+}
+
+// The projector's zoom ring turned 5 %: no pose with the rig's intrinsics explains the
+// content's shift, so the content's correction fails its check and the projector is
+// scanned with the coarse Gray pass (34 frames), not the full scan; the rig then puts
+// the content where the true, zoomed projector does.
+TEST(SimDrift, AZoomedProjectorIsMeasuredAgainWithACoarseScan) {
+  TempDir dir;
+  const double zoom_t = at(6.0);
+  DriftRig r(dir,
+             "[[events]]\nt = " + std::to_string(zoom_t) + "\ntarget = \"proj\"\nzoom = 1.05\n",
+             false);
+  ASSERT_NO_FATAL_FAILURE(r.start(dir));
+  auto [scene, d, c, watcher] = std::tie(r.scene, r.d, r.c, r.watcher);
+  std::optional<json> detected, scanning, scanned, registered;
+  std::vector<std::string> steps;  // every step that ran or failed
+  bool status_scanning = false;
+  // The coarse scan: 34 captures, each a ray cast of the virtual camera (about 1 s on two
+  // idle cores, more when they are busy).
+  const auto deadline = Clock::now() + 150s * kSlowdown;
+  while (Clock::now() < deadline && !registered) {
+    auto e = watcher.next(500ms);
+    if (!e || (*e)["event"] != "drift") continue;
+    const std::string state = (*e)["state"];
+    if (state == "detected" && !detected) detected = *e;
+    if (state == "scanning") {
+      scanning = *e;
+      // Status says so while the scan runs.
+      const json dr = outputDrift(c);
+      status_scanning = dr.is_object() && dr.value("state", "") == "scanning";
+    }
+    if (state == "corrected-scan") scanned = *e;
+    if (state == "corrected") registered = *e;
+    if (e->contains("step")) steps.push_back((*e)["step"].get<std::string>() + ":" + state);
+    EXPECT_NE(state, "failed") << e->dump();
+  }
+  ASSERT_TRUE(detected && scanning && scanned && registered)
+      << testing::PrintToString(steps) << d.log();
+  // The content's pose could not explain a zoom, so the coarse pass ran, and only it.
+  EXPECT_EQ((*scanning)["step"], "coarse-scan") << scanning->dump();
+  EXPECT_NE((*scanning)["why"].get<std::string>().find("projector-pose"), std::string::npos)
+      << scanning->dump();
+  EXPECT_EQ((*scanning)["frames"], 34) << scanning->dump();
+  EXPECT_EQ((*scanned)["step"], "coarse-scan");
+  EXPECT_EQ((*registered)["scan"], "coarse-scan") << registered->dump();
+  EXPECT_TRUE(status_scanning);
+  for (const std::string& s : steps) EXPECT_EQ(s.find("full-scan"), std::string::npos) << s;
+  const geom::CameraModel truth = scene->at(zoom_t + at(1.0)).projectors.at(0).model;
+  EXPECT_NEAR(truth.K.fx, 1.05 * 2400.0, 1e-9);
+  const double rig_px = rigAgainstTruth(dir, truth);
+  const Measured m = keystoneAgainstTruth(c, truth);
+  const json dr = outputDrift(c);
+  auto rig = rig::rigFromText(rigText(dir), "rig.json");
+  ASSERT_TRUE(rig) << rig.error().message;
+  EXPECT_NE(rig->projectors.at(0).calibrated.method.find("drift correction, coarse-scan"),
+            std::string::npos)
+      << rig->projectors.at(0).calibrated.method;
+  EXPECT_EQ(rig->projectors.at(0).name, "proj");
+  std::printf(
+      "[ figures  ] projector zoomed 5 %%: detected at %.2f px; %s; coarse scan of %d frames "
+      "(route %s) in %.1f s; registered at %.3f px; the rig against the true projector %.3f "
+      "px, keystone corner %.3f px, aspect %.4f %%, area %.4f %%; steps %s\n",
+      (*detected)["check"]["misregistration_px"].get<double>(),
+      (*scanning)["why"].get<std::string>().c_str(), (*scanning)["frames"].get<int>(),
+      (*scanning)["route"].get<std::string>().c_str(), (*scanned)["scan_s"].get<double>(),
+      (*registered)["check"]["misregistration_px"].get<double>(), rig_px, m.corner_px,
+      100 * m.aspect_rel, 100 * m.area_rel, testing::PrintToString(steps).c_str());
+  EXPECT_LE(rig_px, 0.5);
+  EXPECT_LE(m.corner_px, 0.5);
+  EXPECT_LE(m.aspect_rel, 1e-3);
+  EXPECT_LE(m.area_rel, 5e-3);
+  EXPECT_LE(dr.value("misregistration_px", 1e9), 0.5) << dr.dump();
+  // The scan's operation is over and the content is back.
+  auto st = c.call({{"cmd", "status"}});
+  ASSERT_TRUE(st);
+  EXPECT_TRUE((*st)["operations"].empty()) << st->dump();
+  EXPECT_EQ((*st)["outputs"]["shown"][0]["source"], "content");
 }
 
 }  // namespace

@@ -45,6 +45,15 @@ struct CameraRadiance {
   std::shared_ptr<const World> world;
   std::uint64_t shows = 0;
   cv::Mat radiance;
+  std::vector<double> lenses;  // every projector's fx, fy, skew (a zoom event changes them)
+
+  static std::vector<double> lensesOf(const SceneState& state) {
+    std::vector<double> out;
+    for (const auto& p : state.projectors) {
+      out.insert(out.end(), {p.model.K.fx, p.model.K.fy, p.model.K.skew});
+    }
+    return out;
+  }
 
   static std::vector<geom::Pose> posesOf(const SceneState& state) {
     std::vector<geom::Pose> out;
@@ -53,7 +62,8 @@ struct CameraRadiance {
     return out;
   }
   bool sameAs(const std::vector<geom::Pose>& p, const SceneState& state, std::uint64_t n) const {
-    if (radiance.empty() || n != shows || state.world != world || p.size() != poses.size()) {
+    if (radiance.empty() || n != shows || state.world != world || p.size() != poses.size() ||
+        lensesOf(state) != lenses) {
       return false;
     }
     // A held pose evaluated at another time differs by rounding (a few 1e-16 from the
@@ -283,11 +293,12 @@ int cameraCapture(void* self, int, procam_image* out, char* err, size_t len) {
     if (spec->latency_s > 0 || !dev->cache.sameAs(poses, state, shows)) {
       dev->cache = {};
       const std::shared_ptr<const World> world = state.world;
+      std::vector<double> lenses = CameraRadiance::lensesOf(state);
       auto renderer = Renderer::create(scene, std::move(state), shown);
       if (!renderer) return report(err, len, renderer.error().message, PROCAM_EIO);
       auto radiance = renderer->cameraRadiance(dev->name);
       if (!radiance) return report(err, len, radiance.error().message, PROCAM_EIO);
-      dev->cache = {poses, world, shows, std::move(*radiance)};
+      dev->cache = {poses, world, shows, std::move(*radiance), std::move(lenses)};
     }
     // A real sensor's noise is new in every frame: averaging frames reduces it.
     RenderOptions options;

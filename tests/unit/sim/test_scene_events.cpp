@@ -110,10 +110,32 @@ move_m = [0.0, 0.0, 0.002]
   }
 }
 
+TEST(SceneEvents, AZoomedProjectorScalesItsFocalLengthsFromItsTime) {
+  auto scene = Scene::parse(eventScene(R"(
+[[events]]
+t = 1.0
+target = "proj"
+zoom = 1.03
+)"),
+                            "zoom.toml", {});
+  ASSERT_TRUE(scene) << scene.error().message;
+  const SceneState before = scene->at(0.9), after = scene->at(1.1);
+  const auto& k0 = before.projector("proj")->model;
+  const auto& k1 = after.projector("proj")->model;
+  EXPECT_NEAR(k1.K.fx, 1.03 * k0.K.fx, 1e-9);
+  EXPECT_NEAR(k1.K.fy, 1.03 * k0.K.fy, 1e-9);
+  EXPECT_EQ(k1.K.cx, k0.K.cx);
+  EXPECT_EQ(k1.K.cy, k0.K.cy);
+  EXPECT_EQ(k1.pose.R, k0.pose.R);  // only the lens changed
+  EXPECT_EQ(k1.pose.t, k0.pose.t);
+}
+
 TEST(SceneEvents, EventsThatNameNothingOrDoNothingAreRefused) {
   for (const auto& [events, key] : std::vector<std::pair<std::string, std::string>>{
            {"[[events]]\nt = 1.0\ntarget = \"nobody\"\nmove_m = [0.0, 0.0, 0.1]\n", "target"},
-           {"[[events]]\nt = 1.0\ntarget = \"proj\"\n", "rotate_deg or move_m"},
+           {"[[events]]\nt = 1.0\ntarget = \"proj\"\n", "rotate_deg, move_m or zoom"},
+           {"[[events]]\nt = 1.0\ntarget = \"cam\"\nzoom = 1.02\n", "zoom"},
+           {"[[events]]\nt = 1.0\ntarget = \"proj\"\nzoom = 3.0\n", "zoom"},
            {"[[events]]\nt = 1.0\ntarget = \"wall\"\nrotate_deg = [1.0, 0.0, 0.0]\n", "rotate_deg"},
            {"[[events]]\nt = 1.0\ntarget = \"proj\"\nrotate_deg = [200.0, 0.0, 0.0]\n",
             "rotate_deg"},

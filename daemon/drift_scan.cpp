@@ -1,0 +1,221 @@
+// recalibrate = "on-drift" when the content's corrections fail their check: the
+// projector scanned with structured light, as calibrate scans it (calibration_plan.hpp),
+// first a coarse Gray pass, then, when that one's check fails too, the full scan
+// (drift_ladder.hpp nextDriftScan). The scan runs as a calibrate operation of its own:
+// the outputs' frames wait, a user's calibrate is busy meanwhile and `cancel` stops it.
+// Loop thread only; the scan itself on the compute worker.
+#include "calibration_plan.hpp"
+#include "daemon.hpp"
+#include "device_manager.hpp"
+#include "log.hpp"
+#include "output_draw.hpp"
+#include "protocol.hpp"
+
+namespace procam::daemon {
+
+using nlohmann::json;
+
+namespace {
+
+// The coarse pass: Gray code alone (no phase frames), one code per 8 projector pixels and
+// nodes every 16. A collineation or a pose needs few, well-spread nodes ([Raskar02]
+// §4.2.1); on a 1920x1080 projector this is 34 frames against the full scan's 62, and no
+// phase to decode.
+constexpr int kCoarseStep = 8;
+constexpr int kCoarseGrid = 16;
+
+// What becomes of the rig when a step fails: corrections that did not converge are
+// dropped (restoreBeforeDrift), else nothing changes.
+std::string keptNote(const DriftRuntime::Output& o) {
+  return o.before ? "; the devices as they were before the corrections go back"
+                  : "; the rig model stays as it was";
+}
+
+}  // namespace
+
+void Daemon::escalateDrift(const std::string& output, const std::string& camera,
+                           const std::string& step, const std::string& why,
+                           const drift::Misregistration& m) {
+  DriftRuntime::Output& o = drift_rt_.outputs[output];
+  const auto next = nextDriftScan(o.scan, config_.recalibrate);
+  if (!next) {
+    unresolveDrift(output, camera, step, why + keptNote(o), m);
+    return restoreBeforeDrift(o);
+  }
+  scanForDrift(output, camera, *next, step + ": " + why, m);
+}
+
+void Daemon::scanForDrift(const std::string& output, const std::string& camera, DriftScan which,
+                          const std::string& why, const drift::Misregistration& m) {
+  DriftRuntime& d = drift_rt_;
+  DriftRuntime::Output& o = d.outputs[output];
+  const char* step = driftScanName(which);
+  const auto giveUp = [&](const std::string& reason) {
+    unresolveDrift(output, camera, step, reason + keptNote(o), m);
+    restoreBeforeDrift(o);
+  };
+  auto args = parseCalibrationArgs(json::object(), config_.calibration);
+  if (!args) return giveUp("the scan's settings: " + args.error());
+  args->output = output;
+  if (which == DriftScan::kCoarse) {
+    args->mode = sl::Mode::kGray;
+    args->step = kCoarseStep;
+    args->grid = kCoarseGrid;
+  }
+  // The cameras that check the output: two triangulate (route (a)), one takes the rig's
+  // plane (route (b′)).
+  for (const std::string& c : o.cameras) {
+    if (args->cameras.size() < 2) args->cameras.push_back(c);
+  }
+  args->response = false;
+  // Corrections that did not converge are dropped: the scan starts from the devices as
+  // a check last confirmed them (the cameras' poses route (a) triangulates with).
+  const rig::RigModel base = o.before ? rig::mergeRig(rig_, *o.before) : rig_;
+  auto made = makeCalibrationPlan(devices_, *args, config_.calibration, base);
+  if (!made) return giveUp("the " + std::string(step) + " cannot run: " + made.error().message);
+  made->scene_plane = std::make_shared<std::optional<geom::Plane>>(base.surface.plane);
+  auto plan = std::make_shared<const CalibrationPlan>(std::move(*made));
+  // Other outputs show black: their light would fall into the captures.
+  std::vector<IdleOutput> idle;
+  for (auto& e : devices_.entries()) {
+    if (e.description.family != PROCAM_FAMILY_OUTPUT || !e.usable() || e.name == output) continue;
+    if (auto mode = outputMode(e.device.raw())) {
+      idle.push_back({{e.name, e.device.share()}, mode->width, mode->height});
+    }
+  }
+  std::vector<std::string> used{output};
+  json cameras = json::array();
+  for (const auto& c : plan->cameras) {
+    used.push_back(c.device.name);
+    cameras.push_back(c.device.name);
+  }
+  const std::string op_id = "op-" + std::to_string(next_operation_++);
+  auto cancelled = std::make_shared<std::atomic<bool>>(false);
+  // No client waits for it: its events go to the watchers.
+  operations_[op_id] = Operation{"calibrate", 0, nullptr, cancelled};
+  const ReadFence fence = device_manager_->readFence(used);
+  beginCalibrationOp(op_id, used);
+  o.scanning = true;
+  o.scan = which;
+  const int captures = plan->captures();
+  const json started = {{"output", output},
+                        {"camera", camera},
+                        {"state", "scanning"},
+                        {"step", step},
+                        {"why", why},
+                        {"operation", op_id},
+                        {"route", plan->planar() ? "b'" : "a"},
+                        {"cameras", cameras},
+                        {"frames", plan->frames()},
+                        {"captures", captures},
+                        {"check", misregistrationJson(m)}};
+  logInfo("drift: output '" + output + "': " + why + "; " + step + " (" +
+          std::to_string(plan->frames()) + " frames, operation " + op_id + ")");
+  broadcast("drift", started);
+  auto progress = [op_id, captures](const CalibrationProgress& p) {
+    return json{{"operation", op_id}, {"kind", "calibrate"},  {"fraction", p.fraction},
+                {"stage", p.stage},   {"capture", p.capture}, {"captures", captures}};
+  };
+  operationEvent(0, "progress", progress({0, "starting", 0}));
+  const CalibrationHooks hooks = operationHooks(0, op_id, cancelled, progress);
+  const auto started_at = DriftRuntime::Clock::now();
+  // The operation ends once its result is written (or it failed): until then a
+  // calibrate request is busy and the outputs' frames wait.
+  const auto finish = [this, op_id, output](const CalibrationFailure* failure) {
+    operations_.erase(op_id);
+    calibration_.op.clear();
+    if (auto it = drift_rt_.outputs.find(output); it != drift_rt_.outputs.end()) {
+      it->second.scanning = false;
+    }
+    json finished = {{"operation", op_id}, {"kind", "calibrate"}, {"ok", failure == nullptr}};
+    if (failure) {
+      finished["error"] = failure->message;
+      logWarning("calibrate " + op_id + " (drift scan of output '" + output +
+                 "'): " + failure->message);
+    }
+    operationEvent(0, "finished", finished);
+    if (failure && closesDevice(failure->rc)) {
+      device_manager_->report(failure->device, failure->rc, failure->message);
+    }
+    refreshOutputs();  // the content again
+  };
+  compute_worker_->submit(
+      [this, plan, idle, hooks, fence, cancelled, output, camera, which, m, finish, started_at] {
+        fence.wait();
+        for (const IdleOutput& i : idle) (void)blankOutput(i);
+        auto r = runCalibration(*plan, hooks);
+        return [this, plan, r = std::move(r), cancelled, output, camera, which, m, finish,
+                started_at] {
+          const char* step = driftScanName(which);
+          auto it = drift_rt_.outputs.find(output);
+          if (!r || cancelled->load()) {
+            const CalibrationFailure f = stoppedRun(r ? nullptr : &r.error(), "scan cancelled");
+            finish(&f);
+            if (it != drift_rt_.outputs.end()) {
+              unresolveDrift(
+                  output, camera, step,
+                  "the " + std::string(step) + " failed: " + f.message + keptNote(it->second), m);
+              restoreBeforeDrift(it->second);
+            }
+            return;
+          }
+          if (it == drift_rt_.outputs.end()) return finish(nullptr);  // the output went away
+          DriftRuntime::Output& o = it->second;
+          Learnt learnt = learntFromRun(*plan, *r);
+          // The scan measures the geometry of the rig's projector for this output: it keeps
+          // that one's name, tilt mount and photometric record.
+          const rig::RigProjector* old = rig_.projectorForOutput(output);
+          std::string name = output;
+          for (rig::RigProjector& p : learnt.update.projectors) {
+            p.calibrated.method =
+                "drift correction, " + std::string(step) + ": " + p.calibrated.method;
+            if (!old) continue;
+            if (auto mesh = learnt.update.surface.meshes.extract(p.name)) {
+              mesh.key() = old->name;
+              learnt.update.surface.meshes.insert(std::move(mesh));
+            }
+            p.name = name = old->name;
+            p.tilt = old->tilt;
+            if (p.photometric.is_null()) p.photometric = old->photometric;
+          }
+          // The devices as a check last confirmed them, the projector as scanned.
+          rig::RigModel update =
+              o.before ? rig::mergeRig(*o.before, learnt.update) : std::move(learnt.update);
+          json event = {{"output", output},
+                        {"projector", name},
+                        {"step", step},
+                        {"scan_s", secondsSince(started_at)},
+                        {"frames", plan->frames()},
+                        {"decoded", r->decoded},
+                        {"learnt", learnt.reply}};
+          event["learnt"].erase("projector");  // rig.json has it
+          logInfo("drift: output '" + output + "': the " + step + " measured the projector (" +
+                  std::to_string(plan->frames()) + " frames, " +
+                  std::to_string(secondsSince(started_at)) + " s)");
+          writeDriftCorrection(
+              output, std::move(update), std::move(event), "corrected-scan",
+              std::move(learnt.meshes), [this, output, finish](const Result<std::string>& written) {
+                if (!written) {
+                  const CalibrationFailure f{proto::code::kIo, written.error().message};
+                  return finish(&f);
+                }
+                // What was kept to restore is now the scan's.
+                if (auto it = drift_rt_.outputs.find(output); it != drift_rt_.outputs.end()) {
+                  it->second.before.reset();
+                }
+                finish(nullptr);
+              });
+        };
+      },
+      [this, output, camera, which, m, finish](const std::string& what) {
+        const CalibrationFailure f{proto::code::kInternal, "the scan failed: " + what};
+        finish(&f);
+        auto it = drift_rt_.outputs.find(output);
+        if (it != drift_rt_.outputs.end()) {
+          unresolveDrift(output, camera, driftScanName(which), f.message + keptNote(it->second), m);
+          restoreBeforeDrift(it->second);
+        }
+      });
+}
+
+}  // namespace procam::daemon
