@@ -83,19 +83,21 @@ tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const json& requ
   }
   std::string error;
   if (auto it = request.find("mode"); it != request.end()) {
-    if (*it == "apriltag") {
+    if (*it == "apriltag" || *it == "adaptive") {
       a.tags = true;
+      a.adaptive = *it == "adaptive";
       for (const char* gray_only : {"step", "phase_steps", "grid"}) {
         if (request.contains(gray_only)) {
           return tl::unexpected("\"" + std::string(gray_only) +
-                                "\" is for Gray-code scans, not \"mode\": \"apriltag\"");
+                                "\" is for Gray-code scans, not \"mode\": \"" +
+                                it->get<std::string>() + "\"");
         }
       }
     } else {
       auto mode = it->is_string() ? sl::parseMode(it->get<std::string>()) : Result<sl::Mode>{};
       if (!it->is_string() || !mode) {
         return tl::unexpected(
-            std::string("\"mode\" must be \"gray\", \"gray+phase\" or \"apriltag\""));
+            std::string("\"mode\" must be \"gray\", \"gray+phase\", \"apriltag\" or \"adaptive\""));
       }
       a.mode = *mode;
     }
@@ -143,7 +145,7 @@ tl::expected<CalibrationArgs, std::string> parseCalibrationArgs(const json& requ
     if (a.tags && *a.response) {
       return tl::unexpected(std::string(
           "\"response\" measures the projector over the pixels a Gray-code scan decoded: not "
-          "with \"mode\": \"apriltag\""));
+          "with \"mode\": \"apriltag\" or \"adaptive\""));
     }
   }
   if (a.tags) a.response = false;

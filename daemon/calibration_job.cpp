@@ -251,7 +251,7 @@ tl::expected<std::vector<CalibrationOutcome>, CalibrationFailure> runBatchCalibr
       return tl::unexpected(CalibrationFailure{
           code::kFailed, "internal: a tag frame calibrates one projector at a time"});
     }
-    auto one = runTagCalibration(plan, hooks);
+    auto one = plan.coarse ? runAdaptiveCalibration(plan, hooks) : runTagCalibration(plan, hooks);
     if (!one) return tl::unexpected(one.error());
     std::vector<CalibrationOutcome> outcomes;
     outcomes.push_back(std::move(*one));

@@ -36,6 +36,9 @@ struct CalibrationArgs {
   sl::Mode mode = sl::Mode::kGrayPhase;
   // mode "apriltag": one frame of tags instead of the Gray sequence (route (b′) only).
   bool tags = false;
+  // mode "adaptive": a coarse Gray pass first; on a plane the tag frame finishes, a
+  // surface that is not planar is refused (route (b′) only).
+  bool adaptive = false;
   int step = 1;  // one code per `step` projector pixels
   int phase_steps = 8;
   int grid = 8;              // projector pixels between solved nodes
@@ -87,6 +90,10 @@ struct CalibrationPlan {
   // capture per camera; its corners are the nodes of route (b′) ([Raskar02] §4.2.4:
   // on a plane a collineation needs only four). `set` then only sizes the frame.
   std::shared_ptr<const FiducialFrame> tags;
+  // Set with `tags`: the adaptive path, this coarse pass (sl::coarsePatternSet, 16x12
+  // blocks) before the tag frame, to tell whether the surface is planar ([Raskar02]
+  // §4.1.4's coarse binary-coded pass).
+  std::optional<sl::PatternSet> coarse;
   int grid = 8;
   int settle_frames = 2;
   bool auto_settle = false;   // measure the latency (latency_probe.hpp) and settle by it
@@ -112,7 +119,10 @@ struct CalibrationPlan {
   // together (calib::solveWallViews) after the last scan.
   bool wallViews() const { return plane && !board && cameras.size() > 1; }
 
-  int frames() const { return tags ? 1 : static_cast<int>(set.frames.size()); }
+  int frames() const {
+    if (!tags) return static_cast<int>(set.frames.size());
+    return 1 + (coarse ? static_cast<int>(coarse->frames.size()) : 0);
+  }
   int captures() const {
     return static_cast<int>(frames() * cameras.size()) +
            (response ? static_cast<int>(kRampLevels.size()) : 0);
@@ -155,6 +165,7 @@ struct CalibrationOutcome {
   std::vector<int> decoded;  // camera pixels decoded, per camera
   int settle_frames = 0;     // waited after every pattern
   nlohmann::json latency;    // the measured latency (auto_settle; latencyJson), else null
+  nlohmann::json coarse;     // the adaptive path's coarse pass: {frames, planar, ...}, else null
 };
 
 // Shared with the latency probe (latency_probe.hpp).
@@ -199,6 +210,18 @@ tl::expected<double, CalibrationFailure> settleFor(const CalibrationPlan& plan,
 // the tag frame shown, one capture per camera, the first camera's corners fitted and
 // solved as calib::solvePlaneFromNodes (tag_calibration_job.cpp).
 tl::expected<CalibrationOutcome, CalibrationFailure> runTagCalibration(
+    const CalibrationPlan& plan, const CalibrationHooks& hooks);
+// The tag frame shown, captured and solved as above, after `settleFor` gave `out` its
+// settle frames; progress from `start` on.
+tl::expected<CalibrationOutcome, CalibrationFailure> tagFrameOutcome(const CalibrationPlan& plan,
+                                                                     const CalibrationHooks& hooks,
+                                                                     CalibrationOutcome out,
+                                                                     double start);
+// The adaptive path (plan.coarse with plan.tags): the coarse pass shown and captured by
+// the first camera, its blocks tested for one homography (sl::testPlanarity); planar,
+// the tag frame finishes as runTagCalibration; not planar, kFailed naming the fit
+// (adaptive_calibration_job.cpp).
+tl::expected<CalibrationOutcome, CalibrationFailure> runAdaptiveCalibration(
     const CalibrationPlan& plan, const CalibrationHooks& hooks);
 
 // Several projectors whose images do not overlap scanned at once: every member shows

@@ -7,6 +7,7 @@
 
 #include "protocol.hpp"
 #include "rig_store.hpp"
+#include "structured_light/adaptive_scan.hpp"
 #include "surface/surface_model.hpp"
 
 namespace procam::daemon {
@@ -142,10 +143,11 @@ tl::expected<CalibrationPlan, Failure> makeCalibrationPlan(DeviceSet& devices,
     }
   }
   if (args.tags && (!planar || several || args.board)) {
-    return tl::unexpected(Failure{
-        code::kBadArgument,
-        "\"mode\": \"apriltag\" is route (b′) with one camera and the display plane (\"plane\" "
-        "or the rig model's surface plane), not with a board or several cameras"});
+    return tl::unexpected(
+        Failure{code::kBadArgument,
+                std::string("\"mode\": \"") + (args.adaptive ? "adaptive" : "apriltag") +
+                    "\" is route (b′) with one camera and the display plane (\"plane\" or the rig "
+                    "model's surface plane), not with a board or several cameras"});
   }
   uint32_t w = 0, h = 0;
   const auto& raw = out->device.raw();
@@ -156,6 +158,14 @@ tl::expected<CalibrationPlan, Failure> makeCalibrationPlan(DeviceSet& devices,
     auto tags = makeFiducialFrame({static_cast<int>(w), static_cast<int>(h)});
     if (!tags) return tl::unexpected(Failure{code::kUnavailable, tags.error()});
     plan.tags = *tags;
+  }
+  if (args.adaptive) {
+    sl::AdaptiveOptions coarse;
+    coarse.full.width = static_cast<int>(w);
+    coarse.full.height = static_cast<int>(h);
+    auto set = sl::coarsePatternSet(coarse);
+    if (!set) return tl::unexpected(Failure{code::kBadArgument, set.error().message});
+    plan.coarse = std::move(*set);
   }
   if (!(plan.refresh_hz > 0)) plan.refresh_hz = 60;
   sl::PatternOptions po;
@@ -248,7 +258,9 @@ Learnt learntByPlaneRoute(const CalibrationPlan& plan, const CalibrationOutcome&
     }
   }
   projector.calibrated = {
-      std::string(plan.tags ? "one AprilTag frame" : "structured light") +
+      std::string(plan.coarse ? "a coarse Gray pass (planar) and one AprilTag frame"
+                  : plan.tags ? "one AprilTag frame"
+                              : "structured light") +
           ", route (b′): " + cameras + ", plane from the " +
           (result.board                ? "board " + plan.board_text
            : result.triangulated_plane ? "cameras " + plan.cameras.at(0).device.name + " and " +
@@ -310,6 +322,7 @@ Learnt learntFromRun(const CalibrationPlan& plan, const CalibrationOutcome& outc
   } else if (!outcome.response_note.empty()) {
     learnt.reply["response"] = {{"measured", false}, {"why", outcome.response_note}};
   }
+  if (!outcome.coarse.is_null()) learnt.reply["coarse"] = outcome.coarse;
   return learnt;
 }
 

@@ -186,8 +186,9 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
                   {"output", plan->output.name},
                   {"cameras", cameras},
                   {"route", plan->planar() ? "b'" : "a"},
-                  {"mode", plan->tags ? std::string("apriltag")
-                                      : std::string(sl::toString(plan->set.options.mode))},
+                  {"mode", plan->coarse ? std::string("adaptive")
+                           : plan->tags ? std::string("apriltag")
+                                        : std::string(sl::toString(plan->set.options.mode))},
                   {"frames", plan->frames()},
                   {"captures", captures},
                   {"settle_frames", plan->auto_settle ? json("auto") : json(plan->settle_frames)}};

@@ -25,7 +25,20 @@ tl::expected<CalibrationOutcome, CalibrationFailure> runTagCalibration(
   CalibrationOutcome out;
   auto settled = settleFor(plan, hooks, out);
   if (!settled) return tl::unexpected(settled.error());
-  const double start = *settled;
+  return tagFrameOutcome(plan, hooks, std::move(out), *settled);
+}
+
+tl::expected<CalibrationOutcome, CalibrationFailure> tagFrameOutcome(const CalibrationPlan& plan,
+                                                                     const CalibrationHooks& hooks,
+                                                                     CalibrationOutcome out,
+                                                                     double start) {
+  const CalibrationFailure cancelled{code::kCancelled, "calibration cancelled"};
+  const auto failed = [&](const std::string& why) {
+    return tl::unexpected(CalibrationFailure{code::kFailed, why});
+  };
+  if (!plan.tags || !plan.plane || plan.cameras.empty()) {
+    return failed("internal: the tag frame is route (b′) with a camera and a plane");
+  }
   if (hooks.cancelled()) return tl::unexpected(cancelled);
   if (auto shown = showFrame(plan.output, plan.tags->rgb, "show the tag frame"); !shown) {
     return tl::unexpected(shown.error());
@@ -38,8 +51,10 @@ tl::expected<CalibrationOutcome, CalibrationFailure> runTagCalibration(
     auto grey = captureGray(plan.cameras[c].device);
     if (!grey) return tl::unexpected(grey.error());
     captures.push_back(std::move(*grey));
-    const int done = static_cast<int>(c + 1);
-    hooks.progress({start + (0.9 - start) * done / static_cast<double>(plan.cameras.size()),
+    // The coarse pass's captures (the adaptive path) came before.
+    const int done = plan.captures() - static_cast<int>(plan.cameras.size() - c - 1);
+    hooks.progress({start + (0.9 - start) * static_cast<double>(c + 1) /
+                                static_cast<double>(plan.cameras.size()),
                     "capturing", done});
     if (hooks.cancelled()) return tl::unexpected(cancelled);
   }

@@ -60,7 +60,7 @@ std::optional<json> calibrateOnTheWall(Connection& c, const DaemonProcess& d, co
   EXPECT_EQ((*started)["route"], "b'");
   EXPECT_EQ((*started)["cameras"], json({"cam"}));
   if ((*started)["class"] != "CALIBRATE") return std::nullopt;
-  auto done = finalReply(c, request["id"].get<int>(), 240s);
+  auto done = finalReply(c, request["id"].get<int>(), 480s);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_TRUE(done) << d.log();
@@ -172,7 +172,7 @@ TEST(SimRigKeystone, CalibratedPlanarWallKeystonesFromTheRig) {
   ASSERT_TRUE(again);
   ASSERT_EQ((*again)["class"], "CALIBRATE") << again->dump();
   EXPECT_EQ((*again)["route"], "b'");
-  auto redone = finalReply(c, 2, 240s);
+  auto redone = finalReply(c, 2, 480s);
   ASSERT_TRUE(redone) << d.log();
   ASSERT_EQ((*redone)["class"], "CALIBRATE") << redone->dump();
   EXPECT_EQ((*redone)["plane_source"], "rig");
@@ -238,6 +238,77 @@ TEST(SimRigKeystone, OneTagFrameCalibratesThePlanarWall) {
       100 * fit["coverage"].get<double>());
   EXPECT_EQ(fit["inliers"], fit["samples"]);
   ASSERT_NO_FATAL_FAILURE(keystoneFromTheRigMatchesTruth(c, dir, truth));
+}
+
+// "mode": "adaptive" with only the camera's calibration given: the coarse Gray pass (16x12
+// blocks, 18 frames) finds wall_oblique planar and one tag frame finishes, 19 frames in
+// all, the keystone from it as from the full scan; on corner_stereo (two walls meeting
+// in a corner, one camera named) the same pass finds the surface not planar and the
+// calibration is refused, the rig model left without a projector.
+TEST(SimRigKeystone, AnAdaptiveScanStopsAtOneTagFrameOnAPlaneAndRefusesACorner) {
+  {
+    auto scene = sim::resolveScene("wall_oblique");
+    ASSERT_TRUE(scene) << scene.error().message;
+    TempDir dir;
+    DaemonProcess d(dir, simWithTruth(dir, "wall_oblique", TruthParts::kCamerasOnly));
+    ASSERT_TRUE(d.started()) << d.log();
+    Connection c(d.socketPath());
+    auto bad = c.call({{"cmd", "calibrate"}, {"mode", "adaptive"}, {"grid", 8}});
+    ASSERT_TRUE(bad);
+    EXPECT_EQ((*bad)["code"], "bad-argument") << bad->dump();
+    const auto t0 = std::chrono::steady_clock::now();
+    auto started = c.call({{"cmd", "calibrate"},
+                           {"id", 1},
+                           {"mode", "adaptive"},
+                           {"plane", kWallPlane},
+                           {"settle_frames", 0}});
+    ASSERT_TRUE(started);
+    ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
+    EXPECT_EQ((*started)["mode"], "adaptive");
+    EXPECT_EQ((*started)["frames"], 19);
+    EXPECT_EQ((*started)["captures"], 19);
+    auto done = finalReply(c, 1, 480s);
+    ASSERT_TRUE(done) << d.log();
+    ASSERT_EQ((*done)["class"], "CALIBRATE") << done->dump();
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const json& coarse = (*done)["coarse"];
+    std::printf(
+        "[ figures  ] adaptive on wall_oblique: calibrate %.1f s, coarse pass %d frames, %d "
+        "blocks fit one homography to %.3f projector px (a plane allows %.3f); tag frame: "
+        "collineation %.4f projector px RMS\n",
+        seconds, coarse["frames"].get<int>(), coarse["blocks"].get<int>(),
+        coarse["rms_px"].get<double>(), coarse["tolerance_px"].get<double>(),
+        (*done)["homography"]["rms_projector_px"].get<double>());
+    EXPECT_TRUE(coarse["planar"].get<bool>()) << done->dump();
+    EXPECT_EQ(coarse["frames"], 18);
+    ASSERT_NO_FATAL_FAILURE(
+        keystoneFromTheRigMatchesTruth(c, dir, scene->at(0).projectors.at(0).model));
+  }
+  TempDir dir;
+  DaemonProcess d(dir, simWithTruth(dir, "corner_stereo", TruthParts::kCamerasOnly));
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  auto started = c.call({{"cmd", "calibrate"},
+                         {"id", 2},
+                         {"mode", "adaptive"},
+                         {"cameras", {"cam_left"}},
+                         {"plane", {0.0, 1.0, 0.0, -3.0}},
+                         {"settle_frames", 0}});
+  ASSERT_TRUE(started);
+  ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
+  auto done = finalReply(c, 2, 480s);
+  ASSERT_TRUE(done) << d.log();
+  std::printf("[ figures  ] adaptive on corner_stereo: %s\n",
+              done->value("message", std::string()).c_str());
+  EXPECT_EQ((*done)["code"], "failed") << done->dump();
+  EXPECT_NE(done->value("message", std::string()).find("not planar"), std::string::npos)
+      << done->dump();
+  // Nothing written: rig.json still holds the cameras alone.
+  std::ifstream rig_file(dir.file("state/rig.json"));
+  const json rig = json::parse(rig_file, nullptr, false);
+  ASSERT_TRUE(rig.is_object());
+  EXPECT_TRUE(!rig.contains("projectors") || rig["projectors"].empty()) << rig.dump();
 }
 
 // Nothing from truth but the camera's calibration: the wall is found from a board
