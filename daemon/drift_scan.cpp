@@ -19,7 +19,7 @@ namespace {
 
 // The coarse pass: Gray code alone (no phase frames), one code per 8 projector pixels and
 // nodes every 16. A collineation or a pose needs few, well-spread nodes ([Raskar02]
-// §4.2.1); on a 1920x1080 projector this is 34 frames against the full scan's 62, and no
+// §4.2.1); on a 1920x1080 projector this is 34 frames against the full scan's 50, and no
 // phase to decode.
 constexpr int kCoarseStep = 8;
 constexpr int kCoarseGrid = 16;

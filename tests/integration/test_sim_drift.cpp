@@ -342,9 +342,11 @@ TEST(SimDrift, PlainContentIsReportedWhenSilentAndOffDoesNothing) {
 // the next fiducial frame and corrected from the tag corners.
 TEST(SimDrift, PlainContentIsCheckedWithFiducialFramesAndABumpCorrected) {
   TempDir dir;
-  // The first fiducial frame comes 3 to 4 s after the daemon starts on two busy cores
-  // (start, content, the first checks); then one every 2 s.
-  const double bump_t = at(10.0);
+  // The first fiducial frame comes 3 to 4 s after the daemon starts on two idle cores
+  // (start, content, the first checks), then one every 3 s or so (a 2 s period, and a
+  // second for the virtual camera to render each new frame); on two busy cores a capture
+  // takes 3 s.
+  const double bump_t = at(14.0);
   const std::string scene_file =
       sceneWithEvents(dir, "[[events]]\nt = " + std::to_string(bump_t) +
                                "\ntarget = \"proj\"\nrotate_deg = [1.0, 0.0, 0.0]\n");
@@ -436,7 +438,11 @@ TEST(SimDrift, ACameraUnpluggedAfterDriftWasSeenLeavesTheRigUntilItIsBack) {
   const json gone = outputDrift(c);
   ASSERT_TRUE(gone.is_object()) << d.log();
   EXPECT_EQ(gone.value("corrections", 0), 0) << gone.dump();
-  EXPECT_GE(gone.value("failures", 0), 1) << gone.dump();
+  // The camera's absence seen: by a check that failed on it, or, when the device manager
+  // closed it first (a busy machine), by no check running without it.
+  EXPECT_TRUE(gone.value("failures", 0) >= 1 ||
+              gone.value("unavailable", "").find("no open") != std::string::npos)
+      << gone.dump();
   EXPECT_EQ(before, rigText(dir));
   // Back at 11 s: checked again and corrected.
   ASSERT_TRUE(eventually(
