@@ -38,12 +38,9 @@ tl::expected<CalibrationOutcome, CalibrationFailure> runAdaptiveCalibration(
     if (hooks.cancelled()) return tl::unexpected(cancelled);
     cv::Mat rgb;
     cv::cvtColor(sl::renderFrame(coarse, f), rgb, cv::COLOR_GRAY2RGB);
-    if (auto shown = showFrame(plan.output, rgb, "show a coarse pattern"); !shown) {
-      return tl::unexpected(shown.error());
-    }
-    if (!waitCancellable(out.settle_frames / plan.refresh_hz, hooks)) {
-      return tl::unexpected(cancelled);
-    }
+    auto shown = showAndSettle(plan, rgb, "show a coarse pattern", out.settle_frames, hooks);
+    if (!shown) return tl::unexpected(shown.error());
+    if (!*shown) return tl::unexpected(cancelled);
     auto grey = captureGray(cam.device);
     if (!grey) return tl::unexpected(grey.error());
     captures.push_back(std::move(*grey));

@@ -88,6 +88,17 @@ tl::expected<cv::Mat, CalibrationFailure> captureGray(const CalibrationDevice& c
   return gray;
 }
 
+// Shows `rgb` on the plan's output and waits `settle_frames` refreshes for it to reach
+// the screen ([Raskar02] §4.1.1 assumes a static projected image per capture); false
+// when cancelled meanwhile.
+tl::expected<bool, CalibrationFailure> showAndSettle(const CalibrationPlan& plan,
+                                                     const cv::Mat& rgb, const char* what,
+                                                     int settle_frames,
+                                                     const CalibrationHooks& hooks) {
+  if (auto shown = showFrame(plan.output, rgb, what); !shown) return tl::unexpected(shown.error());
+  return waitCancellable(settle_frames / plan.refresh_hz, hooks);
+}
+
 namespace {
 
 // The display plane from the board on it, as the camera saw it while the projector
@@ -109,17 +120,6 @@ tl::expected<calib::BoardPlane, CalibrationFailure> planeOfBoard(const Calibrati
                            "' gives no display plane: " + plane.error().message});
   }
   return *plane;
-}
-
-// Shows `rgb` on the plan's output and waits `settle_frames` refreshes for it to reach
-// the screen ([Raskar02] §4.1.1 assumes a static projected image per capture); false
-// when cancelled meanwhile.
-tl::expected<bool, CalibrationFailure> showAndSettle(const CalibrationPlan& plan,
-                                                     const cv::Mat& rgb, const char* what,
-                                                     int settle_frames,
-                                                     const CalibrationHooks& hooks) {
-  if (auto shown = showFrame(plan.output, rgb, what); !shown) return tl::unexpected(shown.error());
-  return waitCancellable(settle_frames / plan.refresh_hz, hooks);
 }
 
 // The camera's mean at each ramp level over the pixels that decoded this projector

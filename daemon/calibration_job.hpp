@@ -182,6 +182,12 @@ tl::expected<void, CalibrationFailure> showFrame(const CalibrationDevice& output
                                                  const cv::Mat& rgb, const char* what);
 // Waits `seconds`, waking every 20 ms to honour a cancel; false when cancelled.
 bool waitCancellable(double seconds, const CalibrationHooks& hooks);
+// Shows `rgb` on the plan's output (showFrame) and waits `settle_frames` of its refreshes
+// for it to reach the screen; false when cancelled meanwhile.
+tl::expected<bool, CalibrationFailure> showAndSettle(const CalibrationPlan& plan,
+                                                     const cv::Mat& rgb, const char* what,
+                                                     int settle_frames,
+                                                     const CalibrationHooks& hooks);
 
 // Shows black on the plan's output (its pattern size), so that it adds no light to
 // another projector's scan; on a worker.

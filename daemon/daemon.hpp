@@ -318,8 +318,12 @@ class Daemon {
   // The projector and cameras as they were before corrections that did not converge
   // (o.before) written back into rig.json.
   void restoreBeforeDrift(DriftRuntime::Output& o);
+  // `step` could not register the output (`why`): unresolved, and what corrections that
+  // did not converge changed goes back (restoreBeforeDrift).
+  void abandonDrift(const std::string& output, const std::string& camera, const std::string& step,
+                    const std::string& why, const drift::Misregistration& m);
   // drift_scan.cpp: `step` failed (`why`): the next scan (nextDriftScan), or the output
-  // unresolved when none is left.
+  // abandoned (abandonDrift) when none is left.
   void escalateDrift(const std::string& output, const std::string& camera, const std::string& step,
                      const std::string& why, const drift::Misregistration& m);
   // The output's projector scanned as calibrate scans it (a calibrate operation without a

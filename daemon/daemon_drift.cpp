@@ -326,38 +326,20 @@ void Daemon::onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, Calibr
         o.last_correction["step"].is_string()) {
       step = o.last_correction["step"].get<std::string>();
     }
-    // A scan when the content's corrections of the projector (or the last scan) did not
-    // register the output: not for a camera that moved (scanning a projector does not
-    // find it) nor a wall (one projector's scan would leave the others on the old one).
-    const auto next = step == "projector-pose" || o.scan != DriftScan::kNone
-                          ? nextDriftScan(o.scan, config_.recalibrate)
-                          : std::nullopt;
-    if (next) {
-      const std::string why =
-          o.scan == DriftScan::kNone
-              ? "corrections from the content left " + std::to_string(m.rms_px) + " px after " +
-                    std::to_string(kMaxDriftPasses) + " passes"
-              : "the output is still " + std::to_string(m.rms_px) + " px off after the scan";
-      o.passes = 0;
-      return scanForDrift(key.output, key.camera, *next, step + ": " + why, m);
-    }
-    // Corrections that do not converge are not kept: the devices as they were before
-    // them (the last state a check confirmed) go back into rig.json.
-    std::string why =
-        o.scan != DriftScan::kNone
-            ? "the full scan did not bring the misregistration under " + std::to_string(threshold) +
-                  " px; calibrate again"
-            : "corrections from the content did not bring the misregistration under " +
-                  std::to_string(threshold) + " px in " + std::to_string(kMaxDriftPasses) +
-                  " passes (the surface may have moved); calibrate again";
-    if (config_.recalibrate != RecalibratePolicy::kOnDrift && step == "projector-pose") {
-      why += " (recalibrate = \"" + std::string(recalibratePolicyName(config_.recalibrate)) +
-             "\" shows no scan)";
-    }
-    unresolveDrift(key.output, key.camera, step, why, m);
-    restoreBeforeDrift(o);
+    const std::string why = o.scan == DriftScan::kNone
+                                ? "corrections from the content left " + std::to_string(m.rms_px) +
+                                      " px (over " + std::to_string(threshold) + ") after " +
+                                      std::to_string(kMaxDriftPasses) + " passes"
+                                : "the output is still " + std::to_string(m.rms_px) +
+                                      " px off after the " + driftScanName(o.scan);
     o.passes = 0;
-    return;
+    // The projector's corrections (or a scan) climb to the next scan; a camera that moved
+    // is not found by scanning a projector, nor a wall (one projector's scan would leave
+    // the others on the old one).
+    if (step == "projector-pose" || o.scan != DriftScan::kNone) {
+      return escalateDrift(key.output, key.camera, step, why, m);
+    }
+    return abandonDrift(key.output, key.camera, step, why + "; calibrate again", m);
   }
   if (other_registered) return correctCamera(key.output, key.camera, m);
   if (other_drifted) {

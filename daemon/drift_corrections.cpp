@@ -55,6 +55,16 @@ std::optional<drift::WallView> wallView(const rig::RigModel& rig, uint64_t gener
                          v->second.reference->grid};
 }
 
+// Why a correction was made: the misregistration, how long it was held, the threshold.
+json heldOver(const drift::Misregistration& m, double held, double threshold) {
+  return {{"misregistration_px", m.rms_px}, {"held_s", held}, {"threshold_px", threshold}};
+}
+
+// rig.json's provenance of a pose fitted again from `tiles` content tiles.
+rig::Provenance fromContent(int tiles) {
+  return {"drift correction: pose from content (" + std::to_string(tiles) + " tiles)", utcNow()};
+}
+
 }  // namespace
 
 std::optional<drift::WallSeen> Daemon::movedWall(const std::string& output,
@@ -144,13 +154,11 @@ void Daemon::correctSurface(const std::string& output, const std::string& camera
   // The wall is measured, not fitted by passes: what was kept to restore after
   // corrections that do not converge belonged to the old wall and cannot come back.
   o.before.reset();
-  const json why = {{"misregistration_px", m.rms_px},
-                    {"held_s", held},
-                    {"threshold_px", config_.drift.threshold_px},
-                    {"wall_offset_mm", 1e3 * wall.offset_m},
-                    {"wall_offset_se_mm", 1e3 * wall.offset_se_m},
-                    {"wall_turned_deg", wall.tilt_deg},
-                    {"plane_kept", drift::wallTurned(wall) ? "fitted" : "shifted"}};
+  json why = heldOver(m, held, config_.drift.threshold_px);
+  why.update({{"wall_offset_mm", 1e3 * wall.offset_m},
+              {"wall_offset_se_mm", 1e3 * wall.offset_se_m},
+              {"wall_turned_deg", wall.tilt_deg},
+              {"plane_kept", drift::wallTurned(wall) ? "fitted" : "shifted"}});
   logInfo("drift: output '" + output + "': the wall moved " + std::to_string(1e3 * wall.offset_m) +
           " mm (turned " + std::to_string(wall.tilt_deg) +
           " deg); the rig's plane measured again from " + std::to_string(wall.points) +
@@ -196,8 +204,7 @@ void Daemon::correctDrift(const std::string& output, const std::string& camera,
   if (!c) return giveUp("the projector's pose from the content: " + c.error().message);
   rig::RigModel update;
   update.projectors.push_back(c->projector);
-  update.projectors.back().calibrated = {
-      "drift correction: pose from content (" + std::to_string(c->tiles) + " tiles)", utcNow()};
+  update.projectors.back().calibrated = fromContent(c->tiles);
   keepBefore(o, *p, nullptr);
   // Cameras mounted on the projector moved with it.
   for (const rig::RigCamera& cam : rig_.cameras) {
@@ -206,9 +213,7 @@ void Daemon::correctDrift(const std::string& output, const std::string& camera,
     update.cameras.push_back(cam);
     update.cameras.back().model.pose = carried(cam.model.pose, p->pose, c->projector.pose);
   }
-  const json why = {{"misregistration_px", m.rms_px},
-                    {"held_s", held},
-                    {"threshold_px", config_.drift.threshold_px}};
+  const json why = heldOver(m, held, config_.drift.threshold_px);
   logInfo("drift: output '" + output + "': correcting projector '" + p->name +
           "' from the content (" + std::to_string(m.rms_px) + " px held " + std::to_string(held) +
           " s; " + std::to_string(c->tiles) + " tiles, pose fit " + std::to_string(c->pose_rms_px) +
@@ -242,13 +247,10 @@ void Daemon::correctCamera(const std::string& output, const std::string& camera,
   if (!c) return giveUp("the camera's pose from the content: " + c.error().message);
   rig::RigModel update;
   update.cameras.push_back(c->camera);
-  update.cameras.back().calibrated = {
-      "drift correction: pose from content (" + std::to_string(c->tiles) + " tiles)", utcNow()};
+  update.cameras.back().calibrated = fromContent(c->tiles);
   keepBefore(o, *p, cam);
-  const json why = {{"misregistration_px", m.rms_px},
-                    {"held_s", held},
-                    {"threshold_px", config_.drift.threshold_px},
-                    {"registered_in", "another camera sees the output registered"}};
+  json why = heldOver(m, held, config_.drift.threshold_px);
+  why["registered_in"] = "another camera sees the output registered";
   logInfo("drift: output '" + output + "' misregistered in camera '" + camera +
           "' only: re-registering the camera from the content (" + std::to_string(m.rms_px) +
           " px held " + std::to_string(held) + " s; " + std::to_string(c->tiles) +
@@ -261,6 +263,17 @@ void Daemon::correctCamera(const std::string& output, const std::string& camera,
                         {"tiles", c->tiles},
                         {"pose_fit_px", c->pose_rms_px}},
                        "corrected-camera");
+}
+
+void Daemon::abandonDrift(const std::string& output, const std::string& camera,
+                          const std::string& step, const std::string& why,
+                          const drift::Misregistration& m) {
+  DriftRuntime::Output& o = drift_rt_.outputs[output];
+  unresolveDrift(output, camera, step,
+                 why + (o.before ? "; the devices as they were before the corrections go back"
+                                 : "; the rig model stays as it was"),
+                 m);
+  restoreBeforeDrift(o);
 }
 
 void Daemon::restoreBeforeDrift(DriftRuntime::Output& o) {

@@ -24,25 +24,19 @@ namespace {
 constexpr int kCoarseStep = 8;
 constexpr int kCoarseGrid = 16;
 
-// What becomes of the rig when a step fails: corrections that did not converge are
-// dropped (restoreBeforeDrift), else nothing changes.
-std::string keptNote(const DriftRuntime::Output& o) {
-  return o.before ? "; the devices as they were before the corrections go back"
-                  : "; the rig model stays as it was";
-}
-
 }  // namespace
 
 void Daemon::escalateDrift(const std::string& output, const std::string& camera,
                            const std::string& step, const std::string& why,
                            const drift::Misregistration& m) {
-  DriftRuntime::Output& o = drift_rt_.outputs[output];
-  const auto next = nextDriftScan(o.scan, config_.recalibrate);
-  if (!next) {
-    unresolveDrift(output, camera, step, why + keptNote(o), m);
-    return restoreBeforeDrift(o);
+  const auto next = nextDriftScan(drift_rt_.outputs[output].scan, config_.recalibrate);
+  if (next) return scanForDrift(output, camera, *next, step + ": " + why, m);
+  std::string tail = "; calibrate again";
+  if (config_.recalibrate != RecalibratePolicy::kOnDrift) {
+    tail += " (recalibrate = \"" + std::string(recalibratePolicyName(config_.recalibrate)) +
+            "\" shows no scan)";
   }
-  scanForDrift(output, camera, *next, step + ": " + why, m);
+  abandonDrift(output, camera, step, why + tail, m);
 }
 
 void Daemon::scanForDrift(const std::string& output, const std::string& camera, DriftScan which,
@@ -51,8 +45,7 @@ void Daemon::scanForDrift(const std::string& output, const std::string& camera, 
   DriftRuntime::Output& o = d.outputs[output];
   const char* step = driftScanName(which);
   const auto giveUp = [&](const std::string& reason) {
-    unresolveDrift(output, camera, step, reason + keptNote(o), m);
-    restoreBeforeDrift(o);
+    abandonDrift(output, camera, step, reason, m);
   };
   auto args = parseCalibrationArgs(json::object(), config_.calibration);
   if (!args) return giveUp("the scan's settings: " + args.error());
@@ -152,10 +145,8 @@ void Daemon::scanForDrift(const std::string& output, const std::string& camera, 
             const CalibrationFailure f = stoppedRun(r ? nullptr : &r.error(), "scan cancelled");
             finish(&f);
             if (it != drift_rt_.outputs.end()) {
-              unresolveDrift(
-                  output, camera, step,
-                  "the " + std::string(step) + " failed: " + f.message + keptNote(it->second), m);
-              restoreBeforeDrift(it->second);
+              abandonDrift(output, camera, step,
+                           "the " + std::string(step) + " failed: " + f.message, m);
             }
             return;
           }
@@ -210,10 +201,8 @@ void Daemon::scanForDrift(const std::string& output, const std::string& camera, 
       [this, output, camera, which, m, finish](const std::string& what) {
         const CalibrationFailure f{proto::code::kInternal, "the scan failed: " + what};
         finish(&f);
-        auto it = drift_rt_.outputs.find(output);
-        if (it != drift_rt_.outputs.end()) {
-          unresolveDrift(output, camera, driftScanName(which), f.message + keptNote(it->second), m);
-          restoreBeforeDrift(it->second);
+        if (drift_rt_.outputs.count(output)) {
+          abandonDrift(output, camera, driftScanName(which), f.message, m);
         }
       });
 }

@@ -15,13 +15,6 @@ namespace code = proto::code;
 
 tl::expected<CalibrationOutcome, CalibrationFailure> runTagCalibration(
     const CalibrationPlan& plan, const CalibrationHooks& hooks) {
-  const CalibrationFailure cancelled{code::kCancelled, "calibration cancelled"};
-  const auto failed = [&](const std::string& why) {
-    return tl::unexpected(CalibrationFailure{code::kFailed, why});
-  };
-  if (!plan.tags || !plan.plane || plan.cameras.empty()) {
-    return failed("internal: the tag frame is route (b′) with a camera and a plane");
-  }
   CalibrationOutcome out;
   auto settled = settleFor(plan, hooks, out);
   if (!settled) return tl::unexpected(settled.error());
@@ -40,12 +33,9 @@ tl::expected<CalibrationOutcome, CalibrationFailure> tagFrameOutcome(const Calib
     return failed("internal: the tag frame is route (b′) with a camera and a plane");
   }
   if (hooks.cancelled()) return tl::unexpected(cancelled);
-  if (auto shown = showFrame(plan.output, plan.tags->rgb, "show the tag frame"); !shown) {
-    return tl::unexpected(shown.error());
-  }
-  if (!waitCancellable(out.settle_frames / plan.refresh_hz, hooks)) {
-    return tl::unexpected(cancelled);
-  }
+  auto shown = showAndSettle(plan, plan.tags->rgb, "show the tag frame", out.settle_frames, hooks);
+  if (!shown) return tl::unexpected(shown.error());
+  if (!*shown) return tl::unexpected(cancelled);
   std::vector<cv::Mat> captures;
   for (std::size_t c = 0; c < plan.cameras.size(); ++c) {
     auto grey = captureGray(plan.cameras[c].device);

@@ -1,0 +1,195 @@
+#pragma once
+// The on-drift end-to-end tests' rig (test_sim_drift.cpp, test_sim_drift_plain.cpp):
+// wall_oblique (one 1920x1080 projector at 30 deg yaw / 15 deg pitch to a wall, one fixed
+// camera with 0.8 DN read noise) with scene events appended, procamd on it with the
+// scene's truth at rest as its rig model, content shown through `keystone rig on`, and
+// the corrected rig judged against the TRUE projector.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "daemon_harness.hpp"
+#include "geometry/intersect.hpp"
+#include "keystone_truth.hpp"
+#include "rig/rig_model.hpp"
+#include "sim/scene_library.hpp"
+#include "truth_rig_file.hpp"
+#include "unit/drift/second_camera.hpp"
+#include "unit/drift/textured_content.hpp"
+
+namespace procam::itest {
+
+using Clock = std::chrono::steady_clock;
+
+// Scene events run on the wall clock; under the sanitizers the daemon and the virtual
+// camera are kSlowdown times slower, so the scene's times stretch with them.
+inline double at(double seconds) {
+  return seconds * kSlowdown;
+}
+inline std::string atText(double seconds) {
+  return std::to_string(at(seconds));
+}
+
+// wall_oblique with `events` appended, written into `dir`.
+inline std::string sceneWithEvents(const TempDir& dir, const std::string& events) {
+  const char* src = std::getenv("PROCAM_SOURCE_DIR");
+  std::ifstream in(std::string(src ? src : ".") + "/tests/scenes/wall_oblique.toml");
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_FALSE(text.str().empty()) << "PROCAM_SOURCE_DIR must name the source tree";
+  dir.write("wall_drift.toml", text.str() + "\n" + events);
+  return dir.file("wall_drift.toml");
+}
+
+// A natural image's spectrum, 1600x900, as a content file.
+inline std::string texturedContent(const TempDir& dir) {
+  cv::Mat rgb;
+  cv::cvtColor(drift::texturedContent({1600, 900}, 11, {80, 27, 9}), rgb, cv::COLOR_GRAY2BGR);
+  const std::string png = contentFile(dir, "texture.png");
+  cv::imwrite(png, rgb);
+  return png;
+}
+
+// rig.json in the daemon's state directory, as text.
+inline std::string rigText(const TempDir& dir) {
+  std::ifstream f(dir.file("state/rig.json"));
+  std::stringstream text;
+  text << f.rdbuf();
+  return text.str();
+}
+
+// procamd on `scene_file` with `recalibrate = POLICY` and the scene's truth at rest as
+// its rig model.
+inline DaemonProcess::Launch driftDaemon(const TempDir& dir, const std::string& policy,
+                                         const std::string& scene_file,
+                                         std::vector<std::string> env = {},
+                                         const std::string& more_policy = "") {
+  dir.write("procamd.toml", "[policy]\nrecalibrate = \"" + policy + "\"\n" + more_policy);
+  return {{"--config", dir.file("procamd.toml"), "--sim", scene_file, "--rig",
+           truthRigFile(dir, scene_file)},
+          std::move(env),
+          -1,
+          true};
+}
+
+// When the daemon started, by its uptime: the virtual rig's clock starts a little later,
+// so scene times measured from here are upper bounds.
+inline Clock::time_point daemonStart(Connection& c) {
+  const auto now = Clock::now();
+  auto st = c.call({{"cmd", "status"}});
+  EXPECT_TRUE(st);
+  const double up = st ? (*st)["uptime_s"].get<double>() : 0.0;
+  return now - std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(up));
+}
+
+// Starts the scene's content through the rig's keystone; the daemon is started by the
+// caller with the truth at rest as its rig.
+inline void showContent(Connection& c, const std::string& png) {
+  auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", png}});
+  ASSERT_TRUE(load);
+  ASSERT_EQ((*load)["class"], "CONTENT") << load->dump();
+  auto on = c.call({{"cmd", "keystone"}, {"action", "rig"}, {"enable", true}});
+  ASSERT_TRUE(on);
+  ASSERT_EQ((*on)["class"], "KEYSTONE") << on->dump();
+}
+
+inline json outputDrift(Connection& c) {
+  auto st = c.call({{"cmd", "status"}});
+  if (!st || (*st)["outputs"]["shown"].empty()) return nullptr;
+  return (*st)["outputs"]["shown"][0].value("drift", json(nullptr));
+}
+
+// The rig model's projector (rig.json as the daemon wrote it) against the true one:
+// the largest distance, in the true projector's pixels, between a framebuffer pixel
+// and where the true projector puts the wall point the rig gives that pixel (by its
+// pose, or by its collineation with the wall when the rig knows only that).
+inline double rigAgainstTruth(const TempDir& dir, const geom::CameraModel& truth) {
+  auto rig = rig::rigFromText(rigText(dir), "rig.json");
+  EXPECT_TRUE(rig) << rig.error().message;
+  if (!rig) return 1e9;
+  const rig::RigProjector& p = rig->projectors.at(0);
+  const geom::CameraModel model = p.model();
+  const bool posed = p.pose_known && p.intrinsics_known;
+  if (!posed && !p.plane_homography) return 1e9;
+  const auto wallPoint = [&](int x, int y) -> std::optional<Vec3> {
+    if (!posed) {
+      const Vec3 ab = p.plane_homography->H * Vec3(x, y, 1.0);
+      return p.plane_homography->basis.toWorld({ab.x() / ab.z(), ab.y() / ab.z()});
+    }
+    auto ray = model.backproject({x, y});
+    auto hit = ray ? geom::intersectPlane(*ray, *rig->surface.plane) : std::nullopt;
+    return hit ? std::optional<Vec3>(hit->point) : std::nullopt;
+  };
+  double worst = 0;
+  for (int y = 0; y < p.height; y += 40) {
+    for (int x = 0; x < p.width; x += 40) {
+      auto hit = wallPoint(x, y);
+      auto back = hit ? truth.project(*hit) : std::nullopt;
+      if (!back) return 1e9;
+      worst = std::max(worst, (*back - Vec2(x, y)).norm());
+    }
+  }
+  return worst;
+}
+
+// The keystone the daemon shows now against the true projector.
+inline Measured keystoneAgainstTruth(Connection& c, const geom::CameraModel& truth) {
+  auto k = c.call({{"cmd", "keystone"}});
+  EXPECT_TRUE(k && (*k)["mode"] == "rig") << (k ? k->dump() : "");
+  if (!k || (*k)["mode"] != "rig") return {1e9, 1, 1};
+  return measureAgainstTruth(truth.K, truth.pose.R, truth.width, truth.height,
+                             matrixOf((*k)["homography"]), (*k)["content_size"][0],
+                             (*k)["content_size"][1]);
+}
+
+// The `drift` event of the correction `state` (none of `wrong`, none unresolved), then
+// whether a check found the output registered after it (within 25 s).
+inline std::optional<json> awaitCorrection(Connection& watcher, const std::string& state,
+                                           const std::string& wrong, bool& registered) {
+  std::optional<json> corrected;
+  registered = false;
+  const auto deadline = Clock::now() + 25s * kSlowdown;
+  while (Clock::now() < deadline && !registered) {
+    auto e = watcher.next(1s);
+    if (!e || (*e)["event"] != "drift") continue;
+    EXPECT_NE((*e)["state"], wrong) << e->dump();
+    EXPECT_NE((*e)["state"], "unresolved") << e->dump();
+    if ((*e)["state"] == state) corrected = *e;
+    registered = corrected && (*e)["state"] == "corrected";
+  }
+  return corrected;
+}
+
+// procamd with recalibrate = "on-drift" on wall_oblique with a second camera (or with
+// its one) and `events`, a watcher on its events and textured content shown.
+struct DriftRig {
+  DriftRig(const TempDir& dir, const std::string& events, bool second_camera = true,
+           const std::string& more_policy = "")
+      : scene_file(sceneWithEvents(
+            dir, (second_camera ? std::string(drift::kSecondCamera) : std::string()) + events)),
+        scene(sim::resolveScene(scene_file)),
+        d(dir, driftDaemon(dir, "on-drift", scene_file, {}, more_policy)),
+        c(d.socketPath()),
+        watcher(d.socketPath()) {}
+  // Fatal failures of the set-up; call first. `png`: the content (default: textured).
+  void start(const TempDir& dir, std::string png = "") {
+    ASSERT_TRUE(scene) << scene.error().message;
+    ASSERT_TRUE(d.started()) << d.log();
+    ASSERT_TRUE(watcher.call({{"cmd", "watch"}}));
+    if (png.empty()) png = texturedContent(dir);
+    ASSERT_NO_FATAL_FAILURE(showContent(c, png));
+  }
+  std::string scene_file;
+  Result<sim::Scene> scene;
+  DaemonProcess d;
+  Connection c, watcher;
+};
+
+}  // namespace procam::itest

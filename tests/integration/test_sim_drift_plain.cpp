@@ -1,0 +1,152 @@
+// recalibrate = "on-drift" and "on-drift-silent" end to end under plain (uniform grey)
+// content, which cannot show drift (sim_drift_rig.hpp: wall_oblique, the truth at rest as
+// the rig model): "on-drift-silent" reports it too plain and changes nothing, "off" does
+// not look, and "on-drift" checks with fiducial frames (AprilTags over the whole frame,
+// shown for one check) and corrects a bumped projector from their corners.
+#include "sim_drift_rig.hpp"
+
+namespace procam::itest {
+namespace {
+
+// Uniform grey content and the projector bumped 1 degree: "on-drift-silent", which shows
+// no frame of its own, reports it too plain to tell and changes nothing; "off" does not
+// look.
+TEST(SimDrift, PlainContentIsReportedWhenSilentAndOffDoesNothing) {
+  for (const std::string policy : {"on-drift-silent", "off"}) {
+    SCOPED_TRACE(policy);
+    TempDir dir;
+    const std::string scene_file =
+        sceneWithEvents(dir, "[[events]]\nt = " + atText(4.0) +
+                                 "\ntarget = \"proj\"\nrotate_deg = [1.0, 0.0, 0.0]\n");
+    const auto spawned = Clock::now();
+    DaemonProcess d(dir, driftDaemon(dir, policy, scene_file));
+    ASSERT_TRUE(d.started()) << d.log();
+    Connection c(d.socketPath());
+    const std::string before = rigText(dir);
+    // Uniform grey for on-drift-silent; the textured image for off (which must not look
+    // at it).
+    std::string png;
+    if (policy == "on-drift-silent") {
+      png = contentFile(dir, "grey.png");
+      cv::imwrite(png, cv::Mat(900, 1600, CV_8UC3, cv::Scalar(128, 128, 128)));
+    } else {
+      png = texturedContent(dir);
+    }
+    ASSERT_NO_FATAL_FAILURE(showContent(c, png));
+    while (std::chrono::duration<double>(Clock::now() - spawned).count() < at(7.0)) {
+      std::this_thread::sleep_for(250ms);
+    }
+    const json dr = outputDrift(c);
+    auto st = c.call({{"cmd", "status"}});
+    ASSERT_TRUE(st);
+    if (policy == "off") {
+      EXPECT_TRUE(dr.is_null()) << dr.dump();
+      EXPECT_EQ((*st)["drift"]["policy"], "off");
+    } else {
+      ASSERT_TRUE(dr.is_object());
+      EXPECT_EQ(dr.value("state", ""), "too plain to tell") << dr.dump();
+      EXPECT_TRUE(dr.value("too_plain", false)) << dr.dump();
+      EXPECT_GE(dr.value("checks", 0), 4) << dr.dump();
+      EXPECT_EQ(dr.value("corrections", -1), 0) << dr.dump();
+      EXPECT_TRUE(dr.value("content_too_plain", false)) << dr.dump();
+      EXPECT_FALSE(dr.contains("fiducial")) << dr.dump();  // silent: none shown
+      EXPECT_EQ((*st)["drift"]["policy"], "on-drift-silent");
+    }
+    EXPECT_EQ(before, rigText(dir));
+  }
+}
+
+// Uniform grey content with "on-drift": the content cannot show drift, a fiducial frame
+// (AprilTags over the whole frame, shown for one check) can. Still, the frames find the
+// output registered and nothing is corrected; the projector bumped 1 degree is found at
+// the next fiducial frame and corrected from the tag corners.
+TEST(SimDrift, PlainContentIsCheckedWithFiducialFramesAndABumpCorrected) {
+  TempDir dir;
+  // The first fiducial frame comes 3 to 4 s after the daemon starts on two idle cores
+  // (start, content, the first checks), then one every 3 s or so (a 2 s period, and a
+  // second for the virtual camera to render each new frame); on two busy cores a capture
+  // takes 3 s.
+  const double bump_t = at(14.0);
+  const std::string scene_file =
+      sceneWithEvents(dir, "[[events]]\nt = " + std::to_string(bump_t) +
+                               "\ntarget = \"proj\"\nrotate_deg = [1.0, 0.0, 0.0]\n");
+  auto scene = sim::resolveScene(scene_file);
+  ASSERT_TRUE(scene) << scene.error().message;
+  DaemonProcess d(dir,
+                  driftDaemon(dir, "on-drift", scene_file, {}, "drift_fiducial_period_s = 2\n"));
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  Connection watcher(d.socketPath());
+  ASSERT_TRUE(watcher.call({{"cmd", "watch"}}));
+  const auto start = daemonStart(c);
+  const auto sceneTime = [&] {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+  };
+  const std::string png = contentFile(dir, "grey.png");
+  cv::imwrite(png, cv::Mat(900, 1600, CV_8UC3, cv::Scalar(128, 128, 128)));
+  ASSERT_NO_FATAL_FAILURE(showContent(c, png));
+  const std::string before = rigText(dir);
+  // Before the bump (the scene's clock starts after the daemon's: a margin of 1 s).
+  while (sceneTime() < bump_t - 1.0) std::this_thread::sleep_for(100ms);
+  json still = outputDrift(c);
+  ASSERT_TRUE(still.is_object()) << still.dump();
+  std::printf(
+      "[ figures  ] still, grey content: %d fiducial frames in %.1f s, misregistration %.3f "
+      "px; %d corrections\n",
+      still["fiducial"].value("frames", 0), sceneTime(),
+      still["fiducial"].value("misregistration_px", -1.0), still.value("corrections", -1));
+  EXPECT_TRUE(still.value("content_too_plain", false)) << still.dump();
+  EXPECT_GE(still["fiducial"].value("frames", 0), 2) << still.dump();
+  EXPECT_EQ(still.value("corrections", -1), 0) << still.dump();
+  // Under half the 0.5 px threshold: no false trigger.
+  EXPECT_LT(still["fiducial"].value("misregistration_px", 1e9), 0.25) << still.dump();
+  EXPECT_EQ(before, rigText(dir));
+  // The bump.
+  bool registered = false;
+  const std::optional<json> corrected =
+      awaitCorrection(watcher, "corrected-pose", "corrected-surface", registered);
+  ASSERT_TRUE(corrected) << outputDrift(c).dump() << d.log();
+  const double corrected_after = sceneTime() - bump_t;
+  EXPECT_TRUE(registered) << outputDrift(c).dump();
+  const json dr = outputDrift(c);
+  const double rig_px = rigAgainstTruth(dir, scene->at(bump_t + at(1.0)).projectors.at(0).model);
+  std::printf(
+      "[ figures  ] projector bumped 1 deg under grey content: seen at %.2f px in a fiducial "
+      "frame, corrected from %d tag corners (pose fit %.3f px), registered within %.1f s of "
+      "the bump (fiducial period 2 s); the rig against the true projector %.3f px; %d "
+      "fiducial frames in all\n",
+      (*corrected)["why"]["misregistration_px"].get<double>(), (*corrected)["tiles"].get<int>(),
+      (*corrected)["pose_fit_px"].get<double>(), corrected_after, rig_px,
+      dr["fiducial"].value("frames", 0));
+  EXPECT_LE(rig_px, 0.5);
+}
+
+// Two fixed cameras and uniform grey content: the projector bumped 1 degree is found in a
+// fiducial frame by one camera, and every camera's next check shows one too, so the
+// other confirms it and the projector is corrected from the tag corners.
+TEST(SimDrift, PlainContentWithTwoCamerasIsCorrectedFromFiducialFrames) {
+  TempDir dir;
+  DriftRig r(
+      dir, "[[events]]\nt = " + atText(6.0) + "\ntarget = \"proj\"\nrotate_deg = [1.0, 0.0, 0.0]\n",
+      true, "drift_fiducial_period_s = 2\n");
+  const std::string png = contentFile(dir, "grey.png");
+  cv::imwrite(png, cv::Mat(900, 1600, CV_8UC3, cv::Scalar(128, 128, 128)));
+  ASSERT_NO_FATAL_FAILURE(r.start(dir, png));
+  bool registered = false;
+  const std::optional<json> corrected =
+      awaitCorrection(r.watcher, "corrected-pose", "corrected-surface", registered);
+  ASSERT_TRUE(corrected) << outputDrift(r.c).dump() << r.d.log();
+  EXPECT_TRUE(registered) << outputDrift(r.c).dump();
+  const json dr = outputDrift(r.c);
+  const double rig_px = rigAgainstTruth(dir, r.scene->at(at(7.0)).projectors.at(0).model);
+  std::printf(
+      "[ figures  ] two cameras, grey content, projector bumped 1 deg: corrected from %d tag "
+      "corners, the rig against the true projector %.3f px; %d fiducial frames\n",
+      (*corrected)["tiles"].get<int>(), rig_px, dr["fiducial"].value("frames", 0));
+  EXPECT_LE(rig_px, 0.5);
+  // A handful of frames, not one at every check.
+  EXPECT_LE(dr["fiducial"].value("frames", 0), 20) << dr.dump();
+}
+
+}  // namespace
+}  // namespace procam::itest
