@@ -1,5 +1,6 @@
 #include "sim/renderer.hpp"
 
+#include <atomic>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -146,6 +147,19 @@ PixelTruth::Light Renderer::light(const Lamp& lamp, const Vec3& point, const Vec
   return out;
 }
 
+cv::Vec3f Renderer::reflectance(const SurfaceHit& hit) const {
+  const auto surface = static_cast<std::size_t>(hit.surface);
+  const cv::Vec3f albedo = albedo_bgr_[surface];
+  const Surface& moved = world().surfaces()[surface];
+  return moved.print ? albedo * moved.print->at(hit.hit.point - moved.offset) : albedo;
+}
+
+float Renderer::irradianceScale(const Lamp& lamp, const PixelTruth::Light& l) const {
+  // Irradiance from a point source: I * cos(theta) / d^2 ([Raskar02] §5.2.4).
+  return static_cast<float>(state_.projectors[lamp.projector].spec.brightness * l.cos_incidence /
+                            (l.distance * l.distance));
+}
+
 cv::Vec3f Renderer::radianceAlong(const geom::Ray& ray) const {
   const auto hit = world().intersect(ray);
   if (!hit) return {0.f, 0.f, 0.f};
@@ -154,16 +168,27 @@ cv::Vec3f Renderer::radianceAlong(const geom::Ray& ray) const {
     if (!lamp.image) continue;
     const PixelTruth::Light l = light(lamp, hit->hit.point, hit->hit.normal, hit->surface);
     if (!l.lit) continue;
-    // Irradiance from a point source: I * cos(theta) / d^2 ([Raskar02] §5.2.4).
-    const double scale = state_.projectors[lamp.projector].spec.brightness * l.cos_incidence /
-                         (l.distance * l.distance);
-    irradiance += lamp.image->sample(l.pixel.x(), l.pixel.y()) * static_cast<float>(scale);
+    irradiance += lamp.image->sample(l.pixel.x(), l.pixel.y()) * irradianceScale(lamp, l);
   }
-  const auto surface = static_cast<std::size_t>(hit->surface);
-  const cv::Vec3f albedo = albedo_bgr_[surface];
-  const Surface& moved = world().surfaces()[surface];
-  return irradiance.mul(moved.print ? albedo * moved.print->at(hit->hit.point - moved.offset)
-                                    : albedo);
+  return irradiance.mul(reflectance(*hit));
+}
+
+void Renderer::rowRays(const geom::CameraModel& view, const std::vector<Vec2>& offsets, int y,
+                       std::vector<std::optional<geom::Ray>>& rays) {
+  rays.assign(static_cast<std::size_t>(view.width) * offsets.size(), std::nullopt);
+  // Undistorted positions of each sample in the previous two pixels: their linear
+  // extrapolation starts the inversion for this pixel (one Newton step suffices).
+  const Vec2 none = Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
+  std::vector<Vec2> last(offsets.size(), none), before(offsets.size(), none);
+  std::size_t i = 0;
+  for (int x = 0; x < view.width; ++x) {
+    for (std::size_t k = 0; k < offsets.size(); ++k, ++i) {
+      Vec2 n = before[k].allFinite() ? Vec2(2 * last[k] - before[k]) : last[k];
+      rays[i] = pixelRay(view, x + offsets[k].x(), y + offsets[k].y(), &n);
+      before[k] = last[k];
+      last[k] = rays[i] ? n : none;
+    }
+  }
 }
 
 cv::Mat Renderer::radianceImage(const geom::CameraModel& view, int supersamples,
@@ -173,18 +198,13 @@ cv::Mat Renderer::radianceImage(const geom::CameraModel& view, int supersamples,
   cv::Mat out(view.height, view.width, CV_32FC3);
   forEachRow(view.height, threads, [&](int y) {
     cv::Vec3f* row = out.ptr<cv::Vec3f>(y);
-    // Undistorted positions of each sample in the previous two pixels: their linear
-    // extrapolation starts the inversion for this pixel (one Newton step suffices).
-    const Vec2 none = Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
-    std::vector<Vec2> last(offsets.size(), none), before(offsets.size(), none);
+    std::vector<std::optional<geom::Ray>> rays;
+    rowRays(view, offsets, y, rays);
+    std::size_t i = 0;
     for (int x = 0; x < view.width; ++x) {
       cv::Vec3f sum(0.f, 0.f, 0.f);
-      for (std::size_t k = 0; k < offsets.size(); ++k) {
-        Vec2 n = before[k].allFinite() ? Vec2(2 * last[k] - before[k]) : last[k];
-        const auto ray = pixelRay(view, x + offsets[k].x(), y + offsets[k].y(), &n);
-        before[k] = last[k];
-        last[k] = ray ? n : none;
-        if (ray) sum += radianceAlong(*ray);
+      for (std::size_t k = 0; k < offsets.size(); ++k, ++i) {
+        if (rays[i]) sum += radianceAlong(*rays[i]);
       }
       row[x] = sum * weight;
     }
@@ -192,14 +212,77 @@ cv::Mat Renderer::radianceImage(const geom::CameraModel& view, int supersamples,
   return out;
 }
 
+Result<LightPaths> Renderer::cameraLightPaths(std::string_view camera, int threads) const {
+  const CameraState* cam = state_.camera(camera);
+  if (!cam) return fail(ErrorCode::kNotFound, "no camera named '" + std::string(camera) + "'");
+  const geom::CameraModel& view = cam->model;
+  const std::vector<Vec2> offsets = sampleOffsets(cam->spec.supersamples);
+  const float weight = 1.f / static_cast<float>(offsets.size());
+  LightPaths paths;
+  paths.ambient = cv::Mat(view.height, view.width, CV_32FC3);
+  paths.rows.resize(static_cast<std::size_t>(view.height));
+  std::atomic<std::size_t> traced{0};
+  forEachRow(view.height, threads, [&](int y) {
+    if (traced.load() > LightPaths::kMaxPaths) return;
+    LightPaths::Row& row = paths.rows[static_cast<std::size_t>(y)];
+    row.end.reserve(static_cast<std::size_t>(view.width));
+    cv::Vec3f* ambient = paths.ambient.ptr<cv::Vec3f>(y);
+    std::vector<std::optional<geom::Ray>> rays;
+    rowRays(view, offsets, y, rays);
+    std::size_t i = 0;
+    for (int x = 0; x < view.width; ++x) {
+      ambient[x] = cv::Vec3f(0.f, 0.f, 0.f);
+      for (std::size_t k = 0; k < offsets.size(); ++k, ++i) {
+        if (!rays[i]) continue;
+        const auto hit = world().intersect(*rays[i]);
+        if (!hit) continue;
+        const cv::Vec3f seen = reflectance(*hit) * weight;
+        ambient[x] += ambient_bgr_.mul(seen);
+        for (const Lamp& lamp : lamps_) {
+          const PixelTruth::Light l = light(lamp, hit->hit.point, hit->hit.normal, hit->surface);
+          if (!l.lit) continue;
+          row.paths.push_back({static_cast<float>(l.pixel.x()), static_cast<float>(l.pixel.y()),
+                               seen * irradianceScale(lamp, l),
+                               static_cast<std::uint32_t>(lamp.projector)});
+        }
+      }
+      row.end.push_back(static_cast<std::uint32_t>(row.paths.size()));
+    }
+    traced += row.paths.size();
+  });
+  if (traced.load() > LightPaths::kMaxPaths) {
+    return fail(ErrorCode::kTooLarge, "camera '" + std::string(camera) + "' sees more than " +
+                                          std::to_string(LightPaths::kMaxPaths) +
+                                          " lit samples: too many light paths to keep");
+  }
+  return paths;
+}
+
 Result<cv::Mat> Renderer::cameraRadiance(std::string_view camera, int threads) const {
   const CameraState* cam = state_.camera(camera);
   if (!cam) return fail(ErrorCode::kNotFound, "no camera named '" + std::string(camera) + "'");
-  cv::Mat radiance = radianceImage(cam->model, cam->spec.supersamples, threads);
-  if (cam->spec.psf_sigma_px > 0) {
+  return blurredByLens(cam->spec, radianceImage(cam->model, cam->spec.supersamples, threads));
+}
+
+Result<cv::Mat> Renderer::cameraRadiance(std::string_view camera, const LightPaths& paths,
+                                         int threads) const {
+  const CameraState* cam = state_.camera(camera);
+  if (!cam) return fail(ErrorCode::kNotFound, "no camera named '" + std::string(camera) + "'");
+  if (paths.ambient.rows != cam->model.height || paths.ambient.cols != cam->model.width)
+    return fail(ErrorCode::kInvalidInput,
+                "light paths traced for another camera than '" + std::string(camera) + "'");
+  std::vector<const ProjectorImage*> images(state_.projectors.size(), nullptr);
+  for (const Lamp& lamp : lamps_) {
+    if (lamp.image) images[lamp.projector] = &*lamp.image;
+  }
+  return blurredByLens(cam->spec, paths.light(images, threads));
+}
+
+cv::Mat Renderer::blurredByLens(const CameraSpec& camera, cv::Mat radiance) {
+  if (camera.psf_sigma_px > 0) {
     // Lens point spread, applied to light (linear) before the sensor.
-    cv::GaussianBlur(radiance, radiance, cv::Size(0, 0), cam->spec.psf_sigma_px,
-                     cam->spec.psf_sigma_px, cv::BORDER_REPLICATE);
+    cv::GaussianBlur(radiance, radiance, cv::Size(0, 0), camera.psf_sigma_px, camera.psf_sigma_px,
+                     cv::BORDER_REPLICATE);
   }
   return radiance;
 }

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "sim/light_paths.hpp"
 #include "sim/projector_image.hpp"
 #include "sim/scene.hpp"
 
@@ -62,6 +63,13 @@ class Renderer {
   // Linear radiance the camera's pixels receive (mean over the supersamples, then
   // the lens blur), CV_32FC3, BGR.
   Result<cv::Mat> cameraRadiance(std::string_view camera, int threads = 0) const;
+  // What the camera's samples see while nothing moves, whatever the projectors show
+  // (light_paths.hpp): every projector of the scene, lit now or dark.
+  Result<LightPaths> cameraLightPaths(std::string_view camera, int threads = 0) const;
+  // cameraRadiance from `paths`, traced for this camera in the same geometry (poses,
+  // surfaces, lenses): the same light, to float rounding, without a ray cast.
+  Result<cv::Mat> cameraRadiance(std::string_view camera, const LightPaths& paths,
+                                 int threads = 0) const;
   // The camera image of `radiance` (cameraRadiance's) through the camera's signal chain:
   // what renderCamera gives, for a caller that keeps the radiance of a still scene.
   static cv::Mat cameraImage(const CameraSpec& camera, const cv::Mat& radiance,
@@ -96,6 +104,16 @@ class Renderer {
   PixelTruth::Light light(const Lamp& lamp, const Vec3& point, const Vec3& normal,
                           int surface) const;
   cv::Mat radianceImage(const geom::CameraModel& view, int supersamples, int threads) const;
+  // The rays of row y's samples (width * offsets, pixel-major); nullopt where the
+  // lens distortion cannot be inverted.
+  static void rowRays(const geom::CameraModel& view, const std::vector<Vec2>& offsets, int y,
+                      std::vector<std::optional<geom::Ray>>& rays);
+  // The albedo (times the surface's print) where a ray hit.
+  cv::Vec3f reflectance(const SurfaceHit& hit) const;
+  // brightness * cos / d^2 of a lamp at a lit point.
+  float irradianceScale(const Lamp& lamp, const PixelTruth::Light& l) const;
+  // The lens point spread (CameraSpec::psf_sigma_px) over linear radiance.
+  static cv::Mat blurredByLens(const CameraSpec& camera, cv::Mat radiance);
 
   // The surfaces as they stand at the state's time.
   const World& world() const { return state_.world ? *state_.world : scene_->world(); }

@@ -1,9 +1,10 @@
 // Virtual-rig render bench: time to render wall_oblique's 1280x960 camera while its
 // 1920x1080 projector shows a checkerboard, on one core, split into framebuffer
 // preparation (gamma LUT + footprint blur), ray casting/shading and the sensor
-// model. Baseline in the same run: cv::warpPerspective of the framebuffer into the
-// camera image through the wall homography (the cheapest possible "rendering" of a
-// plane, no distortion, photometry, shadows or noise).
+// model, and for a still scene the light paths' trace and the radiance lit from
+// them (what every capture after the second costs while nothing moves). Baseline in the same run:
+// cv::warpPerspective of the framebuffer into the camera image through the wall homography (the
+// cheapest possible "rendering" of a plane, no distortion, photometry, shadows or noise).
 //
 //   bench_sim_render [--out DIR] [--runs N]
 #include <algorithm>
@@ -12,6 +13,7 @@
 #include <fstream>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <string>
 
 #include "bench_timing.hpp"
@@ -66,6 +68,12 @@ int main(int argc, char** argv) {
   const Timing radiance = measure(runs, [&] { (void)renderer->cameraRadiance(cam.spec.name, 1); });
   const Timing camera =
       measure(runs, [&] { (void)renderer->renderCamera(cam.spec.name, options); });
+  // A still scene: its light paths traced once, then every capture lit from them.
+  std::optional<LightPaths> paths;
+  const Timing trace =
+      measure(runs, [&] { paths = std::move(*renderer->cameraLightPaths(cam.spec.name, 1)); });
+  const Timing relight =
+      measure(runs, [&] { (void)renderer->cameraRadiance(cam.spec.name, *paths, 1); });
 
   // Baseline: framebuffer -> camera through the wall homography (plane y = 3).
   const Mat34 Pp = proj.model.projectionMatrix(), Pc = cam.model.projectionMatrix();
@@ -99,6 +107,8 @@ int main(int argc, char** argv) {
   row("sim_prepare_framebuffer", prepare);
   row("sim_camera_radiance", radiance);
   row("sim_render_camera", camera);
+  row("sim_trace_light_paths", trace);
+  row("sim_radiance_from_light_paths", relight);
   row("baseline_cv_warpPerspective", warp);
   std::printf("wrote %s\n", (out / "bench_sim_render.csv").c_str());
   return 0;

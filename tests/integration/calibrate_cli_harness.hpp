@@ -1,15 +1,18 @@
 #pragma once
 // Runs the built procam-sim and procam-calibrate as a user would, on files in a
 // temporary directory: patterns written by procam-calibrate are shown on the virtual
-// rig by `procam-sim render`, one process per frame and camera, and the captures go
-// back into procam-calibrate.
+// rig (the first frame by `procam-sim render`, the rest by the same renderer in this
+// process), and the captures go back into procam-calibrate.
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
 
 #include "daemon_harness.hpp"
+#include "sim/scene_library.hpp"
+#include "sim/still_camera.hpp"
 
 namespace procam::testing {
 
@@ -36,22 +39,37 @@ inline void writeTextFile(const fs::path& file, const std::string& text) {
 }
 
 // Shows every frame of DIR/sequence.json on projector `projector` and captures it
-// with `camera` into `out` under the pattern's file name. Empty on success, else
-// the failing command's output.
+// with `camera` into `out` under the pattern's file name. The first frame is rendered
+// by `procam-sim render`, as a user would; the camera then films the rest in this
+// process from light paths traced once (sim/still_camera.hpp: the same images, without
+// a ray cast per frame). Empty on success, else the failing command's output.
 inline std::string renderCaptures(const std::string& scene, const fs::path& patterns,
                                   const std::string& projector, const std::string& camera,
                                   const fs::path& out, int seed) {
   fs::create_directories(out);
   const nlohmann::json seq = readJsonFile(patterns / "sequence.json");
-  if (seq.is_discarded() || !seq.contains("frames"))
+  if (seq.is_discarded() || !seq.contains("frames") || seq["frames"].empty())
     return "no sequence.json in " + patterns.string();
+  auto parsed = sim::resolveScene(scene);
+  if (!parsed) return parsed.error().message;
+  auto still = sim::StillCamera::create(*parsed, parsed->at(0), camera);
+  if (!still) return still.error().message;
   int i = 0;
   for (const auto& f : seq["frames"]) {
     const std::string file = f.at("file").get<std::string>();
-    auto r = simulate({"render", "--scene", scene, "--show",
-                       projector + "=" + (patterns / file).string(), "--camera", camera, "--out",
-                       (out / file).string(), "--seed", std::to_string(seed * 1000 + i++)});
-    if (r.status != 0) return file + ": " + r.err;
+    const std::uint64_t frame_seed = static_cast<std::uint64_t>(seed) * 1000 + i++;
+    if (i == 1) {
+      auto r = simulate({"render", "--scene", scene, "--show",
+                         projector + "=" + (patterns / file).string(), "--camera", camera, "--out",
+                         (out / file).string(), "--seed", std::to_string(frame_seed)});
+      if (r.status != 0) return file + ": " + r.err;
+      continue;
+    }
+    const cv::Mat frame = cv::imread((patterns / file).string(), cv::IMREAD_UNCHANGED);
+    if (frame.empty()) return "cannot read " + (patterns / file).string();
+    auto image = still->capture({{projector, frame}}, {.noise = true, .seed = frame_seed});
+    if (!image) return file + ": " + image.error().message;
+    if (!cv::imwrite((out / file).string(), *image)) return "cannot write " + file;
   }
   return {};
 }

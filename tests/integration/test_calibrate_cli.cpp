@@ -1,5 +1,5 @@
 // procam-calibrate end to end: the built programs on files in a temporary directory,
-// captures rendered by `procam-sim render` (one process per frame and camera), the
+// captures rendered on the virtual rig (calibrate_cli_harness.hpp), the
 // results checked against the rig's ground truth with procamd's calibration accuracy
 // bounds.
 #include <gtest/gtest.h>

@@ -23,25 +23,31 @@ TEST(CalibrateCli, SolveWallFromCamerasAtSeveralPositions) {
   auto r = calibrate({"patterns", "--projector", "1280x800", "--mode", "gray+phase",
                       "--phase-steps", "3", "--out", dir.file("patterns")});
   ASSERT_EQ(r.status, 0) << r.err;
-  // The captures, rendered in this process (one procam-sim run per frame would take
-  // minutes): every camera films every projector's sequence.
+  // The captures, rendered in this process from each camera's light paths (one
+  // procam-sim run per frame would take minutes): every camera films every projector's
+  // sequence.
   auto scene = sim::resolveScene("wall_views");
   ASSERT_TRUE(scene) << scene.error().message;
   const sim::SceneState state = scene->at(0);
   const nlohmann::json seq = readJsonFile(dir.file("patterns/sequence.json"));
   ASSERT_FALSE(seq.is_discarded());
+  std::vector<sim::StillCamera> filming;
+  for (const auto& c : state.cameras) {
+    auto still = sim::StillCamera::create(*scene, state, c.spec.name);
+    ASSERT_TRUE(still) << still.error().message;
+    filming.push_back(std::move(*still));
+  }
   int seed = 40;
   for (const auto& p : state.projectors) {
     for (const auto& f : seq.at("frames")) {
       const std::string file = f.at("file").get<std::string>();
       const cv::Mat frame = cv::imread(dir.file("patterns/" + file), cv::IMREAD_GRAYSCALE);
       ASSERT_FALSE(frame.empty()) << file;
-      auto lit = sim::Renderer::create(*scene, state, {{p.spec.name, frame}});
-      ASSERT_TRUE(lit) << lit.error().message;
-      for (const auto& c : state.cameras) {
-        auto image = lit->renderCamera(c.spec.name, {.noise = true, .seed = std::uint64_t(++seed)});
+      for (const sim::StillCamera& c : filming) {
+        auto image =
+            c.capture({{p.spec.name, frame}}, {.noise = true, .seed = std::uint64_t(++seed)});
         ASSERT_TRUE(image) << image.error().message;
-        const fs::path out = dir.file(p.spec.name + "_" + c.spec.name);
+        const fs::path out = dir.file(p.spec.name + "_" + c.name());
         fs::create_directories(out);
         ASSERT_TRUE(cv::imwrite((out / file).string(), *image));
       }

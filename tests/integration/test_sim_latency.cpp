@@ -188,8 +188,11 @@ TEST(SimLatency, CalibrateSettlesByTheMeasuredLatency) {
   ASSERT_EQ((*good)["class"], "CALIBRATE") << good->dump();
   const json& latency = (*good)["latency"];
   ASSERT_EQ(latency["cameras"].size(), 2u) << good->dump();
-  // Half-resolution cameras ray-cast a frame in 0.1 to 0.2 s on two cores.
-  for (const auto& cam : latency["cameras"]) checkCamera(cam, kLatency, 1, 0.4 * kSlowdown);
+  // Half-resolution cameras ray-cast a frame in 0.1 to 0.2 s on two idle
+  // cores and up to 0.45 s beside another ray-casting test: the measurement's
+  // resolution is MeasuredWithinOneFramePeriod's to show; here it must stay
+  // within its one period and give a settle that calibrates right (below).
+  for (const auto& cam : latency["cameras"]) checkCamera(cam, kLatency, 1, 1.0 * kSlowdown);
   EXPECT_EQ((*good)["settle_frames"], latency["settle_frames"]);
   EXPECT_GE((*good)["settle_frames"].get<int>(), kLatencyFrames);
   // The accuracy of test_sim_calibrate.cpp on the scene without latency.

@@ -36,6 +36,7 @@
 #include "sim/projector_image.hpp"
 #include "sim/renderer.hpp"
 #include "sim/scene_library.hpp"
+#include "sim/still_camera.hpp"
 #include "wave_texture.hpp"
 
 namespace procam::itest {
@@ -120,11 +121,11 @@ Result<lamps::LampPhotometry> measureWith(const Rig& rig, std::span<const lamps:
   options.seed = 7 + index;
   std::vector<cv::Mat> shots;
   const int levels[] = {0, 64, 128, 170, 212, 255};
+  auto still = sim::StillCamera::create(rig.scene, rig.state, camera);
+  if (!still) return tl::unexpected(still.error());
   for (const int level : levels) {
     const cv::Mat frame(p.model.height, p.model.width, CV_8UC3, cv::Scalar::all(level));
-    auto r = sim::Renderer::create(rig.scene, rig.state, {{p.spec.name, frame}});
-    if (!r) return tl::unexpected(r.error());
-    auto shot = r->renderCamera(camera, options);
+    auto shot = still->capture({{p.spec.name, frame}}, options);
     if (!shot) return tl::unexpected(shot.error());
     shots.push_back(*shot);
   }

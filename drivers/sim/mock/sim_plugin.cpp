@@ -37,15 +37,20 @@ struct OutputRender {
   plugins::MeshCache mesh;
 };
 
-// A camera's radiance of the last capture and what it was rendered for: while no
-// device moves and no output shows a new frame, the next capture only draws new noise
-// (a still scene renders the same light; the ray cast is most of a capture's time).
+// What a camera saw at its last capture and the geometry it was rendered in. While
+// no device moves, a capture of the same frames only draws new noise, and one of new
+// frames lights the light paths traced at the second capture of that geometry
+// (light_paths.hpp): the ray cast is most of a capture's time, and a calibration
+// changes only what the projectors show. The first capture of a geometry casts its
+// rays directly, so a moving scene traces nothing it will not use again.
 struct CameraRadiance {
   std::vector<geom::Pose> poses;  // every projector's and camera's, in scene order
   std::shared_ptr<const World> world;
+  std::vector<double> lenses;  // every projector's fx, fy, skew (a zoom event changes them)
   std::uint64_t shows = 0;
   cv::Mat radiance;
-  std::vector<double> lenses;  // every projector's fx, fy, skew (a zoom event changes them)
+  std::optional<LightPaths> paths;
+  bool untraceable = false;  // more paths than LightPaths::kMaxPaths
 
   static std::vector<double> lensesOf(const SceneState& state) {
     std::vector<double> out;
@@ -61,8 +66,8 @@ struct CameraRadiance {
     for (const auto& c : state.cameras) out.push_back(c.model.pose);
     return out;
   }
-  bool sameAs(const std::vector<geom::Pose>& p, const SceneState& state, std::uint64_t n) const {
-    if (radiance.empty() || n != shows || state.world != world || p.size() != poses.size() ||
+  bool sameGeometry(const std::vector<geom::Pose>& p, const SceneState& state) const {
+    if (radiance.empty() || state.world != world || p.size() != poses.size() ||
         lensesOf(state) != lenses) {
       return false;
     }
@@ -289,21 +294,38 @@ int cameraCapture(void* self, int, procam_image* out, char* err, size_t len) {
         spec->latency_s > 0 ? dev->world->shownAt(t - spec->latency_s) : dev->world->shown();
     SceneState state = scene.at(t);
     const std::vector<geom::Pose> poses = CameraRadiance::posesOf(state);
-    // With a latency the frames lit are those of another time: always cast again.
-    if (spec->latency_s > 0 || !dev->cache.sameAs(poses, state, shows)) {
-      dev->cache = {};
-      const std::shared_ptr<const World> world = state.world;
-      std::vector<double> lenses = CameraRadiance::lensesOf(state);
+    CameraRadiance& cache = dev->cache;
+    const bool still = cache.sameGeometry(poses, state);
+    // With a latency the frames lit are those of another time: always light again.
+    if (!still || spec->latency_s > 0 || shows != cache.shows) {
+      if (!still) {
+        cache = {poses, state.world, CameraRadiance::lensesOf(state), 0, {}, std::nullopt, false};
+      }
       auto renderer = Renderer::create(scene, std::move(state), shown);
       if (!renderer) return report(err, len, renderer.error().message, PROCAM_EIO);
-      auto radiance = renderer->cameraRadiance(dev->name);
-      if (!radiance) return report(err, len, radiance.error().message, PROCAM_EIO);
-      dev->cache = {poses, world, shows, std::move(*radiance), std::move(lenses)};
+      if (still && !cache.paths && !cache.untraceable) {
+        auto paths = renderer->cameraLightPaths(dev->name);
+        if (paths) {
+          cache.paths = std::move(*paths);
+        } else if (paths.error().code == ErrorCode::kTooLarge) {
+          cache.untraceable = true;  // too many to keep: cast every capture's rays
+        } else {
+          return report(err, len, paths.error().message, PROCAM_EIO);
+        }
+      }
+      auto radiance = cache.paths ? renderer->cameraRadiance(dev->name, *cache.paths)
+                                  : renderer->cameraRadiance(dev->name);
+      if (!radiance) {
+        cache = {};
+        return report(err, len, radiance.error().message, PROCAM_EIO);
+      }
+      cache.radiance = std::move(*radiance);
+      cache.shows = shows;
     }
     // A real sensor's noise is new in every frame: averaging frames reduces it.
     RenderOptions options;
     options.seed = ++dev->frames;
-    cv::Mat m = Renderer::cameraImage(*spec, dev->cache.radiance, options);
+    cv::Mat m = Renderer::cameraImage(*spec, cache.radiance, options);
     if (m.channels() == 3) cv::cvtColor(m, m, cv::COLOR_BGR2RGB);
     if (!m.isContinuous()) m = m.clone();
     dev->buffer.assign(m.datastart, m.dataend);

@@ -14,6 +14,7 @@
 
 #include "sim/renderer.hpp"
 #include "sim/scene.hpp"
+#include "sim/still_camera.hpp"
 #include "structured_light/pattern_set.hpp"
 
 namespace procam::testing {
@@ -112,18 +113,22 @@ inline Result<std::map<std::string, std::vector<cv::Mat>>> capture(
     const sim::Scene& scene, const sl::PatternSet& set, std::uint64_t seed,
     const std::vector<std::string>& cameras = {}) {
   const sim::SceneState state = scene.at(0);
+  std::vector<sim::StillCamera> filming;
+  for (const auto& cam : state.cameras) {
+    if (!cameras.empty() &&
+        std::find(cameras.begin(), cameras.end(), cam.spec.name) == cameras.end())
+      continue;
+    auto still = sim::StillCamera::create(scene, state, cam.spec.name);
+    if (!still) return tl::unexpected(still.error());
+    filming.push_back(std::move(*still));
+  }
   std::map<std::string, std::vector<cv::Mat>> out;
   for (std::size_t i = 0; i < set.frames.size(); ++i) {
-    auto r = sim::Renderer::create(scene, state,
-                                   {{state.projectors[0].spec.name, sl::renderFrame(set, i)}});
-    if (!r) return tl::unexpected(r.error());
-    for (const auto& cam : state.cameras) {
-      if (!cameras.empty() &&
-          std::find(cameras.begin(), cameras.end(), cam.spec.name) == cameras.end())
-        continue;
-      auto image = r->renderCamera(cam.spec.name, {.noise = true, .seed = seed * 1000 + i});
+    const sim::Framebuffers shown = {{state.projectors[0].spec.name, sl::renderFrame(set, i)}};
+    for (const sim::StillCamera& cam : filming) {
+      auto image = cam.capture(shown, {.noise = true, .seed = seed * 1000 + i});
       if (!image) return tl::unexpected(image.error());
-      out[cam.spec.name].push_back(*image);
+      out[cam.name()].push_back(*image);
     }
   }
   return out;
