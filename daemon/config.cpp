@@ -6,7 +6,9 @@
 #include <toml++/toml.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <set>
@@ -188,7 +190,30 @@ bool numbers(Checker& c, const toml::node& node, const std::string& key, double 
 }
 
 void parseContent(Checker& c, const toml::table& t, Config& cfg) {
-  c.onlyKnown(t, "content.", {"viewer", "viewer_threshold_m", "roots", "allow_pipeline"});
+  c.onlyKnown(t, "content.",
+              {"viewer", "viewer_threshold_m", "roots", "allow_pipeline", "projection",
+               "dome_front", "dome_fov_deg"});
+  if (auto* n = t.get("projection")) {
+    std::string s;
+    if (c.string(*n, "content.projection", s)) {
+      if (s == "perspective" || s == "dome") {
+        cfg.content_dome = s == "dome";
+      } else {
+        c.error(n->source(), "content.projection", "'" + s + "' is not one of: perspective, dome");
+      }
+    }
+  }
+  if (auto* n = t.get("dome_fov_deg")) {
+    c.number(*n, "content.dome_fov_deg", 1.0, 360.0, cfg.content_dome_fov_deg);
+  }
+  std::array<double, 3> front{};
+  if (auto* n = t.get("dome_front"); n && numbers(c, *n, "content.dome_front", -1e4, 1e4, front)) {
+    if (std::hypot(front[0], front[1]) < 1e-6 * std::max(1.0, std::abs(front[2]))) {
+      c.error(n->source(), "content.dome_front", "must point away from the vertical");
+    } else {
+      cfg.content_dome_front = front;
+    }
+  }
   if (auto* n = t.get("allow_pipeline")) {
     c.boolean(*n, "content.allow_pipeline", cfg.content_allow_pipeline);
   }

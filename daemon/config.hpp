@@ -94,6 +94,13 @@ struct Config {
   // [content] viewer: the viewer's eye (world, metres) for 3D content when no tracker
   // has reported one.
   std::optional<std::array<double, 3>> content_viewer;
+  // [content] projection: what image content is on a non-planar display. "perspective"
+  // (the default): the image the viewer at the sweet spot sees through a pinhole;
+  // "dome": a dome master (render/dome_master.hpp) around that eye, its front toward
+  // dome_front, dome_fov_deg wide, drawn for that eye whether or not a tracker reports.
+  bool content_dome = false;
+  std::array<double, 3> content_dome_front{0.0, 1.0, 0.0};
+  double content_dome_fov_deg = 180.0;
   // [content] viewer_threshold_m: a tracked viewer who moved this far since the mesh was
   // last drawn has it drawn again (content_follow.cpp says why 5 mm).
   double content_viewer_threshold_m = 0.005;

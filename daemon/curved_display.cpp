@@ -7,13 +7,18 @@
 // (blend/curved_display.hpp). Made on the compute worker and kept until the content's
 // size, the outputs, the rig or the eye change. A tracked viewer sees the same display
 // (rectangle, weights, photometric match) from where they are: each output draws it by
-// the two-pass path for the tracked eye (rig_surfaces.cpp).
+// the two-pass path for the tracked eye (rig_surfaces.cpp). With [content] projection =
+// "dome" the content is a dome master around the static eye (render/dome_master.hpp),
+// drawn through the lookup warps for that eye alone.
+#include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "blend/rig_tiles.hpp"
 #include "daemon.hpp"
 #include "json_matrix.hpp"
 #include "log.hpp"
+#include "render/dome_master.hpp"
 #include "render/post_render_warp.hpp"
 
 namespace procam::daemon {
@@ -21,6 +26,12 @@ namespace procam::daemon {
 using nlohmann::json;
 
 namespace {
+
+// [content] projection = "dome": the master's front and field of view.
+struct DomeSettings {
+  Vec3 front;
+  double fov_deg = 180;
+};
 
 struct CurvedInput {
   std::string output;
@@ -34,10 +45,12 @@ struct CurvedInput {
 
 // What a display is made for: the content's size, the eye, every output's projector,
 // surface and response.
-std::string curvedKey(cv::Size content, const Vec3& eye, const std::vector<CurvedInput>& inputs) {
+std::string curvedKey(cv::Size content, const Vec3& eye, const std::vector<CurvedInput>& inputs,
+                      const std::optional<DomeSettings>& dome) {
   std::ostringstream key;
   key.precision(17);
   key << content.width << 'x' << content.height << " eye " << eye.transpose();
+  if (dome) key << " dome " << dome->front.transpose() << ' ' << dome->fov_deg;
   for (const auto& in : inputs) {
     key << ' ' << in.output << ' ' << in.size.width << 'x' << in.size.height << ' '
         << in.surface.get();
@@ -66,22 +79,30 @@ const KeystoneRuntime::Curved* Daemon::curvedDisplay(cv::Size content, const Vie
     inputs.push_back({e.name, p->model(), *mode, surface, &surface->intersector, rigResponse(*p),
                       rig_surfaces_.count(p->name) > 0});
   }
-  if (inputs.size() < 2 || content.width < 1 || content.height < 1) {
+  std::optional<DomeSettings> dome;
+  if (config_.content_dome) {
+    const auto& f = config_.content_dome_front;
+    dome = DomeSettings{Vec3(f[0], f[1], f[2]), config_.content_dome_fov_deg};
+  }
+  // A dome master is drawn by one projector as by several; a perspective display of
+  // one projector is nonPlanarSetup's own.
+  if (inputs.size() < (dome ? 1u : 2u) || content.width < 1 || content.height < 1) {
     k.curved.reset();
     k.curved_key.clear();
     k.curved_error.clear();
     return nullptr;
   }
-  const std::string key = curvedKey(content, eye.position, inputs);
+  const std::string key = curvedKey(content, eye.position, inputs, dome);
   if (key == k.curved_key) return k.curved.get();  // made, failed, or on its way
   k.curved_key = key;
   k.curved_error.clear();
   k.curved.reset();
   if (k.curving) return nullptr;  // the job running sees the new key when it ends
   k.curving = true;
-  logInfo("display across " + std::to_string(inputs.size()) + " outputs on the surface: solving");
+  const std::string what = dome ? "dome display" : "display";
+  logInfo(what + " across " + std::to_string(inputs.size()) + " outputs on the surface: solving");
   compute_worker_->submit(
-      [this, key, content, inputs, eye] {
+      [this, key, content, inputs, eye, dome, what] {
         auto made = std::make_shared<KeystoneRuntime::Curved>();
         std::vector<blend::SurfaceProjector> projectors;
         std::vector<std::optional<blend::ProjectorResponse>> responses;
@@ -104,8 +125,13 @@ const KeystoneRuntime::Curved* Daemon::curvedDisplay(cv::Size content, const Vie
           made->post_warps.push_back(*warp);
         }
         Result<blend::CurvedBlend> blended = fail(ErrorCode::kInvalidInput, error);
-        if (error.empty())
+        if (error.empty() && dome) {
+          auto master = render::domeMaster(eye.position, dome->front, dome->fov_deg, content);
+          blended = master ? blend::makeDomeBlend(projectors, responses, *master)
+                           : Result<blend::CurvedBlend>(tl::unexpected(master.error()));
+        } else if (error.empty()) {
           blended = blend::makeCurvedBlend(projectors, responses, eye.position, content);
+        }
         if (blended) {
           static_cast<blend::CurvedBlend&>(*made) = std::move(*blended);
           made->weights.clear();  // the outputs take the 8-bit mask
@@ -114,18 +140,18 @@ const KeystoneRuntime::Curved* Daemon::curvedDisplay(cv::Size content, const Vie
         } else {
           error = blended.error().message;
         }
-        return [this, key, made, error] {
+        return [this, key, made, error, what] {
           KeystoneRuntime& k = keystone_rt_;
           k.curving = false;
           if (key == k.curved_key) {
             if (error.empty()) {
               k.curved = made;
-              logInfo("display across " + std::to_string(made->outputs.size()) +
+              logInfo(what + " across " + std::to_string(made->outputs.size()) +
                       " outputs on the surface: ready");
             } else {
               k.curved.reset();
               k.curved_error = error;
-              warn("no display across the projectors on the surface: " + error);
+              warn("no " + what + " across the projectors on the surface: " + error);
             }
           } else {
             k.curved_key.clear();  // made for something older: make it again
@@ -163,7 +189,27 @@ json Daemon::curvedDisplayJson() const {
   }
   json eye = k.curved->eye_source;
   eye["position"] = {d.eye.x(), d.eye.y(), d.eye.z()};
+  const json blend = {{"weights", "feathered"},
+                      {"response", k.curved->measured ? "measured" : "assumed gamma 2.2"},
+                      {"photometric", blend::matchingJson(*k.curved)}};
+  if (d.dome) {
+    const Vec3 front = d.dome->frame.row(1).transpose();
+    return {{"state", "ready"},
+            {"projection", "dome"},
+            {"surface", "mesh"},
+            {"outputs", k.curved->outputs},
+            {"content_size", {k.curved->content.width, k.curved->content.height}},
+            {"viewer", eye},
+            {"dome",
+             {{"front", {front.x(), front.y(), front.z()}},
+              {"fov_deg", 2 * d.dome->half_fov * 180 / M_PI},
+              // The part of the master's circle the projectors draw.
+              {"coverage", d.coverage}}},
+            {"tiles", tiles},
+            {"blend", blend}};
+  }
   return {{"state", "ready"},
+          {"projection", "perspective"},
           {"surface", "mesh"},
           {"outputs", k.curved->outputs},
           {"content_size", {k.curved->content.width, k.curved->content.height}},
@@ -176,10 +222,7 @@ json Daemon::curvedDisplayJson() const {
           {"union_area_tan2", d.union_area},
           {"cell_tan", d.cell},
           {"tiles", tiles},
-          {"blend",
-           {{"weights", "feathered"},
-            {"response", k.curved->measured ? "measured" : "assumed gamma 2.2"},
-            {"photometric", blend::matchingJson(*k.curved)}}}};
+          {"blend", blend}};
 }
 
 }  // namespace procam::daemon

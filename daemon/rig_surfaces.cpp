@@ -101,7 +101,9 @@ Result<std::shared_ptr<const render::RenderSetup>> Daemon::nonPlanarSetup(
   if (!surface) return fail(ErrorCode::kNotFound, "the surface mesh is not loaded");
   // The eye of the viewer kind the path is chosen for: a tracker's when tracked, else the
   // configured or the rig's sweet spot. Content drawn for a fixed matrix needs none.
-  const bool tracked = traits.viewer == render::ViewerKind::kTracked && !fixed_viewer;
+  // A dome master is made for the static eye: a tracker does not move it.
+  const bool tracked =
+      traits.viewer == render::ViewerKind::kTracked && !fixed_viewer && !config_.content_dome;
   std::optional<Vec3> eye;
   if (fixed_viewer) {
     eye = Vec3::Zero();
@@ -130,6 +132,11 @@ Result<std::shared_ptr<const render::RenderSetup>> Daemon::nonPlanarSetup(
     }
   }
   if (share) *share = index;
+  if (!fixed && !curved && config_.content_dome) {
+    const std::string& error = keystone_rt_.curved_error;
+    return fail(ErrorCode::kNotFound,
+                error.empty() ? "the dome display is being solved" : "no dome display: " + error);
+  }
   if (st.np_setup && st.np_surface == surface && st.np_eye == *eye && st.np_content == content &&
       st.np_projector == P && st.np_tracked == tracked && st.np_fixed == fixed &&
       st.np_curved == curved) {

@@ -86,7 +86,14 @@ Result<json> renderCurved(const CurvedRenderInput& in) {
                           cv::Size(chosen[t]->width, chosen[t]->height), grid});
     responses.push_back(blend::projectorResponse(*chosen[t]));
   }
-  auto made = blend::makeCurvedBlend(projectors, responses, *eye, in.content.size());
+  std::optional<render::DomeMaster> master;
+  if (in.dome_front) {
+    auto m = render::domeMaster(*eye, *in.dome_front, in.dome_fov_deg, in.content.size());
+    if (!m) return tl::unexpected(m.error());
+    master = *m;
+  }
+  auto made = master ? blend::makeDomeBlend(projectors, responses, *master)
+                     : blend::makeCurvedBlend(projectors, responses, *eye, in.content.size());
   if (!made) return tl::unexpected(made.error());
   const blend::CurvedDisplay& d = made->display;
   json shares = json::array();
@@ -117,16 +124,22 @@ Result<json> renderCurved(const CurvedRenderInput& in) {
     if (!package) return tl::unexpected(package.error());
     if (auto ok = writeMpcdiZip(in.mpcdi, *package); !ok) return tl::unexpected(ok.error());
   }
-  json viewer_matrix = json::array();
-  for (int i = 0; i < 12; ++i) viewer_matrix.push_back(d.viewer(i / 4, i % 4));
-  json doc = {{"display",
-               {{"surface", "mesh"},
-                {"viewer", {{"position", daemon::vectorJson(*eye)}, {"source", eye_source}}},
-                {"viewer_matrix", viewer_matrix},
-                {"rect_tan",
-                 {{"centre", {d.rect.centre.x(), d.rect.centre.y()}},
-                  {"size", {2 * d.rect.half_width, 2 * d.rect.half_height}}}},
-                {"union_area_tan2", d.union_area}}},
+  json display = {{"projection", master ? "dome" : "perspective"},
+                  {"surface", "mesh"},
+                  {"viewer", {{"position", daemon::vectorJson(*eye)}, {"source", eye_source}}}};
+  if (master) {
+    display["dome"] = {{"front", daemon::vectorJson(Vec3(master->frame.row(1).transpose()))},
+                       {"fov_deg", in.dome_fov_deg},
+                       {"coverage", d.coverage}};
+  } else {
+    json viewer_matrix = json::array();
+    for (int i = 0; i < 12; ++i) viewer_matrix.push_back(d.viewer(i / 4, i % 4));
+    display["viewer_matrix"] = viewer_matrix;
+    display["rect_tan"] = {{"centre", {d.rect.centre.x(), d.rect.centre.y()}},
+                           {"size", {2 * d.rect.half_width, 2 * d.rect.half_height}}};
+    display["union_area_tan2"] = d.union_area;
+  }
+  json doc = {{"display", display},
               {"blend",
                {{"weights", in.geometry_only ? "none" : "feathered"},
                 {"response", in.geometry_only ? "none"

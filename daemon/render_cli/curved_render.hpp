@@ -1,6 +1,7 @@
 #pragma once
 // procam-render on a curved rig: the projectors with a pose and a surface mesh in the rig
-// model shown as one display for a viewer at a sweet spot (blend/curved_display.hpp).
+// model shown as one display for a viewer at a sweet spot (blend/curved_display.hpp), or
+// as one dome master around that eye (render/dome_master.hpp).
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
@@ -18,10 +19,12 @@ struct CurvedRenderInput {
   std::filesystem::path rig_file;       // its meshes are files beside it
   std::vector<std::string> projectors;  // only these (empty: every posed one with a mesh)
   std::optional<Vec3> viewer;           // --viewer, else the rig model's
-  cv::Mat content;                      // decoded, 8 or 16 bit
-  std::filesystem::path out;            // frames go here (empty: none)
-  std::filesystem::path mpcdi;          // the MPCDI package (empty: none)
-  std::string date;                     // the package's date, in MPCDI's form
+  std::optional<Vec3> dome_front;       // a dome master's front (render/dome_master.hpp)
+  double dome_fov_deg = 180;
+  cv::Mat content;              // decoded, 8 or 16 bit
+  std::filesystem::path out;    // frames go here (empty: none)
+  std::filesystem::path mpcdi;  // the MPCDI package (empty: none)
+  std::string date;             // the package's date, in MPCDI's form
   int bit_depth = 8;
   bool geometry_only = false;
 };

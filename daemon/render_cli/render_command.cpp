@@ -1,5 +1,6 @@
 #include "render_command.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <ctime>
 #include <fstream>
@@ -102,11 +103,12 @@ Result<RenderArgs> parseRenderArgs(const std::vector<std::string>& args) {
   bool object_only = false;  // an option only --object takes was given
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& opt = args[i];
-    const bool takes_value =
-        opt == "--rig" || opt == "--content" || opt == "--out" || opt == "--rect" ||
-        opt == "--bit-depth" || opt == "--projector" || opt == "--mpcdi" || opt == "--viewer" ||
-        opt == "--object" || opt == "--texture" || opt == "--off" || opt == "--light" ||
-        opt == "--specular" || opt == "--shininess" || opt == "--max-incidence" || opt == "--white";
+    const bool takes_value = opt == "--rig" || opt == "--content" || opt == "--out" ||
+                             opt == "--rect" || opt == "--bit-depth" || opt == "--projector" ||
+                             opt == "--mpcdi" || opt == "--viewer" || opt == "--dome" ||
+                             opt == "--dome-fov" || opt == "--object" || opt == "--texture" ||
+                             opt == "--off" || opt == "--light" || opt == "--specular" ||
+                             opt == "--shininess" || opt == "--max-incidence" || opt == "--white";
     const auto number = [&](double lo, double hi) -> Result<double> {
       auto v = numberList(args[++i], 1, opt);
       if (!v) return tl::unexpected(v.error());
@@ -136,6 +138,17 @@ Result<RenderArgs> parseRenderArgs(const std::vector<std::string>& args) {
       auto v = numberList(args[++i], 3, "--viewer");
       if (!v) return tl::unexpected(v.error());
       a.viewer = Vec3((*v)[0], (*v)[1], (*v)[2]);
+    } else if (opt == "--dome") {
+      auto v = numberList(args[++i], 3, "--dome");
+      if (!v) return tl::unexpected(v.error());
+      if (!(std::hypot((*v)[0], (*v)[1]) > 1e-6 * std::max(1.0, std::abs((*v)[2]))))
+        return fail(ErrorCode::kInvalidInput,
+                    "--dome: the front must point away from the vertical");
+      a.dome = Vec3((*v)[0], (*v)[1], (*v)[2]);
+    } else if (opt == "--dome-fov") {
+      auto v = number(1, 360);
+      if (!v) return tl::unexpected(v.error());
+      a.dome_fov_deg = *v;
     } else if (opt == "--bit-depth") {
       const std::string& v = args[++i];
       if (v != "8" && v != "16") return fail(ErrorCode::kInvalidInput, "--bit-depth is 8 or 16");
@@ -211,6 +224,8 @@ Result<json> runCurved(const RenderArgs& args, const rig::RigModel& rig) {
   in.rig_file = args.rig;
   in.projectors = args.projectors;
   in.viewer = args.viewer;
+  in.dome_front = args.dome;
+  in.dome_fov_deg = args.dome_fov_deg;
   in.content = *content;
   in.out = args.out;
   in.mpcdi = args.mpcdi;
@@ -280,7 +295,7 @@ Result<json> runRender(const RenderArgs& args) {
   // A rig with surface meshes (route (a) on a curved surface), or a viewer given: one
   // display for the viewer.
   const bool meshed = !rig->surface.meshes.empty() || !rig->surface.unified_mesh.empty();
-  if (args.viewer || (meshed && !rig->surface.plane)) return runCurved(args, *rig);
+  if (args.viewer || args.dome || (meshed && !rig->surface.plane)) return runCurved(args, *rig);
 
   std::vector<blend::DisplayTile> tiles;
   std::vector<std::optional<blend::ProjectorResponse>> responses;

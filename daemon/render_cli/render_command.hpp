@@ -32,6 +32,10 @@ inline constexpr const char* kUsage =
     "  --bit-depth 8|16   PNG depth (default 8: exactly the daemon's frames; 16: drawn in\n"
     "                     double precision, content ramps keep their codes)\n"
     "  --viewer X,Y,Z     the viewer's eye (world, metres): a curved display drawn for it\n"
+    "  --dome FX,FY,FZ    the content is a dome master around that eye (fisheye, zenith\n"
+    "                     world +Z at its centre, this front at its bottom) instead of\n"
+    "                     the eye's perspective view\n"
+    "  --dome-fov DEG     the dome master's field of view across its circle (default 180)\n"
     "  --geometry-only    no blending and no response correction: the geometry alone\n"
     "  --projector NAME   only this projector of the rig (repeatable; default all that\n"
     "                     map onto the display plane)\n"
@@ -69,6 +73,8 @@ struct RenderArgs {
   std::vector<std::string> projectors;
   std::filesystem::path mpcdi;  // empty: no MPCDI export
   std::optional<Vec3> viewer;   // a curved display's eye
+  std::optional<Vec3> dome;     // --dome: a dome master with this front
+  double dome_fov_deg = 180;    // --dome-fov
   // An object to paint (shader lamps) instead of a display.
   std::filesystem::path object, texture;
   std::vector<std::string> off;

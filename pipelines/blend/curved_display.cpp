@@ -134,6 +134,29 @@ Result<CurvedDisplay> solveCurvedDisplay(std::span<const SurfaceProjector> proje
               "no display rectangle is drawn whole by the projectors' lookup warps");
 }
 
+namespace {
+
+// Eq. 4.3 weights over each projector's drawn image and the blend tables of a display.
+Result<CurvedBlend> blendOf(std::span<const SurfaceProjector> projectors,
+                            std::span<const std::optional<ProjectorResponse>> responses,
+                            CurvedDisplay display, cv::Size content,
+                            const CurvedDisplayOptions& options) {
+  auto weights = curvedFeatherWeights(projectors, options.feather, display.lookup);
+  if (!weights) return tl::unexpected(weights.error());
+  std::vector<ContentOf> to_content;
+  for (const render::WarpGrid& grid : display.lookup) {
+    to_content.push_back([&grid](const Vec2& pixel) { return render::gridSource(grid, pixel); });
+  }
+  auto tables = blendTables(std::move(*weights), responses, to_content, content);
+  if (!tables) return tl::unexpected(tables.error());
+  CurvedBlend out;
+  static_cast<BlendTables&>(out) = std::move(*tables);
+  out.display = std::move(display);
+  return out;
+}
+
+}  // namespace
+
 Result<CurvedBlend> makeCurvedBlend(std::span<const SurfaceProjector> projectors,
                                     std::span<const std::optional<ProjectorResponse>> responses,
                                     const Vec3& eye, cv::Size content,
@@ -142,18 +165,68 @@ Result<CurvedBlend> makeCurvedBlend(std::span<const SurfaceProjector> projectors
     return fail(ErrorCode::kInvalidInput, "one response per projector, or none");
   auto display = solveCurvedDisplay(projectors, eye, content, options);
   if (!display) return tl::unexpected(display.error());
-  auto weights = curvedFeatherWeights(projectors, options.feather, display->lookup);
-  if (!weights) return tl::unexpected(weights.error());
-  std::vector<ContentOf> to_content;
-  for (const render::WarpGrid& grid : display->lookup) {
-    to_content.push_back([&grid](const Vec2& pixel) { return render::gridSource(grid, pixel); });
+  return blendOf(projectors, responses, std::move(*display), content, options);
+}
+
+Result<CurvedDisplay> solveDomeDisplay(std::span<const SurfaceProjector> projectors,
+                                       const render::DomeMaster& master,
+                                       const CurvedDisplayOptions& options) {
+  if (projectors.empty()) return fail(ErrorCode::kInvalidInput, "a display needs a projector");
+  const cv::Size content = master.content;
+  if (content.width < 1 || content.height < 1 || content.width > 65536 || content.height > 65536)
+    return fail(ErrorCode::kInvalidInput, "content size out of range");
+  if (options.lookup_step < 1 || options.lookup_step > 64)
+    return fail(ErrorCode::kInvalidInput, "lookup step outside [1, 64]");
+  auto found = surfaceProjectorRays(projectors);
+  if (!found) return tl::unexpected(found.error());
+  const std::vector<render::PixelRays>& rays = *found;
+  CurvedDisplay out;
+  out.eye = master.eye;
+  out.dome = master;
+  for (const SurfaceProjector& p : projectors) {
+    auto grid = render::lookupGridForDome(*p.surface, p.projector, p.size, master,
+                                          options.lookup_step, p.post_warp);
+    if (!grid) return tl::unexpected(grid.error());
+    out.lookup.push_back(std::move(*grid));
   }
-  auto tables = blendTables(std::move(*weights), responses, to_content, content);
-  if (!tables) return tl::unexpected(tables.error());
-  CurvedBlend out;
-  static_cast<BlendTables&>(out) = std::move(*tables);
-  out.display = std::move(*display);
+  // The part of the circle some projector draws: the eye's ray of each cell of a
+  // 128 x 128 lattice over the circle meets a surface at a pixel a lookup warp draws.
+  constexpr int kN = 128;
+  long inside = 0, drawn = 0;
+  const Vec2 c0 = master.centre();
+  const double r = master.radius();
+  for (int j = 0; j < kN; ++j) {
+    for (int i = 0; i < kN; ++i) {
+      const Vec2 c = c0 + r * Vec2(-1 + (2 * i + 1.0) / kN, -1 + (2 * j + 1.0) / kN);
+      const auto d = master.direction(c);
+      if (!d) continue;
+      ++inside;
+      for (std::size_t m = 0; m < projectors.size(); ++m) {
+        const auto hit = projectors[m].surface->intersect({master.eye, *d});
+        if (!hit) continue;
+        const auto pixel = rays[m].framebufferPixelOf(hit->point);
+        if (pixel && render::gridSource(out.lookup[m], *pixel)) {
+          ++drawn;
+          break;
+        }
+      }
+    }
+  }
+  out.coverage = inside > 0 ? double(drawn) / inside : 0;
+  if (drawn == 0)
+    return fail(ErrorCode::kDegenerate, "no projector draws any of the dome master's circle");
   return out;
+}
+
+Result<CurvedBlend> makeDomeBlend(std::span<const SurfaceProjector> projectors,
+                                  std::span<const std::optional<ProjectorResponse>> responses,
+                                  const render::DomeMaster& master,
+                                  const CurvedDisplayOptions& options) {
+  if (!responses.empty() && responses.size() != projectors.size())
+    return fail(ErrorCode::kInvalidInput, "one response per projector, or none");
+  auto display = solveDomeDisplay(projectors, master, options);
+  if (!display) return tl::unexpected(display.error());
+  return blendOf(projectors, responses, std::move(*display), master.content, options);
 }
 
 nlohmann::json postWarpJson(const render::PostRenderWarp& warp) {

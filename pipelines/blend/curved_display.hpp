@@ -17,6 +17,7 @@
 #include "blend/curved_feather.hpp"
 #include "core/error.hpp"
 #include "keystone/inscribed_rect.hpp"
+#include "render/dome_master.hpp"
 #include "render/post_render_warp.hpp"
 #include "render/warp_map.hpp"
 
@@ -38,6 +39,11 @@ struct CurvedDisplay {
   double cell = 0;                       // the rectangle's accuracy on that plane
   double union_area = 0;                 // of the images on that plane
   std::vector<render::WarpGrid> lookup;  // per projector: pixel -> content pixel
+  // Dome-master content (render/dome_master.hpp) in place of the eye's pinhole: then
+  // `viewer`, `rotation`, `rect` and `cell` are unused, and `coverage` is the part of
+  // the master's circle the projectors draw.
+  std::optional<render::DomeMaster> dome;
+  double coverage = 0;
 };
 
 struct CurvedBlend : BlendTables {
@@ -57,6 +63,19 @@ Result<CurvedBlend> makeCurvedBlend(std::span<const SurfaceProjector> projectors
                                     std::span<const std::optional<ProjectorResponse>> responses,
                                     const Vec3& eye, cv::Size content,
                                     const CurvedDisplayOptions& options = {});
+
+// The display of dome-master content: every projector's lookup warp onto `master`.
+// kInvalidInput for no projectors, a missing surface, bad sizes or lookup step;
+// kDegenerate when no projector draws any of the master's circle.
+Result<CurvedDisplay> solveDomeDisplay(std::span<const SurfaceProjector> projectors,
+                                       const render::DomeMaster& master,
+                                       const CurvedDisplayOptions& options = {});
+
+// The dome display, its weights and blend tables. `responses` as blendTables takes them.
+Result<CurvedBlend> makeDomeBlend(std::span<const SurfaceProjector> projectors,
+                                  std::span<const std::optional<ProjectorResponse>> responses,
+                                  const render::DomeMaster& master,
+                                  const CurvedDisplayOptions& options = {});
 
 // A projector's post-rendering warp for status and display.json: {"source": "measured"
 // or "lens", "rms_px", "max_px" (how far it moves the pinhole's pixels), "points" (the

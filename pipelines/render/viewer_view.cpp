@@ -162,11 +162,12 @@ Result<Mat34> viewerContentMatrix(const geom::MeshIntersector& surface, const Ma
   return V;
 }
 
-Result<WarpGrid> lookupGridForViewer(const geom::MeshIntersector& surface, const Mat34& projector,
-                                     cv::Size size, const Mat34& viewer, int step,
-                                     std::shared_ptr<const WarpGrid> post_warp) {
-  if (size.width < 2 || size.height < 2 || step < 1 || !viewer.allFinite()) {
-    return fail(ErrorCode::kInvalidInput, "lookup grid: bad size, step or viewer");
+Result<WarpGrid> lookupGridThrough(
+    const geom::MeshIntersector& surface, const Mat34& projector, cv::Size size, int step,
+    std::shared_ptr<const WarpGrid> post_warp,
+    const std::function<std::optional<Vec2>(const Vec3&)>& to_content) {
+  if (size.width < 2 || size.height < 2 || step < 1) {
+    return fail(ErrorCode::kInvalidInput, "lookup grid: bad size or step");
   }
   auto rays = pixelRays(projector, std::move(post_warp));
   if (!rays) return tl::unexpected(rays.error());
@@ -177,13 +178,24 @@ Result<WarpGrid> lookupGridForViewer(const geom::MeshIntersector& surface, const
         const Vec2 n = g.node(i, j);
         const auto hit = surface.intersect(rays->through(n.x(), n.y()));
         if (!hit) continue;
-        const Vec3 q = viewer * hit->point.homogeneous();
-        if (q.z() <= 0) continue;
-        g.source[static_cast<size_t>(j) * g.cols + i] = q.hnormalized();
+        if (const auto c = to_content(hit->point))
+          g.source[static_cast<size_t>(j) * g.cols + i] = *c;
       }
     }
   });
   return g;
+}
+
+Result<WarpGrid> lookupGridForViewer(const geom::MeshIntersector& surface, const Mat34& projector,
+                                     cv::Size size, const Mat34& viewer, int step,
+                                     std::shared_ptr<const WarpGrid> post_warp) {
+  if (!viewer.allFinite()) return fail(ErrorCode::kInvalidInput, "lookup grid: bad viewer");
+  return lookupGridThrough(surface, projector, size, step, std::move(post_warp),
+                           [&viewer](const Vec3& X) -> std::optional<Vec2> {
+                             const Vec3 q = viewer * X.homogeneous();
+                             if (q.z() <= 0) return std::nullopt;
+                             return q.hnormalized();
+                           });
 }
 
 }  // namespace procam::render

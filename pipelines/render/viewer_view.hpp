@@ -7,6 +7,7 @@
 // the content pixel where the eye's ray through that pixel's surface point crosses the
 // plane: the two-pass path draws exactly that (§3.2.3), the lookup warp samples it on a
 // grid (§4.1.5).
+#include <functional>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <optional>
@@ -62,6 +63,15 @@ Mat34 contentViewMatrix(const Mat3& R, const Vec3& eye, const keystone::AxisRect
 // eye; kInvalidInput for empty sizes or non-finite input.
 Result<Mat34> viewerContentMatrix(const geom::MeshIntersector& surface, const Mat34& projector,
                                   cv::Size projector_size, const Vec3& eye, cv::Size content_size);
+
+// A lookup warp to any content projection: nodes every `step` framebuffer pixels
+// (framebufferGrid) holding to_content(the surface point the node's ray meets), kOutside
+// where the ray misses the surface or to_content gives nothing. kInvalidInput for a
+// size under 2 x 2, a step under 1 or a singular projector matrix.
+Result<WarpGrid> lookupGridThrough(
+    const geom::MeshIntersector& surface, const Mat34& projector, cv::Size projector_size, int step,
+    std::shared_ptr<const WarpGrid> post_warp,
+    const std::function<std::optional<Vec2>(const Vec3&)>& to_content);
 
 // The lookup warp for that viewer: nodes every `step` projector pixels (the last row and
 // column on the frame's edge) holding the content pixel each shows; nodes whose ray misses

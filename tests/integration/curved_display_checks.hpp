@@ -1,7 +1,7 @@
 #pragma once
 // Checks of one display across projectors on a curved surface against the virtual rig's
-// TRUE projectors and surface, shared by the cylinder (static viewer, lookup warps) and
-// dome (tracked viewer, two-pass) tests. Each output is described by its lookup from its
+// TRUE projectors and surface, shared by the cylinder (static viewer, lookup warps;
+// tracked viewer, two-pass) and dome-master tests. Each output is described by its lookup from its
 // projector's pixels to content pixels (for the two-pass path: the same lookup rebuilt
 // from the viewer matrix it drew with and the calibrated surface).
 #include <gtest/gtest.h>
@@ -9,7 +9,10 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -18,6 +21,8 @@
 #include "blend/curved_display.hpp"
 #include "blend/rig_tiles.hpp"
 #include "content/mesh_content.hpp"
+#include "daemon_harness.hpp"
+#include "render/cpu_renderer.hpp"
 #include "render/post_render_warp.hpp"
 #include "render/render_setup.hpp"
 #include "render/viewer_view.hpp"
@@ -209,6 +214,91 @@ inline double bentOnTheTrueSurface(const std::vector<render::WarpGrid>& lookup,
     straightness(false, content.width * k / 10.0);
   }
   return bent;
+}
+
+// An output of a route (a) calibrate reply: its figures printed (nodes triangulated,
+// reprojection, its centre against the TRUE projector's, its response's gamma), a mesh
+// surface and the gamma within 0.05 of the TRUE one.
+inline void checkRouteAOutput(const nlohmann::json& o, const geom::CameraModel& truth,
+                              double true_gamma) {
+  const std::string name = o["output"].get<std::string>();
+  const Vec3 centre(o["position"][0].get<double>(), o["position"][1].get<double>(),
+                    o["position"][2].get<double>());
+  const double centre_mm = 1000 * (centre - truth.pose.center()).norm();
+  std::printf(
+      "[ figures  ] %s: route a, %d nodes triangulated, reprojection %.4f px, centre %.2f mm "
+      "off, response gamma %.3f (true %.1f)\n",
+      name.c_str(), o["triangulated"].get<int>(),
+      o["projector"]["reprojection_rms_px"].get<double>(), centre_mm,
+      o["response"]["response_gamma"].get<double>(), true_gamma);
+  EXPECT_EQ(o["surface_type"], "mesh") << name;
+  EXPECT_NEAR(o["response"]["response_gamma"].get<double>(), true_gamma, 0.05) << name;
+}
+
+// What status says once content is drawn across the surface: its `outputs.display`
+// entry and, per output drawing its share by a lookup warp, its `outputs.shown[]` entry.
+struct LookupDisplay {
+  nlohmann::json display;
+  std::map<std::string, nlohmann::json> shown;
+  bool ready = false;  // the display ready and `outputs` outputs drawing it
+};
+
+// Loads the image `png` as content and waits (60 s, scaled by kSlowdown) until `outputs`
+// outputs draw it by their lookup warps from a ready display.
+inline LookupDisplay loadOntoLookupDisplay(Connection& c, const std::string& png,
+                                           std::size_t outputs) {
+  LookupDisplay out;
+  auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", png}}, kSlowdown * 30s);
+  if (!load || (*load)["class"] != "CONTENT") {
+    ADD_FAILURE() << "content load: " << (load ? load->dump() : "no answer");
+    return out;
+  }
+  out.ready = eventually(
+      [&] {
+        auto s = c.call({{"cmd", "status"}});
+        if (!s) return false;
+        out.display = (*s)["outputs"].value("display", nlohmann::json());
+        out.shown.clear();
+        if (!out.display.is_object() || out.display.value("state", "") != "ready") return false;
+        for (const nlohmann::json& o : (*s)["outputs"]["shown"]) {
+          if (o["source"] == "content" && o.value("path", "") == "lookup-warp" &&
+              o.contains("display")) {
+            out.shown[o["name"].get<std::string>()] = o;
+          }
+        }
+        return out.shown.size() == outputs;
+      },
+      kSlowdown * 60s);
+  return out;
+}
+
+// White content drawn by output `t` through its lookup warp and blend, as the daemon
+// draws it (BGR, 8 bits), after checking it against the daemon's statistics of that
+// output (`shown`: its status `outputs.shown[]` entry): lit fraction and mean.
+inline cv::Mat whiteThroughLookup(const render::WarpGrid& lookup, const blend::BlendTables& blend,
+                                  std::size_t t, cv::Size output, cv::Size content,
+                                  const nlohmann::json& shown, const std::string& name) {
+  const cv::Mat white(content, CV_8UC4, cv::Scalar::all(255));
+  render::RenderSetup setup;
+  setup.output_size = output;
+  setup.content_size = content;
+  setup.path = render::RenderPath::kLookupWarp;
+  setup.lookup = lookup;
+  setup.final_stage.alpha = blend.alpha[t];
+  setup.final_stage.weight_lut = blend.weight_lut[t];
+  render::CpuRenderer cpu;
+  EXPECT_TRUE(cpu.configure(setup)) << name;
+  EXPECT_TRUE(cpu.render({&white, nullptr, 1})) << name;
+  cv::Mat bgr, grey;
+  cv::cvtColor(cpu.frame(), bgr, cv::COLOR_RGBA2BGR);
+  cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+  const double lit = cv::countNonZero(grey) / double(grey.total());
+  const double mean = cv::mean(bgr)[0];
+  std::printf("[ figures  ] %s: lit %.5f (daemon %.5f), mean %.3f (daemon %.3f)\n", name.c_str(),
+              lit, shown["lit_fraction"].get<double>(), mean, shown["mean_rgb"][0].get<double>());
+  EXPECT_NEAR(lit, shown["lit_fraction"].get<double>(), 1e-4) << name;
+  EXPECT_NEAR(mean, shown["mean_rgb"][0].get<double>(), 0.01) << name;
+  return bgr;
 }
 
 // White seen by the viewer (a linear-light CV_32FC3 image): over the pixels `inside`

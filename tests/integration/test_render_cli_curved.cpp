@@ -22,6 +22,7 @@
 #include "cylinder_mesh.hpp"
 #include "daemon_harness.hpp"
 #include "mpcdi_readback.hpp"
+#include "render/dome_master.hpp"
 #include "render_command.hpp"
 #include "rig/rig_model.hpp"
 #include "sim/renderer.hpp"
@@ -65,6 +66,30 @@ Mat34 rowMajor34(const json& j) {
   return m;
 }
 
+// Every 7th pixel of every projector's 16-bit frame in `frames`, with the TRUE wall
+// point the TRUE projector lights there: expected(point) gives the content pixel it
+// should show (nullopt: none), added to `error`.
+template <typename Expected>
+void rampAgainstTheTrueWall(const Rig& rig, const TempDir& dir, Expected expected,
+                            RampError& error) {
+  for (const auto& p : rig.state.projectors) {
+    const cv::Mat frame =
+        cv::imread(dir.file("frames/" + p.spec.name + ".png"), cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(frame.type(), CV_16UC3) << p.spec.name;
+    const Mat34 P = p.model.projectionMatrix();
+    const Mat3 Minv = P.leftCols<3>().inverse();
+    const Vec3 C = -Minv * P.col(3);
+    for (int y = 2; y < frame.rows; y += 7) {
+      for (int x = 2; x < frame.cols; x += 7) {
+        const auto hit = rig.scene.world().intersect({C, (Minv * Vec3(x, y, 1)).normalized()});
+        if (!hit) continue;
+        const cv::Vec3w code = frame.at<cv::Vec3w>(y, x);
+        if (const auto c = expected(hit->hit.point, code)) error.add(code, *c);
+      }
+    }
+  }
+}
+
 TEST(RenderCliCurved, FramebuffersShowTheViewerEveryContentPixelWhereTheTrueRigPutsIt) {
   TempDir dir;
   const Rig rig = trueCylinder(dir);
@@ -82,24 +107,15 @@ TEST(RenderCliCurved, FramebuffersShowTheViewerEveryContentPixelWhereTheTrueRigP
   const Mat34 V = rowMajor34((*doc)["display"]["viewer_matrix"]);
   RampError error{kW, kH};
   for (const json& share : (*doc)["projectors"]) EXPECT_EQ(share["path"], "lookup-warp");
-  for (const auto& p : rig.state.projectors) {
-    const cv::Mat frame =
-        cv::imread(dir.file("frames/" + p.spec.name + ".png"), cv::IMREAD_UNCHANGED);
-    ASSERT_EQ(frame.type(), CV_16UC3) << p.spec.name;
-    const Mat34 P = p.model.projectionMatrix();
-    const Mat3 Minv = P.leftCols<3>().inverse();
-    const Vec3 C = -Minv * P.col(3);
-    for (int y = 2; y < frame.rows; y += 7) {
-      for (int x = 2; x < frame.cols; x += 7) {
-        const auto hit = rig.scene.world().intersect({C, (Minv * Vec3(x, y, 1)).normalized()});
-        if (!hit) continue;
-        const Vec2 c = (V * hit->hit.point.homogeneous()).hnormalized();
+  rampAgainstTheTrueWall(
+      rig, dir,
+      [&](const Vec3& X, const cv::Vec3w&) -> std::optional<Vec2> {
+        const Vec2 c = (V * X.homogeneous()).hnormalized();
         // Inside the content, one pixel in from its edge (the edge half pixel is clamped).
-        if (c.x() < 1 || c.y() < 1 || c.x() > kW - 2 || c.y() > kH - 2) continue;
-        error.add(frame.at<cv::Vec3w>(y, x), c);
-      }
-    }
-  }
+        if (c.x() < 1 || c.y() < 1 || c.x() > kW - 2 || c.y() > kH - 2) return std::nullopt;
+        return c;
+      },
+      error);
   ASSERT_GT(error.n, 10000);
   std::printf(
       "[ figures  ] procam-render, curved: %ld framebuffer pixels, content position error RMS "
@@ -109,6 +125,57 @@ TEST(RenderCliCurved, FramebuffersShowTheViewerEveryContentPixelWhereTheTrueRigP
   // this wall) and 16-bit codes (1/14 content px across 4800).
   EXPECT_LT(error.rms(), 0.05);
   EXPECT_LT(error.worst, 0.1);
+}
+
+// The same rig drawn as a dome master around the viewer (--dome): 240 degrees across
+// its circle, the front +Y at its bottom, so that the wall around the eye's horizon is
+// inside it. Every framebuffer pixel shows the content pixel of the direction from the
+// eye to the TRUE wall point the TRUE projector lights (render/dome_master.hpp).
+TEST(RenderCliCurved, ADomeMasterShowsEachDirectionWhereItsFisheyePutsIt) {
+  TempDir dir;
+  const Rig rig = trueCylinder(dir);
+  constexpr int kSide = 2048;
+  ASSERT_TRUE(cv::imwrite(dir.file("ramp.png"), contentRamp(kSide, kSide)));
+  auto args =
+      render_cli::parseRenderArgs({"--rig", rig.file, "--content", dir.file("ramp.png"), "--out",
+                                   dir.file("frames"), "--viewer", rig.eye, "--dome", "0,1,0",
+                                   "--dome-fov", "240", "--bit-depth", "16", "--geometry-only"});
+  ASSERT_TRUE(args) << args.error().message;
+  auto doc = render_cli::runRender(*args);
+  ASSERT_TRUE(doc) << doc.error().message;
+  ASSERT_EQ((*doc)["projectors"].size(), 3u) << doc->dump();
+  EXPECT_EQ((*doc)["display"]["projection"], "dome");
+  EXPECT_EQ((*doc)["display"]["dome"]["fov_deg"], 240.0);
+  EXPECT_FALSE((*doc)["display"].contains("viewer_matrix"));
+  const double coverage = (*doc)["display"]["dome"]["coverage"].get<double>();
+  EXPECT_GT(coverage, 0.0);
+  EXPECT_LT(coverage, 1.0);
+  auto master =
+      render::domeMaster(rig.state.viewer.pose.center(), Vec3(0, 1, 0), 240, {kSide, kSide});
+  ASSERT_TRUE(master);
+  RampError error{kSide, kSide};
+  rampAgainstTheTrueWall(
+      rig, dir,
+      [&](const Vec3& X, const cv::Vec3w& code) -> std::optional<Vec2> {
+        if (code[2] == 0) return std::nullopt;  // outside the drawn circle: black
+        return master->contentPixel(X);
+      },
+      error);
+  ASSERT_GT(error.n, 10000);
+  std::printf(
+      "[ figures  ] procam-render, dome master: %ld framebuffer pixels, content position "
+      "error RMS %.4f px, max %.4f px; %.1f %% of the circle drawn\n",
+      error.n, error.rms(), error.worst, 100 * coverage);
+  // As the perspective display's: the lookup's interpolation between nodes 8 px apart
+  // and 16-bit codes (1/32 content px across 2048).
+  EXPECT_LT(error.rms(), 0.05);
+  EXPECT_LT(error.worst, 0.1);
+
+  // A vertical front is refused.
+  auto bad = render_cli::parseRenderArgs({"--rig", rig.file, "--content", dir.file("ramp.png"),
+                                          "--out", dir.file("frames"), "--dome", "0,0,1"});
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("--dome"), std::string::npos) << bad.error().message;
 }
 
 TEST(RenderCliCurved, BlendedFramesLightTheCurvedWallEvenlyForTheViewer) {

@@ -25,7 +25,6 @@
 #include "curved_display_checks.hpp"
 #include "cylinder_scene.hpp"
 #include "daemon_harness.hpp"
-#include "render/cpu_renderer.hpp"
 #include "render/viewer_view.hpp"
 #include "rig/rig_model.hpp"
 #include "sim/renderer.hpp"
@@ -89,17 +88,7 @@ TEST(SimCurvedWall, ThreeProjectorsCalibratedIntoOneDisplayForTheSweetSpot) {
   ASSERT_EQ((*done)["outputs"].size(), 3u) << done->dump();
   for (const json& o : (*done)["outputs"]) {
     const std::string name = o["output"].get<std::string>();
-    const json& p = o["projector"];
-    const Vec3 centre(o["position"][0].get<double>(), o["position"][1].get<double>(),
-                      o["position"][2].get<double>());
-    const double centre_mm = 1000 * (centre - truth[name].pose.center()).norm();
-    std::printf(
-        "[ figures  ] %s: route a, %d nodes triangulated, reprojection %.4f px, centre %.2f mm "
-        "off, response gamma %.3f (true %.1f)\n",
-        name.c_str(), o["triangulated"].get<int>(), p["reprojection_rms_px"].get<double>(),
-        centre_mm, o["response"]["response_gamma"].get<double>(), spec[name].gamma);
-    EXPECT_EQ(o["surface_type"], "mesh") << name;
-    EXPECT_NEAR(o["response"]["response_gamma"].get<double>(), spec[name].gamma, 0.05) << name;
+    checkRouteAOutput(o, truth[name], spec[name].gamma);
   }
   // The three meshes unified where they overlap ([Raskar02] eq. 4.4): before, two
   // triangulations of the same wall differ by their noise; after, by far less.
@@ -127,27 +116,10 @@ TEST(SimCurvedWall, ThreeProjectorsCalibratedIntoOneDisplayForTheSweetSpot) {
   // A white panorama on the one display.
   const std::string png = contentFile(dir, "panorama.png");
   ASSERT_TRUE(cv::imwrite(png, cv::Mat(kH, kW, CV_8UC3, cv::Scalar(255, 255, 255))));
-  auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", png}}, kSlowdown * 30s);
-  ASSERT_TRUE(load);
-  ASSERT_EQ((*load)["class"], "CONTENT") << load->dump();
-  json display;
-  std::map<std::string, json> shown;
-  const bool ready = eventually(
-      [&] {
-        auto s = c.call({{"cmd", "status"}});
-        if (!s) return false;
-        display = (*s)["outputs"].value("display", json());
-        shown.clear();
-        for (const json& o : (*s)["outputs"]["shown"]) {
-          if (o["source"] == "content" && o.value("path", "") == "lookup-warp" &&
-              o.contains("display") && display.is_object() && display["state"] == "ready") {
-            shown[o["name"].get<std::string>()] = o;
-          }
-        }
-        return shown.size() == 3;
-      },
-      kSlowdown * 60s);
-  ASSERT_TRUE(ready) << display.dump() << "\n" << d.log();
+  LookupDisplay drawn = loadOntoLookupDisplay(c, png, 3);
+  ASSERT_TRUE(drawn.ready) << drawn.display.dump() << "\n" << d.log();
+  const json& display = drawn.display;
+  std::map<std::string, json>& shown = drawn.shown;
   EXPECT_EQ(display["outputs"], json({"proj_l", "proj_c", "proj_r"})) << display.dump();
   EXPECT_EQ(display["viewer"]["source"], "config");
   EXPECT_EQ(display["blend"]["response"], "measured");
@@ -214,30 +186,10 @@ TEST(SimCurvedWall, ThreeProjectorsCalibratedIntoOneDisplayForTheSweetSpot) {
   // (its statistics agree), lit by the TRUE projectors and seen by the viewer in linear
   // light: no step above 2 % between neighbouring viewer pixels over the display (inset by
   // 3 %).
-  const cv::Mat white(kH, kW, CV_8UC4, cv::Scalar::all(255));
   sim::Framebuffers frames;
   for (std::size_t t = 0; t < 3; ++t) {
-    render::RenderSetup setup;
-    setup.output_size = cv::Size(1280, 800);
-    setup.content_size = cv::Size(kW, kH);
-    setup.path = render::RenderPath::kLookupWarp;
-    setup.lookup = lookup[t];
-    setup.final_stage.alpha = blend->alpha[t];
-    setup.final_stage.weight_lut = blend->weight_lut[t];
-    render::CpuRenderer cpu;
-    ASSERT_TRUE(cpu.configure(setup));
-    ASSERT_TRUE(cpu.render({&white, nullptr, 1}));
-    cv::Mat bgr, grey;
-    cv::cvtColor(cpu.frame(), bgr, cv::COLOR_RGBA2BGR);
-    cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
-    const double lit = cv::countNonZero(grey) / double(grey.total());
-    const double mean = cv::mean(bgr)[0];
-    std::printf("[ figures  ] %s: lit %.5f (daemon %.5f), mean %.3f (daemon %.3f)\n", kOutputs[t],
-                lit, shown[kOutputs[t]]["lit_fraction"].get<double>(), mean,
-                shown[kOutputs[t]]["mean_rgb"][0].get<double>());
-    EXPECT_NEAR(lit, shown[kOutputs[t]]["lit_fraction"].get<double>(), 1e-4) << kOutputs[t];
-    EXPECT_NEAR(mean, shown[kOutputs[t]]["mean_rgb"][0].get<double>(), 0.01) << kOutputs[t];
-    frames[kOutputs[t]] = bgr;
+    frames[kOutputs[t]] = whiteThroughLookup(lookup[t], *blend, t, {1280, 800}, {kW, kH},
+                                             shown[kOutputs[t]], kOutputs[t]);
   }
   auto lit = sim::Renderer::create(*scene, state, frames);
   ASSERT_TRUE(lit) << lit.error().message;

@@ -185,6 +185,30 @@ TEST(Config, ContentViewerIsThreeNumbers) {
                        "rig.toml:2: content.eye: unknown key"));
 }
 
+TEST(Config, ContentProjectionIsPerspectiveOrADomeMaster) {
+  auto cfg = parseConfig("", "rig.toml");
+  ASSERT_TRUE(cfg);
+  EXPECT_FALSE(cfg->content_dome);
+  EXPECT_EQ(cfg->content_dome_front, (std::array<double, 3>{0, 1, 0}));
+  EXPECT_EQ(cfg->content_dome_fov_deg, 180.0);
+  cfg = parseConfig(
+      "[content]\nprojection = \"dome\"\ndome_front = [1, 0, 0.5]\ndome_fov_deg = 220\n",
+      "rig.toml");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_TRUE(cfg->content_dome);
+  EXPECT_EQ(cfg->content_dome_front, (std::array<double, 3>{1, 0, 0.5}));
+  EXPECT_EQ(cfg->content_dome_fov_deg, 220.0);
+  auto e = parseError(
+      "[content]\nprojection = \"fisheye\"\ndome_front = [0, 0, 1]\ndome_fov_deg = 400\n");
+  EXPECT_TRUE(contains(
+      e.message, "rig.toml:2: content.projection: 'fisheye' is not one of: perspective, dome"))
+      << e.message;
+  EXPECT_TRUE(
+      contains(e.message, "rig.toml:3: content.dome_front: must point away from the vertical"))
+      << e.message;
+  EXPECT_TRUE(contains(e.message, "rig.toml:4: content.dome_fov_deg")) << e.message;
+}
+
 TEST(Config, AllProblemsAreReportedAtOnce) {
   auto e = parseError("[daemon]\nfoo = 1\nmax_clients = -1\n[policy]\nbar = 2\n");
   EXPECT_TRUE(contains(e.message, "rig.toml:2: daemon.foo")) << e.message;

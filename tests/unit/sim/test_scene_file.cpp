@@ -240,6 +240,7 @@ TEST(SimSceneFile, ShippedScenesMatchTheIssue) {
   auto dome = resolveScene("dome3");
   ASSERT_TRUE(dome);
   EXPECT_EQ(dome->projectors().size(), 3u);
+  EXPECT_EQ(dome->cameras().size(), 2u);  // route (a) triangulates the dome
 
   // The curved panoramic wall: three projectors, two cameras, a cylinder.
   auto cylinder = resolveScene("cylinder3");
