@@ -192,37 +192,30 @@ json Daemon::curvedDisplayJson() const {
   const json blend = {{"weights", "feathered"},
                       {"response", k.curved->measured ? "measured" : "assumed gamma 2.2"},
                       {"photometric", blend::matchingJson(*k.curved)}};
+  json out = {{"state", "ready"},
+              {"projection", d.dome ? "dome" : "perspective"},
+              {"surface", "mesh"},
+              {"outputs", k.curved->outputs},
+              {"content_size", {k.curved->content.width, k.curved->content.height}},
+              {"viewer", eye},
+              {"tiles", tiles},
+              {"blend", blend}};
   if (d.dome) {
     const Vec3 front = d.dome->frame.row(1).transpose();
-    return {{"state", "ready"},
-            {"projection", "dome"},
-            {"surface", "mesh"},
-            {"outputs", k.curved->outputs},
-            {"content_size", {k.curved->content.width, k.curved->content.height}},
-            {"viewer", eye},
-            {"dome",
-             {{"front", {front.x(), front.y(), front.z()}},
-              {"fov_deg", 2 * d.dome->half_fov * 180 / M_PI},
-              // The part of the master's circle the projectors draw.
-              {"coverage", d.coverage}}},
-            {"tiles", tiles},
-            {"blend", blend}};
+    out["dome"] = {{"front", {front.x(), front.y(), front.z()}},
+                   {"fov_deg", 2 * d.dome->half_fov * 180 / M_PI},
+                   // The part of the master's circle the projectors draw.
+                   {"coverage", d.coverage}};
+    return out;
   }
-  return {{"state", "ready"},
-          {"projection", "perspective"},
-          {"surface", "mesh"},
-          {"outputs", k.curved->outputs},
-          {"content_size", {k.curved->content.width, k.curved->content.height}},
-          {"viewer", eye},
-          {"viewer_matrix", rowMajor(d.viewer)},
-          // The content on the eye's image plane z = 1 (x right, y up): its field of view.
-          {"rect_tan",
-           {{"centre", {d.rect.centre.x(), d.rect.centre.y()}},
-            {"size", {2 * d.rect.half_width, 2 * d.rect.half_height}}}},
-          {"union_area_tan2", d.union_area},
-          {"cell_tan", d.cell},
-          {"tiles", tiles},
-          {"blend", blend}};
+  out.update(json{{"viewer_matrix", rowMajor(d.viewer)},
+                  // The content on the eye's image plane z = 1 (x right, y up): its field of view.
+                  {"rect_tan",
+                   {{"centre", {d.rect.centre.x(), d.rect.centre.y()}},
+                    {"size", {2 * d.rect.half_width, 2 * d.rect.half_height}}}},
+                  {"union_area_tan2", d.union_area},
+                  {"cell_tan", d.cell}});
+  return out;
 }
 
 }  // namespace procam::daemon

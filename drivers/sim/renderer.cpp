@@ -248,6 +248,7 @@ Result<LightPaths> Renderer::cameraLightPaths(std::string_view camera, int threa
       }
       row.end.push_back(static_cast<std::uint32_t>(row.paths.size()));
     }
+    row.paths.shrink_to_fit();  // kMaxPaths bounds the memory kept, not only the count
     traced += row.paths.size();
   });
   if (traced.load() > LightPaths::kMaxPaths) {
