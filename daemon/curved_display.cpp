@@ -203,7 +203,8 @@ json Daemon::curvedDisplayJson() const {
   if (d.dome) {
     const Vec3 front = d.dome->frame.row(1).transpose();
     out["dome"] = {{"front", {front.x(), front.y(), front.z()}},
-                   {"fov_deg", 2 * d.dome->half_fov * 180 / M_PI},
+                   // Degrees as configured, not their round trip through radians.
+                   {"fov_deg", std::round(2 * d.dome->half_fov * 180 / M_PI * 1e9) / 1e9},
                    // The part of the master's circle the projectors draw.
                    {"coverage", d.coverage}};
     return out;

@@ -38,7 +38,9 @@ render::SceneTraits Daemon::sceneTraits(const std::string& output, bool mesh_con
                                             : render::SurfaceKind::kPlanar;
   if (rig_.surface.object) t.surface = render::SurfaceKind::kObject;
   // Tracked: a tracker reports the viewer (the eye viewerEye() gives) or the rig names one.
-  if (!viewerJson().is_null() || !rig_.viewer.tracker.empty()) {
+  // A dome master is made for the static eye: a tracker does not move it.
+  const bool dome = config_.content_dome && !mesh_content;
+  if (!dome && (!viewerJson().is_null() || !rig_.viewer.tracker.empty())) {
     t.viewer = render::ViewerKind::kTracked;
   } else if (staticEye()) {
     t.viewer = render::ViewerKind::kStatic;
@@ -124,7 +126,8 @@ std::optional<OutputDraw> Daemon::planOutput(DeviceEntry& e, const OutputDrawPol
                              mesh_image ? &mesh_image->viewer : nullptr, &share);
     if (np) {
       plan->setup = **np;
-      st.viewer = (*np)->viewer;
+      // A dome master has no world -> content matrix: its content is directions.
+      if (!(*np)->viewer.isZero()) st.viewer = (*np)->viewer;
       tile = share;
     } else {
       np_note = "non-planar surface, drawn by homography: " + np.error().message;

@@ -101,6 +101,7 @@ std::string utcNow() {
 Result<RenderArgs> parseRenderArgs(const std::vector<std::string>& args) {
   RenderArgs a;
   bool object_only = false;  // an option only --object takes was given
+  bool dome_fov_given = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& opt = args[i];
     const bool takes_value = opt == "--rig" || opt == "--content" || opt == "--out" ||
@@ -149,6 +150,7 @@ Result<RenderArgs> parseRenderArgs(const std::vector<std::string>& args) {
       auto v = number(1, 360);
       if (!v) return tl::unexpected(v.error());
       a.dome_fov_deg = *v;
+      dome_fov_given = true;
     } else if (opt == "--bit-depth") {
       const std::string& v = args[++i];
       if (v != "8" && v != "16") return fail(ErrorCode::kInvalidInput, "--bit-depth is 8 or 16");
@@ -205,6 +207,8 @@ Result<RenderArgs> parseRenderArgs(const std::vector<std::string>& args) {
                 "are for --object");
   if (a.rig.empty() || a.content.empty() || (a.out.empty() && a.mpcdi.empty()))
     return fail(ErrorCode::kInvalidInput, "--rig, --content and --out or --mpcdi are required");
+  if (dome_fov_given && !a.dome)
+    return fail(ErrorCode::kInvalidInput, "--dome-fov is the field of a dome master: give --dome");
   return a;
 }
 

@@ -14,8 +14,9 @@ std::optional<Vec2> DomeMaster::contentPixel(const Vec3& X) const {
   const double theta = std::atan2(horizontal, d.z());  // from the zenith
   if (theta > half_fov) return std::nullopt;
   const double r = radius() * theta / half_fov;
-  // Straight up: the centre, whatever the azimuth.
-  if (horizontal < 1e-15 * n) return centre();
+  // Straight up: the centre, whatever the azimuth. Straight down (a 360-degree master):
+  // the whole rim is the nadir; the front's point of it stands for it.
+  if (horizontal < 1e-15 * n) return d.z() > 0 ? centre() : Vec2(centre() + Vec2(0, r));
   return centre() + r * Vec2(d.x(), d.y()) / horizontal;
 }
 

@@ -176,6 +176,11 @@ TEST(RenderCliCurved, ADomeMasterShowsEachDirectionWhereItsFisheyePutsIt) {
                                           "--out", dir.file("frames"), "--dome", "0,0,1"});
   ASSERT_FALSE(bad);
   EXPECT_NE(bad.error().message.find("--dome"), std::string::npos) << bad.error().message;
+  // So is a field without a dome master to give it to.
+  auto lone = render_cli::parseRenderArgs({"--rig", rig.file, "--content", dir.file("ramp.png"),
+                                           "--out", dir.file("frames"), "--dome-fov", "200"});
+  ASSERT_FALSE(lone);
+  EXPECT_NE(lone.error().message.find("give --dome"), std::string::npos) << lone.error().message;
 }
 
 TEST(RenderCliCurved, BlendedFramesLightTheCurvedWallEvenlyForTheViewer) {

@@ -316,8 +316,9 @@ TEST(SimCalibrate, CancelMidRunKeepsThePreviousRigJson) {
 }
 
 // A camera unplugged mid-run (the mock drivers' PROCAM_SIM_UNPLUG window opens 4 s
-// after the daemon started, a few frames into the run) cancels the operation with
-// an error naming it; the device manager then lists it lost.
+// after the daemon started; half a second of settle per frame makes the 34-frame run
+// last at least 17 s however fast the virtual camera lights it) cancels the operation
+// with an error naming it; the device manager then lists it lost.
 TEST(SimCalibrate, CameraGoneMidRunCancelsNamingIt) {
   TempDir dir;
   const std::string scene = sceneFile(dir);
@@ -325,7 +326,9 @@ TEST(SimCalibrate, CameraGoneMidRunCancelsNamingIt) {
   DaemonProcess d(dir, {{"--sim", scene}, {"PROCAM_SIM_UNPLUG=cam_right@4-1000"}, -1, true});
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
-  auto started = c.call(calibrateRequest(1));
+  json request = calibrateRequest(1);
+  request["settle_frames"] = 30;  // 0.5 s at the mock output's 60 Hz
+  auto started = c.call(request);
   ASSERT_TRUE(started);
   ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
   CalibrateRun run;

@@ -120,6 +120,12 @@ TEST(SimDome, ThreeProjectorsCalibratedIntoOneDomeMaster) {
   EXPECT_EQ(display["outputs"], json(kOutputs)) << display.dump();
   EXPECT_EQ(display["dome"]["fov_deg"], 180.0);
   EXPECT_EQ(display["blend"]["response"], "measured");
+  // The master is made for the static eye, whatever ir_head reports; its content is
+  // directions, so no world -> content matrix is reported.
+  for (const auto& [name, o] : shown) {
+    EXPECT_EQ(o.value("chosen_path", ""), "lookup-warp") << o.dump();
+    EXPECT_FALSE(o.contains("viewer_matrix")) << o.dump();
+  }
 
   // The same display from the rig model the daemon wrote: what every output draws.
   Calibrated cal;

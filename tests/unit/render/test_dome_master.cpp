@@ -49,6 +49,13 @@ TEST(DomeMaster, AWiderFieldAndANonSquareImage) {
   EXPECT_NEAR(c->x(), 1023.5, 1e-9);
   EXPECT_NEAR(c->y(), 511.5 + 512 * 100.0 / 110.0, 1e-9);
   EXPECT_FALSE(m->contentPixel(Vec3(1, 0, -std::tan(25 * M_PI / 180))));
+  // A full sphere: the nadir is on the rim (at the front's point of it), not the centre.
+  auto sphere = domeMaster(Vec3::Zero(), Vec3(1, 0, 0), 360, {1024, 1024});
+  ASSERT_TRUE(sphere);
+  const auto nadir = sphere->contentPixel(Vec3(0, 0, -2));
+  ASSERT_TRUE(nadir);
+  EXPECT_LT((*nadir - Vec2(511.5, 1023.5)).norm(), 1e-9);
+  EXPECT_LT((*sphere->contentPixel(Vec3(0, 0, 2)) - Vec2(511.5, 511.5)).norm(), 1e-9);
 }
 
 TEST(DomeMaster, BadArgumentsAreRefused) {
