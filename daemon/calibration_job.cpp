@@ -365,6 +365,20 @@ tl::expected<std::vector<CalibrationOutcome>, CalibrationFailure> runBatchCalibr
       }
       views.push_back({member.cameras[c].device.name, member.cameras[c].model, std::move(d)});
     }
+    if (member.known_projector) {
+      auto nodes = views.size() > 1
+                       ? calib::triangulateNodes(member.set, views[0], views[1], member.grid)
+                       : calib::triangulateWithProjector(member.set, *member.known_projector,
+                                                         views[0], member.grid);
+      auto fit = nodes ? calib::triangulatedPlane(*nodes)
+                       : Result<geom::PlaneFit>(tl::unexpected(nodes.error()));
+      if (!fit) {
+        return tl::unexpected(
+            CalibrationFailure{code::kFailed, "the wall's plane: " + fit.error().message});
+      }
+      out.triangulated_plane = std::move(*fit);
+      continue;
+    }
     if (wall_views) {
       for (const calib::DecodedView& view : views) {
         auto seen = calib::wallSighting(member.set, view, {.step = member.grid});

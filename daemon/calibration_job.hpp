@@ -113,6 +113,12 @@ struct CalibrationPlan {
   // triangulated. One object for all plans of a run; only the run's worker touches it.
   std::shared_ptr<std::optional<geom::Plane>> scene_plane;
 
+  // Set: the projector stands where this model (pose, intrinsics, distortion) has it and
+  // the run measures only the plane its light falls on, a moved wall: triangulated by the
+  // two cameras, or by the projector and the one camera ([Raskar02] §4.1.1); the outcome's
+  // triangulated_plane, nothing solved for the projector.
+  std::optional<geom::CameraModel> known_projector;
+
   bool planar() const { return plane || board; }
   // Route (b′) with cameras at several positions: the first camera is the calibrated
   // reference, the others need only their intrinsics; the run's projectors are solved

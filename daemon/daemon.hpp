@@ -307,9 +307,15 @@ class Daemon {
   std::optional<drift::WallSeen> movedWallOneCamera(const std::string& output,
                                                     const std::string& camera);
   // `seen_by`: what triangulated the wall ("two cameras", ...), for the log and event.
+  // Under "on-drift" the wall is measured by the coarse Gray pass instead (scanForDrift
+  // with `surface`); under "on-drift-silent" from the content `wall` gives.
   void correctSurface(const std::string& output, const std::string& camera,
                       const drift::Misregistration& m, const drift::WallSeen& wall,
                       const std::string& seen_by);
+  // The rig model's update for the wall `plane` (scatter `rms_m`): every projector keeps its
+  // pose, and one known by its collineation with the old plane gets it from its pose and
+  // the new plane; kNotFound naming a projector known only by that collineation.
+  Result<rig::RigModel> wallUpdate(const geom::Plane& plane, double rms_m) const;
   // Merges a correction into rig.json; `event` (a drift event's body) goes out with
   // `state` when written, "failed" otherwise; `after` first hears how the write went.
   void writeDriftCorrection(const std::string& output, rig::RigModel update, nlohmann::json event,
@@ -327,9 +333,16 @@ class Daemon {
   void escalateDrift(const std::string& output, const std::string& camera, const std::string& step,
                      const std::string& why, const drift::Misregistration& m);
   // The output's projector scanned as calibrate scans it (a calibrate operation without a
-  // client), the result merged into rig.json as a correction.
+  // client), the result merged into rig.json as a correction. `surface`: the projector
+  // stands, the wall moved: the scan measures only the wall's plane (wallUpdate).
   void scanForDrift(const std::string& output, const std::string& camera, DriftScan which,
-                    const std::string& why, const drift::Misregistration& m);
+                    const std::string& why, const drift::Misregistration& m, bool surface = false);
+  // A surface scan's result `r`: the wall's plane written (wallUpdate) as a correction,
+  // then `finish` told how that went.
+  void scannedWall(const std::string& output, const std::string& camera, DriftScan which,
+                   const drift::Misregistration& m, const CalibrationPlan& plan,
+                   const CalibrationOutcome& r, DriftRuntime::Clock::time_point started_at,
+                   const std::function<void(const CalibrationFailure*)>& finish);
   // The cameras that check `projector` (mapped onto the plane by `tile`).
   std::vector<const rig::RigCamera*> driftCameras(const rig::RigProjector& projector,
                                                   const geom::PlaneHomography& tile) const;

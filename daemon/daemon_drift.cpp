@@ -6,9 +6,9 @@
 // registered has moved and gets its pose again (drift/camera_correction.hpp); drift that
 // two cameras see and triangulate off the rig's wall, or that one camera sees along its
 // epipolar lines with the projector (the rays of both meet off the wall, and the content
-// fits no turned projector), is the wall's, whose plane is measured again
-// (drift/wall_from_views.hpp); other drift that every camera sees is the projector's,
-// whose pose and plane collineation are fitted again
+// fits no turned projector), is the wall's, whose plane a coarse Gray pass measures again
+// (under on-drift-silent the content does, drift/wall_from_views.hpp); other drift that every
+// camera sees is the projector's, whose pose and plane collineation are fitted again
 // (drift/projector_correction.hpp); the steps themselves are in drift_corrections.cpp.
 // Where those fail their check, the projector is scanned: a coarse Gray pass, then the
 // full scan (drift_scan.cpp). Loop thread only; the checks run on the compute worker

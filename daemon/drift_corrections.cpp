@@ -1,9 +1,12 @@
 // recalibrate = "on-drift": the correction steps a drift check decides on
 // (daemon_drift.cpp): a camera re-registered (drift/camera_correction.hpp), the wall
-// measured again from two cameras or one camera and the projector
+// measured again by a coarse Gray pass (drift_scan.cpp) or, under on-drift-silent, from
+// the content two cameras or one camera and the projector triangulate
 // (drift/wall_from_views.hpp), the projector's pose and collineation fitted again
 // (drift/projector_correction.hpp); each merged into rig.json atomically, a failed step
 // escalating to a scan (drift_scan.cpp) or keeping the last good rig. Loop thread only.
+#include <cstdio>
+
 #include "blend/rig_tiles.hpp"
 #include "daemon.hpp"
 #include "drift/camera_correction.hpp"
@@ -128,29 +131,49 @@ std::optional<drift::WallSeen> Daemon::movedWallOneCamera(const std::string& out
   return *seen;
 }
 
+Result<rig::RigModel> Daemon::wallUpdate(const geom::Plane& plane, double rms_m) const {
+  // Every projector on the wall keeps its pose; those that kept a collineation with the
+  // old plane get theirs from the pose and the new plane.
+  rig::RigModel update;
+  update.surface.plane = plane;
+  update.surface.plane_rms_m = rms_m;
+  for (const rig::RigProjector& p : rig_.projectors) {
+    if (!p.plane_homography) continue;
+    if (!p.pose_known || !p.intrinsics_known || !p.scale_known) {
+      return fail(ErrorCode::kNotFound,
+                  "projector '" + p.name +
+                      "' is known only by its collineation with the old wall, which the moved "
+                      "wall does not carry");
+    }
+    update.projectors.push_back(p);
+    update.projectors.back().plane_homography.reset();
+  }
+  return update;
+}
+
 void Daemon::correctSurface(const std::string& output, const std::string& camera,
                             const drift::Misregistration& m, const drift::WallSeen& wall,
                             const std::string& seen_by) {
   DriftRuntime::Output& o = drift_rt_.outputs[output];
   const double held = heldFor(o);
-  const auto giveUp = [&](const std::string& why) {
-    unresolveDrift(output, camera, "surface", why + "; the rig model stays as it was", m);
-  };
-  // Every projector on the wall keeps its pose; those that kept a collineation with the
-  // old plane get theirs from the pose and the new plane.
-  rig::RigModel update;
-  update.surface.plane = drift::wallToKeep(wall);
-  update.surface.plane_rms_m = wall.rms_m;
-  for (const rig::RigProjector& p : rig_.projectors) {
-    if (!p.plane_homography) continue;
-    if (!p.pose_known || !p.intrinsics_known || !p.scale_known) {
-      return giveUp("projector '" + p.name +
-                    "' is known only by its collineation with the old wall, which the moved "
-                    "wall does not carry");
-    }
-    update.projectors.push_back(p);
-    update.projectors.back().plane_homography.reset();
+  if (config_.recalibrate == RecalibratePolicy::kOnDrift) {
+    // Pattern frames allowed: the coarse Gray pass measures the wall from thousands of
+    // nodes where the content gave tens of points, and checks the diagnosis (a projector
+    // that moved along the epipolar lines triangulates as a tilted wall).
+    char seen[160];
+    std::snprintf(seen, sizeof seen,
+                  "the content moved as a moved wall moves it: %.2f mm (standard error %.3f) "
+                  "off the rig's wall, turned %.3f deg, ",
+                  1e3 * wall.offset_m, 1e3 * wall.offset_se_m, wall.tilt_deg);
+    return scanForDrift(output, camera, DriftScan::kCoarse,
+                        seen + std::string("seen by ") + seen_by, m, true);
   }
+  auto made = wallUpdate(drift::wallToKeep(wall), wall.rms_m);
+  if (!made) {
+    return unresolveDrift(output, camera, "surface",
+                          made.error().message + "; the rig model stays as it was", m);
+  }
+  rig::RigModel update = std::move(*made);
   // The wall is measured, not fitted by passes: what was kept to restore after
   // corrections that do not converge belonged to the old wall and cannot come back.
   o.before.reset();

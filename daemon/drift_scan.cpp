@@ -4,9 +4,12 @@
 // (drift_ladder.hpp nextDriftScan). The scan runs as a calibrate operation of its own:
 // the outputs' frames wait, a user's calibrate is busy meanwhile and `cancel` stops it.
 // Loop thread only; the scan itself on the compute worker.
+#include <cmath>
+
 #include "calibration_plan.hpp"
 #include "daemon.hpp"
 #include "device_manager.hpp"
+#include "geometry/intersect.hpp"
 #include "log.hpp"
 #include "output_draw.hpp"
 #include "protocol.hpp"
@@ -40,13 +43,17 @@ void Daemon::escalateDrift(const std::string& output, const std::string& camera,
 }
 
 void Daemon::scanForDrift(const std::string& output, const std::string& camera, DriftScan which,
-                          const std::string& why, const drift::Misregistration& m) {
+                          const std::string& why, const drift::Misregistration& m, bool surface) {
   DriftRuntime& d = drift_rt_;
   DriftRuntime::Output& o = d.outputs[output];
   const char* step = driftScanName(which);
   const auto giveUp = [&](const std::string& reason) {
     abandonDrift(output, camera, step, reason, m);
   };
+  const rig::RigProjector* projector = rig_.projectorForOutput(output);
+  if (surface && (!projector || !projector->pose_known || !projector->intrinsics_known)) {
+    return giveUp("the wall is measured from the projector's pose, which the rig model lacks");
+  }
   auto args = parseCalibrationArgs(json::object(), config_.calibration);
   if (!args) return giveUp("the scan's settings: " + args.error());
   args->output = output;
@@ -67,6 +74,7 @@ void Daemon::scanForDrift(const std::string& output, const std::string& camera, 
   auto made = makeCalibrationPlan(devices_, *args, config_.calibration, base);
   if (!made) return giveUp("the " + std::string(step) + " cannot run: " + made.error().message);
   made->scene_plane = std::make_shared<std::optional<geom::Plane>>(base.surface.plane);
+  if (surface) made->known_projector = projector->model();
   auto plan = std::make_shared<const CalibrationPlan>(std::move(*made));
   // Other outputs show black: their light would fall into the captures.
   std::vector<IdleOutput> idle;
@@ -97,7 +105,10 @@ void Daemon::scanForDrift(const std::string& output, const std::string& camera, 
                         {"step", step},
                         {"why", why},
                         {"operation", op_id},
-                        {"route", plan->planar() ? "b'" : "a"},
+                        {"route", surface          ? "surface"
+                                  : plan->planar() ? "b'"
+                                                   : "a"},
+                        {"measures", surface ? "surface" : "projector"},
                         {"cameras", cameras},
                         {"frames", plan->frames()},
                         {"captures", captures},
@@ -133,12 +144,13 @@ void Daemon::scanForDrift(const std::string& output, const std::string& camera, 
     refreshOutputs();  // the content again
   };
   compute_worker_->submit(
-      [this, plan, idle, hooks, fence, cancelled, output, camera, which, m, finish, started_at] {
+      [this, plan, idle, hooks, fence, cancelled, output, camera, which, m, finish, started_at,
+       surface] {
         fence.wait();
         for (const IdleOutput& i : idle) (void)blankOutput(i);
         auto r = runCalibration(*plan, hooks);
         return [this, plan, r = std::move(r), cancelled, output, camera, which, m, finish,
-                started_at] {
+                started_at, surface] {
           const char* step = driftScanName(which);
           auto it = drift_rt_.outputs.find(output);
           if (!r || cancelled->load()) {
@@ -152,6 +164,7 @@ void Daemon::scanForDrift(const std::string& output, const std::string& camera, 
           }
           if (it == drift_rt_.outputs.end()) return finish(nullptr);  // the output went away
           DriftRuntime::Output& o = it->second;
+          if (surface) return scannedWall(output, camera, which, m, *plan, *r, started_at, finish);
           Learnt learnt = learntFromRun(*plan, *r);
           // The scan measures the geometry of the rig's projector for this output: it keeps
           // that one's name, tilt mount and photometric record.
@@ -205,6 +218,65 @@ void Daemon::scanForDrift(const std::string& output, const std::string& camera, 
           abandonDrift(output, camera, driftScanName(which), f.message, m);
         }
       });
+}
+
+void Daemon::scannedWall(const std::string& output, const std::string& camera, DriftScan which,
+                         const drift::Misregistration& m, const CalibrationPlan& plan,
+                         const CalibrationOutcome& r, DriftRuntime::Clock::time_point started_at,
+                         const std::function<void(const CalibrationFailure*)>& finish) {
+  const char* step = driftScanName(which);
+  const std::string by = plan.cameras.size() > 1
+                             ? "cameras '" + plan.cameras[0].device.name + "' and '" +
+                                   plan.cameras[1].device.name + "'"
+                             : "the projector and camera '" + plan.cameras[0].device.name + "'";
+  const auto failed = [&](const std::string& why) {
+    const CalibrationFailure f{proto::code::kFailed, why};
+    finish(&f);
+    abandonDrift(output, camera, step, why, m);
+  };
+  if (!r.triangulated_plane) return failed("internal: the " + std::string(step) + " gave no wall");
+  const geom::PlaneFit& fit = *r.triangulated_plane;
+  auto made = wallUpdate(fit.plane, fit.rms);
+  if (!made) return failed(made.error().message);
+  // How far the wall moved where the projector's optical axis meets it, and how far it
+  // turned.
+  double offset_m = 0, turned_deg = 0;
+  const rig::RigProjector* p = rig_.projectorForOutput(output);
+  if (p && rig_.surface.plane) {
+    const geom::Plane& old = *rig_.surface.plane;
+    const geom::Ray axis{p->model().pose.center(), p->model().pose.R.row(2).transpose()};
+    if (auto hit = geom::intersectPlane(axis, fit.plane)) {
+      offset_m = old.signedDistance(hit->point);
+    }
+    turned_deg = std::acos(std::min(1.0, std::abs(old.n.dot(fit.plane.n)))) * 180 / M_PI;
+  }
+  json event = {{"output", output},
+                {"step", step},
+                {"measured", "surface"},
+                {"triangulated_by", by},
+                {"points", fit.inliers.size()},
+                {"plane_rms_mm", 1e3 * fit.rms},
+                {"wall_offset_mm", 1e3 * offset_m},
+                {"wall_turned_deg", turned_deg},
+                {"scan_s", secondsSince(started_at)},
+                {"frames", plan.frames()},
+                {"decoded", r.decoded}};
+  logInfo("drift: output '" + output + "': the " + step + " measured the wall again (" +
+          std::to_string(fit.inliers.size()) + " nodes triangulated by " + by + ", " +
+          std::to_string(1e3 * offset_m) + " mm from the rig's, turned " +
+          std::to_string(turned_deg) + " deg; " + std::to_string(secondsSince(started_at)) + " s)");
+  // The wall is measured: what was kept to restore belonged to the old one.
+  if (auto it = drift_rt_.outputs.find(output); it != drift_rt_.outputs.end()) {
+    it->second.before.reset();
+  }
+  writeDriftCorrection(output, std::move(*made), std::move(event), "corrected-scan", {},
+                       [finish](const Result<std::string>& written) {
+                         if (!written) {
+                           const CalibrationFailure f{proto::code::kIo, written.error().message};
+                           return finish(&f);
+                         }
+                         finish(nullptr);
+                       });
 }
 
 }  // namespace procam::daemon

@@ -15,30 +15,53 @@ double sampleRadius(const sl::PatternSet& set) {
   return std::max({2.0, static_cast<double>(set.columns.cell), static_cast<double>(set.rows.cell)});
 }
 
-Result<surface::SurfacePoints> triangulateNodes(const sl::PatternSet& set, const DecodedView& a,
-                                                const DecodedView& b, int step) {
-  const int pw = set.options.width, ph = set.options.height;
-  surface::ProjectorSamples samples[2];
-  const DecodedView* views[2] = {&a, &b};
-  for (int i = 0; i < 2; ++i) {
-    const DecodedView& v = *views[i];
-    if (v.decoded.u.cols != v.camera.width || v.decoded.u.rows != v.camera.height)
-      return fail(ErrorCode::kInvalidInput,
-                  "captures of camera '" + v.name + "' are " + std::to_string(v.decoded.u.cols) +
-                      "x" + std::to_string(v.decoded.u.rows) + " but its calibration is " +
-                      std::to_string(v.camera.width) + "x" + std::to_string(v.camera.height));
-    auto s = surface::sampleProjectorGrid(v.decoded, pw, ph,
-                                          {.step = step, .radius = sampleRadius(set)});
-    if (!s) return tl::unexpected(s.error());
-    samples[i] = std::move(*s);
-  }
-  auto points = surface::triangulateStereo(a.camera, samples[0], b.camera, samples[1]);
+namespace {
+
+// The projector grid nodes `v` decoded, where its camera sees each.
+Result<surface::ProjectorSamples> samplesOf(const sl::PatternSet& set, const DecodedView& v,
+                                            int step) {
+  if (v.decoded.u.cols != v.camera.width || v.decoded.u.rows != v.camera.height)
+    return fail(ErrorCode::kInvalidInput,
+                "captures of camera '" + v.name + "' are " + std::to_string(v.decoded.u.cols) +
+                    "x" + std::to_string(v.decoded.u.rows) + " but its calibration is " +
+                    std::to_string(v.camera.width) + "x" + std::to_string(v.camera.height));
+  return surface::sampleProjectorGrid(v.decoded, set.options.width, set.options.height,
+                                      {.step = step, .radius = sampleRadius(set)});
+}
+
+Result<surface::SurfacePoints> atLeastTwenty(Result<surface::SurfacePoints> points,
+                                             const char* seen_by) {
   if (!points) return tl::unexpected(points.error());
   if (points->world.size() < 20)
-    return fail(ErrorCode::kTooFewPoints,
-                "only " + std::to_string(points->world.size()) +
-                    " projector nodes were seen by both cameras (need 20)");
+    return fail(ErrorCode::kTooFewPoints, "only " + std::to_string(points->world.size()) +
+                                              " projector nodes were seen by " + seen_by +
+                                              " (need 20)");
   return points;
+}
+
+}  // namespace
+
+Result<surface::SurfacePoints> triangulateNodes(const sl::PatternSet& set, const DecodedView& a,
+                                                const DecodedView& b, int step) {
+  auto sa = samplesOf(set, a, step);
+  if (!sa) return tl::unexpected(sa.error());
+  auto sb = samplesOf(set, b, step);
+  if (!sb) return tl::unexpected(sb.error());
+  return atLeastTwenty(surface::triangulateStereo(a.camera, *sa, b.camera, *sb), "both cameras");
+}
+
+Result<surface::SurfacePoints> triangulateWithProjector(const sl::PatternSet& set,
+                                                        const geom::CameraModel& projector,
+                                                        const DecodedView& view, int step) {
+  if (projector.width != set.options.width || projector.height != set.options.height)
+    return fail(ErrorCode::kInvalidInput, "the projector's model is not the pattern set's size");
+  auto seen = samplesOf(set, view, step);
+  if (!seen) return tl::unexpected(seen.error());
+  // The projector "sees" each node at the node itself.
+  surface::ProjectorSamples own = *seen;
+  own.camera = own.projector;
+  return atLeastTwenty(surface::triangulateStereo(projector, own, view.camera, *seen),
+                       "the projector and the camera");
 }
 
 namespace {

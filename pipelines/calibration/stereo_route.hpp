@@ -39,6 +39,14 @@ double sampleRadius(const sl::PatternSet& set);
 Result<surface::SurfacePoints> triangulateNodes(const sl::PatternSet& set, const DecodedView& a,
                                                 const DecodedView& b, int step);
 
+// A calibrated projector as the second view (a projector is a camera in reverse,
+// [Raskar02] §4.1.1): the projector grid nodes one camera decoded, triangulated from the
+// camera's ray and the projector's ray through the node. `projector` must have its pose,
+// intrinsics and distortion. Errors as triangulateNodes.
+Result<surface::SurfacePoints> triangulateWithProjector(const sl::PatternSet& set,
+                                                        const geom::CameraModel& projector,
+                                                        const DecodedView& view, int step);
+
 // A planar scene (solveStereoRoute's kCoplanar): the plane the two cameras
 // triangulate, for the plane route (solvePlaneHomographyRoute): RANSAC with five
 // times the nodes' own noise (from second differences along the projector grid, at

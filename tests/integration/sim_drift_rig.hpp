@@ -150,12 +150,14 @@ inline Measured keystoneAgainstTruth(Connection& c, const geom::CameraModel& tru
 }
 
 // The `drift` event of the correction `state` (none of `wrong`, none unresolved), then
-// whether a check found the output registered after it (within 25 s).
+// whether a check found the output registered after it (within `within`, 25 s unless a
+// scan's frames must be filmed first).
 inline std::optional<json> awaitCorrection(Connection& watcher, const std::string& state,
-                                           const std::string& wrong, bool& registered) {
+                                           const std::string& wrong, bool& registered,
+                                           std::chrono::seconds within = 25s) {
   std::optional<json> corrected;
   registered = false;
-  const auto deadline = Clock::now() + 25s * kSlowdown;
+  const auto deadline = Clock::now() + within * kSlowdown;
   while (Clock::now() < deadline && !registered) {
     auto e = watcher.next(1s);
     if (!e || (*e)["event"] != "drift") continue;
@@ -167,15 +169,16 @@ inline std::optional<json> awaitCorrection(Connection& watcher, const std::strin
   return corrected;
 }
 
-// procamd with recalibrate = "on-drift" on wall_oblique with a second camera (or with
-// its one) and `events`, a watcher on its events and textured content shown.
+// procamd with recalibrate = `policy` (default "on-drift") on wall_oblique with a second
+// camera (or with its one) and `events`, a watcher on its events and textured content
+// shown.
 struct DriftRig {
   DriftRig(const TempDir& dir, const std::string& events, bool second_camera = true,
-           const std::string& more_policy = "")
+           const std::string& more_policy = "", const std::string& policy = "on-drift")
       : scene_file(sceneWithEvents(
             dir, (second_camera ? std::string(drift::kSecondCamera) : std::string()) + events)),
         scene(sim::resolveScene(scene_file)),
-        d(dir, driftDaemon(dir, "on-drift", scene_file, {}, more_policy)),
+        d(dir, driftDaemon(dir, policy, scene_file, {}, more_policy)),
         c(d.socketPath()),
         watcher(d.socketPath()) {}
   // Fatal failures of the set-up; call first. `png`: the content (default: textured).

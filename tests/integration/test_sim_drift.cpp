@@ -267,21 +267,33 @@ TEST(SimDrift, ABumpedCameraIsReregisteredAndTheProjectorLeftAlone) {
   EXPECT_LE(rig_px, 0.5);
 }
 
-// The wall moved 1 cm back (to y = 3.01) while the daemon runs: the surface step measures
-// it again from the content, the projector and cameras left as they are; the plane and
-// where the content lands on it checked against the truth. `triangulated_by`: the
-// correction's event names who triangulated it.
-void expectMovedWallMeasuredAgain(const TempDir& dir, DriftRig& r,
+// The wall moved 1 cm back (to y = 3.01) while the daemon runs: under "on-drift" the
+// coarse Gray pass measures it again (the step that ran: "coarse-scan", measuring the
+// surface), under "on-drift-silent" the content does (the "surface" step); the projector
+// and cameras left as they are; the plane and where the content lands on it checked
+// against the truth. `triangulated_by`: who triangulated it, as the correction's event
+// names them.
+void expectMovedWallMeasuredAgain(const TempDir& dir, DriftRig& r, bool by_scan,
                                   const std::string& triangulated_by) {
   ASSERT_NO_FATAL_FAILURE(r.start(dir));
   auto [scene, d, c, watcher] = std::tie(r.scene, r.d, r.c, r.watcher);
   auto before = rig::rigFromText(rigText(dir), "rig.json");
   ASSERT_TRUE(before) << before.error().message;
   bool registered = false;
+  // A scan films its 34 frames with every camera that checks the output: 68 captures with
+  // two cameras, each lit again by the virtual camera.
   const std::optional<json> corrected =
-      awaitCorrection(watcher, "corrected-surface", "corrected-pose", registered);
+      awaitCorrection(watcher, by_scan ? "corrected-scan" : "corrected-surface", "corrected-pose",
+                      registered, by_scan ? 90s : 25s);
   ASSERT_TRUE(corrected) << outputDrift(c).dump() << d.log();
-  EXPECT_EQ((*corrected)["step"], "surface");
+  if (by_scan) {
+    std::printf("[ figures  ] the coarse Gray pass: %d frames, %.1f s\n",
+                (*corrected)["frames"].get<int>(), (*corrected)["scan_s"].get<double>());
+    EXPECT_EQ((*corrected)["step"], "coarse-scan");
+    EXPECT_EQ((*corrected)["measured"], "surface");
+  } else {
+    EXPECT_EQ((*corrected)["step"], "surface");
+  }
   EXPECT_EQ((*corrected)["triangulated_by"], triangulated_by);
   EXPECT_TRUE(registered) << outputDrift(c).dump();
   auto after = rig::rigFromText(rigText(dir), "rig.json");
@@ -310,15 +322,16 @@ void expectMovedWallMeasuredAgain(const TempDir& dir, DriftRig& r,
     }
   }
   const json dr = outputDrift(c);
-  const json& why = (*corrected)["why"];
+  const json& e = *corrected;
+  const double offset_mm =
+      by_scan ? e["wall_offset_mm"].get<double>() : e["why"]["wall_offset_mm"].get<double>();
   std::printf(
-      "[ figures  ] wall moved 1 cm back, triangulated by %s: seen at %.2f px, %.2f mm off "
-      "the rig's wall (standard error %.3f) from %d content points; the wall measured again "
-      "%.3f mm and %.4f deg from the true one, the content on it %.3f projector px from where "
-      "the rig puts it; now %.3f px; projector and cameras unchanged\n",
-      triangulated_by.c_str(), why["misregistration_px"].get<double>(),
-      why["wall_offset_mm"].get<double>(), why["wall_offset_se_mm"].get<double>(),
-      (*corrected)["points"].get<int>(), off_mm, turned, worst_px,
+      "[ figures  ] wall moved 1 cm back, measured by the %s, triangulated by %s: %.2f mm off "
+      "the rig's wall from %d %s; the wall measured again %.3f mm and %.4f deg from the true "
+      "one, the content on it %.3f projector px from where the rig puts it; now %.3f px; "
+      "projector and cameras unchanged\n",
+      by_scan ? "coarse Gray pass" : "content", triangulated_by.c_str(), offset_mm,
+      e["points"].get<int>(), by_scan ? "Gray nodes" : "content points", off_mm, turned, worst_px,
       dr.value("misregistration_px", -1.0));
   EXPECT_LE(off_mm, 1.0);
   EXPECT_LE(turned, 0.1);
@@ -328,23 +341,37 @@ void expectMovedWallMeasuredAgain(const TempDir& dir, DriftRig& r,
 
 constexpr const char* kWallMovedBack = "\ntarget = \"wall\"\nmove_m = [0.0, 0.01, 0.0]\n";
 
-// Two fixed cameras, the wall moved 1 cm back: both see the content drift, and where
-// they both found it their rays meet 1 cm behind the rig's wall, so the wall is measured
-// again from the content and the projector left as it is.
-TEST(SimDrift, AMovedWallIsMeasuredAgainFromTheContentAndTheProjectorLeftAlone) {
-  TempDir dir;
-  DriftRig r(dir, "[[events]]\nt = " + atText(6.0) + kWallMovedBack);
-  expectMovedWallMeasuredAgain(dir, r, "two cameras");
-}
-
 // One fixed camera, the wall moved 1 cm back: the content moved along the camera's
 // epipolar lines with the projector, so the projector's rays and the camera's meet 1 cm
 // behind the rig's wall, and the pose fitted to the content would not turn the projector:
-// the wall moved, and is measured again from the projector and the camera.
-TEST(SimDrift, AMovedWallIsMeasuredAgainWithOneCamera) {
+// the wall moved. The coarse Gray pass measures it from the projector and the camera.
+TEST(SimDrift, AMovedWallIsMeasuredAgainByTheCoarsePass) {
   TempDir dir;
   DriftRig r(dir, "[[events]]\nt = " + atText(6.0) + kWallMovedBack, false);
-  expectMovedWallMeasuredAgain(dir, r, "the projector and camera 'cam'");
+  expectMovedWallMeasuredAgain(dir, r, true, "the projector and camera 'cam'");
+}
+
+// Two fixed cameras: both see the content drift, and where they both found it their rays
+// meet 1 cm behind the rig's wall; the coarse Gray pass measures the wall from the two.
+TEST(SimDrift, AMovedWallIsMeasuredAgainByTheCoarsePassFromTwoCameras) {
+  TempDir dir;
+  DriftRig r(dir, "[[events]]\nt = " + atText(6.0) + kWallMovedBack);
+  expectMovedWallMeasuredAgain(dir, r, true, "cameras 'cam' and 'cam2'");
+}
+
+// recalibrate = "on-drift-silent" shows no pattern: the wall is measured again from the
+// content alone, by the two cameras' rays where they found the same content.
+TEST(SimDrift, SilentlyAMovedWallIsMeasuredAgainFromTheContent) {
+  TempDir dir;
+  DriftRig r(dir, "[[events]]\nt = " + atText(6.0) + kWallMovedBack, true, "", "on-drift-silent");
+  expectMovedWallMeasuredAgain(dir, r, false, "two cameras");
+}
+
+// The same with one camera: the projector's rays and the camera's through the content.
+TEST(SimDrift, SilentlyAMovedWallIsMeasuredAgainFromTheContentWithOneCamera) {
+  TempDir dir;
+  DriftRig r(dir, "[[events]]\nt = " + atText(6.0) + kWallMovedBack, false, "", "on-drift-silent");
+  expectMovedWallMeasuredAgain(dir, r, false, "the projector and camera 'cam'");
 }
 
 // The projector's zoom ring turned 5 %: no pose with the rig's intrinsics explains the
