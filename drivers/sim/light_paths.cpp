@@ -10,6 +10,21 @@ std::size_t LightPaths::size() const {
   return n;
 }
 
+bool LightPaths::consistent() const {
+  if (ambient.type() != CV_32FC3 || rows.size() != static_cast<std::size_t>(ambient.rows))
+    return false;
+  for (const Row& row : rows) {
+    if (row.end.size() != static_cast<std::size_t>(ambient.cols)) return false;
+    std::uint32_t last = 0;
+    for (const std::uint32_t end : row.end) {
+      if (end < last) return false;
+      last = end;
+    }
+    if (last > row.paths.size()) return false;
+  }
+  return true;
+}
+
 cv::Mat LightPaths::light(const std::vector<const ProjectorImage*>& images, int threads) const {
   cv::Mat out = ambient.clone();
   forEachRow(out.rows, threads, [&](int y) {

@@ -33,6 +33,9 @@ struct LightPaths {
   std::vector<Row> rows;
 
   std::size_t size() const;
+  // One row per ambient row, one end per pixel, ends rising within the row's paths:
+  // what light() indexes by.
+  bool consistent() const;
   // The radiance (CV_32FC3, BGR) while projector i shows `images[i]` (nullptr:
   // dark); `threads` as RenderOptions::threads.
   cv::Mat light(const std::vector<const ProjectorImage*>& images, int threads = 0) const;

@@ -272,6 +272,9 @@ Result<cv::Mat> Renderer::cameraRadiance(std::string_view camera, const LightPat
   if (paths.ambient.rows != cam->model.height || paths.ambient.cols != cam->model.width)
     return fail(ErrorCode::kInvalidInput,
                 "light paths traced for another camera than '" + std::string(camera) + "'");
+  if (!paths.consistent())
+    return fail(ErrorCode::kInvalidInput,
+                "the light paths of camera '" + std::string(camera) + "' are malformed");
   std::vector<const ProjectorImage*> images(state_.projectors.size(), nullptr);
   for (const Lamp& lamp : lamps_) {
     if (lamp.image) images[lamp.projector] = &*lamp.image;

@@ -65,6 +65,14 @@ TEST_P(LightPathsScene, LightTheImageACastWould) {
   auto refused = renderer->cameraRadiance(camera, other);
   ASSERT_FALSE(refused);
   EXPECT_EQ(refused.error().code, ErrorCode::kInvalidInput);
+  // So are paths whose rows do not index their own paths.
+  EXPECT_TRUE(paths->consistent());
+  LightPaths broken = *paths;
+  broken.rows.back().end.back() = static_cast<std::uint32_t>(broken.rows.back().paths.size() + 1);
+  EXPECT_FALSE(broken.consistent());
+  auto malformed = renderer->cameraRadiance(camera, broken);
+  ASSERT_FALSE(malformed);
+  EXPECT_EQ(malformed.error().code, ErrorCode::kInvalidInput);
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, LightPathsScene,
