@@ -312,10 +312,11 @@ class Daemon {
   void correctSurface(const std::string& output, const std::string& camera,
                       const drift::Misregistration& m, const drift::WallSeen& wall,
                       const std::string& seen_by);
-  // The rig model's update for the wall `plane` (scatter `rms_m`): every projector keeps its
+  // The update of `rig` for the wall `plane` (scatter `rms_m`): every projector keeps its
   // pose, and one known by its collineation with the old plane gets it from its pose and
   // the new plane; kNotFound naming a projector known only by that collineation.
-  Result<rig::RigModel> wallUpdate(const geom::Plane& plane, double rms_m) const;
+  static Result<rig::RigModel> wallUpdate(const rig::RigModel& rig, const geom::Plane& plane,
+                                          double rms_m);
   // Merges a correction into rig.json; `event` (a drift event's body) goes out with
   // `state` when written, "failed" otherwise; `after` first hears how the write went.
   void writeDriftCorrection(const std::string& output, rig::RigModel update, nlohmann::json event,

@@ -333,10 +333,12 @@ void Daemon::onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, Calibr
                                 : "the output is still " + std::to_string(m.rms_px) +
                                       " px off after the " + driftScanName(o.scan);
     o.passes = 0;
-    // The projector's corrections (or a scan) climb to the next scan; a camera that moved
-    // is not found by scanning a projector, nor a wall (one projector's scan would leave
-    // the others on the old one).
-    if (step == "projector-pose" || o.scan != DriftScan::kNone) {
+    // The projector's corrections (or a scan of it) climb to the next scan; a camera that
+    // moved is not found by scanning a projector, nor a wall (one projector's scan would
+    // leave the others on the old one), which its own coarse pass measured already.
+    const bool wall_scanned =
+        o.last_correction.is_object() && o.last_correction.value("measured", "") == "surface";
+    if (!wall_scanned && (step == "projector-pose" || o.scan != DriftScan::kNone)) {
       return escalateDrift(key.output, key.camera, step, why, m);
     }
     return abandonDrift(key.output, key.camera, step, why + "; calibrate again", m);

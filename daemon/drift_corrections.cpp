@@ -131,13 +131,14 @@ std::optional<drift::WallSeen> Daemon::movedWallOneCamera(const std::string& out
   return *seen;
 }
 
-Result<rig::RigModel> Daemon::wallUpdate(const geom::Plane& plane, double rms_m) const {
+Result<rig::RigModel> Daemon::wallUpdate(const rig::RigModel& rig, const geom::Plane& plane,
+                                         double rms_m) {
   // Every projector on the wall keeps its pose; those that kept a collineation with the
   // old plane get theirs from the pose and the new plane.
   rig::RigModel update;
   update.surface.plane = plane;
   update.surface.plane_rms_m = rms_m;
-  for (const rig::RigProjector& p : rig_.projectors) {
+  for (const rig::RigProjector& p : rig.projectors) {
     if (!p.plane_homography) continue;
     if (!p.pose_known || !p.intrinsics_known || !p.scale_known) {
       return fail(ErrorCode::kNotFound,
@@ -158,17 +159,24 @@ void Daemon::correctSurface(const std::string& output, const std::string& camera
   const double held = heldFor(o);
   if (config_.recalibrate == RecalibratePolicy::kOnDrift) {
     // Pattern frames allowed: the coarse Gray pass measures the wall from thousands of
-    // nodes where the content gave tens of points, and checks the diagnosis (a projector
-    // that moved along the epipolar lines triangulates as a tilted wall).
+    // nodes where the content gave tens of points. Refused before any frame is shown when
+    // the wall could not be written.
+    const rig::RigModel base = o.before ? rig::mergeRig(rig_, *o.before) : rig_;
+    if (rig_.surface.plane) {
+      if (auto can = wallUpdate(base, *rig_.surface.plane, 0); !can) {
+        return unresolveDrift(output, camera, "surface",
+                              can.error().message + "; the rig model stays as it was", m);
+      }
+    }
     char seen[160];
     std::snprintf(seen, sizeof seen,
-                  "the content moved as a moved wall moves it: %.2f mm (standard error %.3f) "
+                  "the content moved as a moved wall moves it: %.2f mm (standard error %.3f mm) "
                   "off the rig's wall, turned %.3f deg, ",
                   1e3 * wall.offset_m, 1e3 * wall.offset_se_m, wall.tilt_deg);
     return scanForDrift(output, camera, DriftScan::kCoarse,
                         seen + std::string("seen by ") + seen_by, m, true);
   }
-  auto made = wallUpdate(drift::wallToKeep(wall), wall.rms_m);
+  auto made = wallUpdate(rig_, drift::wallToKeep(wall), wall.rms_m);
   if (!made) {
     return unresolveDrift(output, camera, "surface",
                           made.error().message + "; the rig model stays as it was", m);

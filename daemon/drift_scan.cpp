@@ -50,10 +50,7 @@ void Daemon::scanForDrift(const std::string& output, const std::string& camera, 
   const auto giveUp = [&](const std::string& reason) {
     abandonDrift(output, camera, step, reason, m);
   };
-  const rig::RigProjector* projector = rig_.projectorForOutput(output);
-  if (surface && (!projector || !projector->pose_known || !projector->intrinsics_known)) {
-    return giveUp("the wall is measured from the projector's pose, which the rig model lacks");
-  }
+
   auto args = parseCalibrationArgs(json::object(), config_.calibration);
   if (!args) return giveUp("the scan's settings: " + args.error());
   args->output = output;
@@ -71,10 +68,20 @@ void Daemon::scanForDrift(const std::string& output, const std::string& camera, 
   // Corrections that did not converge are dropped: the scan starts from the devices as
   // a check last confirmed them (the cameras' poses route (a) triangulates with).
   const rig::RigModel base = o.before ? rig::mergeRig(rig_, *o.before) : rig_;
+  // One camera measures a wall with the projector as the second view: its pose,
+  // intrinsics and metric scale as a check last confirmed them.
+  const rig::RigProjector* projector = base.projectorForOutput(output);
+  if (surface && args->cameras.size() < 2 &&
+      (!projector || !projector->pose_known || !projector->intrinsics_known ||
+       !projector->scale_known)) {
+    return giveUp(
+        "one camera measures the wall with the projector's metric pose, which the rig model "
+        "lacks");
+  }
   auto made = makeCalibrationPlan(devices_, *args, config_.calibration, base);
   if (!made) return giveUp("the " + std::string(step) + " cannot run: " + made.error().message);
   made->scene_plane = std::make_shared<std::optional<geom::Plane>>(base.surface.plane);
-  if (surface) made->known_projector = projector->model();
+  if (surface) made->known_projector = projector ? projector->model() : geom::CameraModel{};
   auto plan = std::make_shared<const CalibrationPlan>(std::move(*made));
   // Other outputs show black: their light would fall into the captures.
   std::vector<IdleOutput> idle;
@@ -236,44 +243,52 @@ void Daemon::scannedWall(const std::string& output, const std::string& camera, D
   };
   if (!r.triangulated_plane) return failed("internal: the " + std::string(step) + " gave no wall");
   const geom::PlaneFit& fit = *r.triangulated_plane;
-  auto made = wallUpdate(fit.plane, fit.rms);
-  if (!made) return failed(made.error().message);
+  // The devices as a check last confirmed them (the scan's cameras and projector): what
+  // corrections that did not converge changed goes back with the new wall.
+  auto it = drift_rt_.outputs.find(output);
+  const std::optional<rig::RigModel> before =
+      it != drift_rt_.outputs.end() ? it->second.before : std::nullopt;
+  const rig::RigModel base = before ? rig::mergeRig(rig_, *before) : rig_;
+  auto made = wallUpdate(base, fit.plane, fit.rms);
+  if (!made) return failed(made.error().message + "; calibrate again");
+  rig::RigModel update = before ? rig::mergeRig(*before, *made) : std::move(*made);
   // How far the wall moved where the projector's optical axis meets it, and how far it
   // turned.
-  double offset_m = 0, turned_deg = 0;
-  const rig::RigProjector* p = rig_.projectorForOutput(output);
-  if (p && rig_.surface.plane) {
-    const geom::Plane& old = *rig_.surface.plane;
-    const geom::Ray axis{p->model().pose.center(), p->model().pose.R.row(2).transpose()};
-    if (auto hit = geom::intersectPlane(axis, fit.plane)) {
-      offset_m = old.signedDistance(hit->point);
-    }
-    turned_deg = std::acos(std::min(1.0, std::abs(old.n.dot(fit.plane.n)))) * 180 / M_PI;
-  }
   json event = {{"output", output},
                 {"step", step},
                 {"measured", "surface"},
                 {"triangulated_by", by},
                 {"points", fit.inliers.size()},
                 {"plane_rms_mm", 1e3 * fit.rms},
-                {"wall_offset_mm", 1e3 * offset_m},
-                {"wall_turned_deg", turned_deg},
                 {"scan_s", secondsSince(started_at)},
                 {"frames", plan.frames()},
                 {"decoded", r.decoded}};
+  double offset_m = 0, turned_deg = 0;
+  const rig::RigProjector* p = base.projectorForOutput(output);
+  if (p && p->pose_known && rig_.surface.plane) {
+    const geom::Plane& old = *rig_.surface.plane;
+    const geom::Ray axis{p->model().pose.center(), p->model().pose.R.row(2).transpose()};
+    if (auto hit = geom::intersectPlane(axis, fit.plane)) {
+      offset_m = old.signedDistance(hit->point);
+      event["wall_offset_mm"] = 1e3 * offset_m;
+    }
+    turned_deg = std::acos(std::min(1.0, std::abs(old.n.dot(fit.plane.n)))) * 180 / M_PI;
+    event["wall_turned_deg"] = turned_deg;
+  }
   logInfo("drift: output '" + output + "': the " + step + " measured the wall again (" +
           std::to_string(fit.inliers.size()) + " nodes triangulated by " + by + ", " +
           std::to_string(1e3 * offset_m) + " mm from the rig's, turned " +
           std::to_string(turned_deg) + " deg; " + std::to_string(secondsSince(started_at)) + " s)");
-  // The wall is measured: what was kept to restore belonged to the old one.
-  if (auto it = drift_rt_.outputs.find(output); it != drift_rt_.outputs.end()) {
-    it->second.before.reset();
-  }
-  writeDriftCorrection(output, std::move(*made), std::move(event), "corrected-scan", {},
-                       [finish](const Result<std::string>& written) {
+  writeDriftCorrection(output, std::move(update), std::move(event), "corrected-scan", {},
+                       [this, output, finish](const Result<std::string>& written) {
                          if (!written) {
                            const CalibrationFailure f{proto::code::kIo, written.error().message};
                            return finish(&f);
+                         }
+                         // What was kept to restore is now written with the new wall.
+                         if (auto o = drift_rt_.outputs.find(output);
+                             o != drift_rt_.outputs.end()) {
+                           o->second.before.reset();
                          }
                          finish(nullptr);
                        });

@@ -44,7 +44,7 @@ Result<SurfacePoints> triangulateStereo(const geom::CameraModel& a, const Projec
   }
   if (p.world.empty())
     return fail(ErrorCode::kTooFewPoints,
-                "no projector pixel was decoded by both cameras (check overlap and exposure)");
+                "no projector pixel was seen in both views (check overlap and exposure)");
   return p;
 }
 
