@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "blend/rig_tiles.hpp"
+#include "core/units.hpp"
 #include "daemon.hpp"
 #include "json_matrix.hpp"
 #include "log.hpp"
@@ -204,7 +205,7 @@ json Daemon::curvedDisplayJson() const {
     const Vec3 front = d.dome->frame.row(1).transpose();
     out["dome"] = {{"front", {front.x(), front.y(), front.z()}},
                    // Degrees as configured, not their round trip through radians.
-                   {"fov_deg", std::round(2 * d.dome->half_fov * 180 / M_PI * 1e9) / 1e9},
+                   {"fov_deg", std::round(radToDeg(2 * d.dome->half_fov) * 1e9) / 1e9},
                    // The part of the master's circle the projectors draw.
                    {"coverage", d.coverage}};
     return out;

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "calibration_plan.hpp"
+#include "core/units.hpp"
 #include "daemon.hpp"
 #include "device_manager.hpp"
 #include "geometry/intersect.hpp"
@@ -50,7 +51,6 @@ void Daemon::scanForDrift(const std::string& output, const std::string& camera, 
   const auto giveUp = [&](const std::string& reason) {
     abandonDrift(output, camera, step, reason, m);
   };
-
   auto args = parseCalibrationArgs(json::object(), config_.calibration);
   if (!args) return giveUp("the scan's settings: " + args.error());
   args->output = output;
@@ -272,7 +272,7 @@ void Daemon::scannedWall(const std::string& output, const std::string& camera, D
       offset_m = old.signedDistance(hit->point);
       event["wall_offset_mm"] = 1e3 * offset_m;
     }
-    turned_deg = std::acos(std::min(1.0, std::abs(old.n.dot(fit.plane.n)))) * 180 / M_PI;
+    turned_deg = radToDeg(std::acos(std::min(1.0, std::abs(old.n.dot(fit.plane.n)))));
     event["wall_turned_deg"] = turned_deg;
   }
   logInfo("drift: output '" + output + "': the " + step + " measured the wall again (" +
