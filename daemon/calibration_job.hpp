@@ -19,6 +19,7 @@
 #include "calibration/board_plane.hpp"
 #include "calibration/plane_homography_route.hpp"
 #include "calibration/stereo_route.hpp"
+#include "calibration/two_view_plane.hpp"
 #include "config.hpp"
 #include "drift_fiducial.hpp"
 #include "driver.hpp"
@@ -36,8 +37,8 @@ struct CalibrationArgs {
   sl::Mode mode = sl::Mode::kGrayPhase;
   // mode "apriltag": one frame of tags instead of the Gray sequence (route (b′) only).
   bool tags = false;
-  // mode "adaptive": a coarse Gray pass first; on a plane the tag frame finishes, a
-  // surface that is not planar is refused (route (b′) only).
+  // mode "adaptive": a coarse Gray pass first; on a plane the tag frame finishes. With
+  // one camera a surface that is not planar is refused; with two the full scan follows.
   bool adaptive = false;
   int step = 1;  // one code per `step` projector pixels
   int phase_steps = 8;
@@ -88,11 +89,14 @@ struct CalibrationPlan {
   sl::PatternSet set;
   // Set: the single-frame path, one frame of AprilTags over the framebuffer and one
   // capture per camera; its corners are the nodes of route (b′) ([Raskar02] §4.2.4:
-  // on a plane a collineation needs only four). `set` then only sizes the frame.
+  // on a plane a collineation needs only four). `set` then only sizes the frame, or is
+  // the full scan of the adaptive pair (see `coarse`).
   std::shared_ptr<const FiducialFrame> tags;
   // Set with `tags`: the adaptive path, this coarse pass (sl::coarsePatternSet, 16x12
   // blocks) before the tag frame, to tell whether the surface is planar ([Raskar02]
-  // §4.1.4's coarse binary-coded pass).
+  // §4.1.4's coarse binary-coded pass). With one camera on the plan's plane; with two
+  // and no plane (adaptivePair) the two triangulate the plane from the tag frame, and a
+  // surface that is not planar gets `set`, the full scan of route (a).
   std::optional<sl::PatternSet> coarse;
   int grid = 8;
   int settle_frames = 2;
@@ -108,9 +112,10 @@ struct CalibrationPlan {
   std::optional<calib::BoardSpec> board;  // set: route (b′), the plane from this board
   std::string board_text;
   bool response = false;  // a grey ramp after the patterns: the projector's response
-  // Route (a) on a planar scene: the plane the run's projectors share, the rig's
-  // surface plane at the start (taken when the nodes lie on it), else the first one
-  // triangulated. One object for all plans of a run; only the run's worker touches it.
+  // Route (a) on a planar scene, and the adaptive pair: the plane the run's projectors
+  // share, the rig's surface plane at the start (taken when the nodes or tag corners lie
+  // on it), else the first one triangulated. One object for all plans of a run; only the
+  // run's worker touches it.
   std::shared_ptr<std::optional<geom::Plane>> scene_plane;
 
   // Set: the projector stands where this model (pose, intrinsics, distortion) has it and
@@ -120,6 +125,8 @@ struct CalibrationPlan {
   std::optional<geom::CameraModel> known_projector;
 
   bool planar() const { return plane || board; }
+  // The adaptive path with two cameras and no plane (see `coarse`).
+  bool adaptivePair() const { return coarse && !planar() && cameras.size() == 2; }
   // Route (b′) with cameras at several positions: the first camera is the calibrated
   // reference, the others need only their intrinsics; the run's projectors are solved
   // together (calib::solveWallViews) after the last scan.
@@ -141,6 +148,9 @@ struct CalibrationProgress {
   double fraction = 0;  // 0..1 over the whole run
   std::string stage;    // "capturing", "decoding", "solving"
   int capture = 0;      // captures done (of plan.captures())
+  // Set when the run takes more captures than planned: the adaptive path went on to the
+  // full scan. The new total.
+  int captures = 0;
 };
 
 struct CalibrationHooks {
@@ -229,9 +239,28 @@ tl::expected<CalibrationOutcome, CalibrationFailure> tagFrameOutcome(const Calib
                                                                      const CalibrationHooks& hooks,
                                                                      CalibrationOutcome out,
                                                                      double start);
+// The tag frame shown and captured by every camera of the plan; the corners the first
+// camera found, and with no plane (the adaptive pair) the second's too. kFailed when a
+// camera found none or its captures are not its calibration's size.
+using TagViews = std::vector<std::vector<drift::FiducialCorner>>;
+tl::expected<TagViews, CalibrationFailure> captureTagFrame(const CalibrationPlan& plan,
+                                                           const CalibrationHooks& hooks,
+                                                           int settle_frames, double start);
+// Route (b′) from the first camera's corners on `plane` (calib::solvePlaneFromNodes): sets
+// out.planar and out.decoded.
+tl::expected<void, CalibrationFailure> solveTagFrame(const CalibrationPlan& plan,
+                                                     const TagViews& views,
+                                                     const geom::Plane& plane,
+                                                     CalibrationOutcome& out);
+// The plane the two cameras of the adaptive pair triangulate from the corners both found
+// (calib::planeFromTwoViews).
+Result<calib::TwoViewPlane> tagFramePlane(const CalibrationPlan& plan, const TagViews& views);
 // The adaptive path (plan.coarse with plan.tags): the coarse pass shown and captured by
-// the first camera, its blocks tested for one homography (sl::testPlanarity); planar,
-// the tag frame finishes as runTagCalibration; not planar, kFailed naming the fit
+// the plan's cameras, its blocks tested for one homography in each (sl::testPlanarity).
+// Planar: the tag frame finishes, on the plan's plane as runTagCalibration, or (the
+// adaptive pair) on the plane the two cameras triangulate from it. Not planar: with one
+// camera kFailed naming the fit; with two, and when the pair's tag corners are not one
+// plane after all, the full scan of route (a) follows as runCalibration
 // (adaptive_calibration_job.cpp).
 tl::expected<CalibrationOutcome, CalibrationFailure> runAdaptiveCalibration(
     const CalibrationPlan& plan, const CalibrationHooks& hooks);

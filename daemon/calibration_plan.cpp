@@ -142,12 +142,18 @@ tl::expected<CalibrationPlan, Failure> makeCalibrationPlan(DeviceSet& devices,
                       "\"aprilgrid:6x4:0.15\"), or put surface.plane in the rig model"});
     }
   }
-  if (args.tags && (!planar || several || args.board)) {
-    return tl::unexpected(
-        Failure{code::kBadArgument,
-                std::string("\"mode\": \"") + (args.adaptive ? "adaptive" : "apriltag") +
-                    "\" is route (b′) with one camera and the display plane (\"plane\" or the rig "
-                    "model's surface plane), not with a board or several cameras"});
+  // The adaptive path also takes two cameras and no plane: they triangulate the plane
+  // on a planar surface and scan it fully (route (a)) otherwise.
+  if (args.tags && (several || args.board || (!planar && !args.adaptive))) {
+    return tl::unexpected(Failure{
+        code::kBadArgument,
+        args.adaptive ? std::string("\"mode\": \"adaptive\" is route (b′) with one camera and "
+                                    "the display plane (\"plane\" or the rig model's surface "
+                                    "plane), or two cameras and no plane; not with a board or "
+                                    "cameras at several positions")
+                      : std::string("\"mode\": \"apriltag\" is route (b′) with one camera and "
+                                    "the display plane (\"plane\" or the rig model's surface "
+                                    "plane), not with a board or several cameras")});
   }
   uint32_t w = 0, h = 0;
   const auto& raw = out->device.raw();
@@ -204,7 +210,9 @@ Learnt learntByStereoRoute(const CalibrationPlan& plan, const CalibrationOutcome
   projector.scale_known = route.projector.scale_known;
   projector.rms_px = route.projector.rms_px;
   projector.points = route.projector.points;
-  std::string how = "structured light, route (a): cameras";
+  // The adaptive path's coarse pass says why the full scan followed it.
+  std::string how = plan.coarse ? "a coarse Gray pass, then structured light, route (a): cameras"
+                                : "structured light, route (a): cameras";
   for (const auto& c : plan.cameras) how += " " + c.device.name;
   projector.calibrated = {how, utcNow()};
   out.update.projectors.push_back(projector);
@@ -258,9 +266,11 @@ Learnt learntByPlaneRoute(const CalibrationPlan& plan, const CalibrationOutcome&
     }
   }
   projector.calibrated = {
-      std::string(plan.coarse ? "a coarse Gray pass (planar) and one AprilTag frame"
-                  : plan.tags ? "one AprilTag frame"
-                              : "structured light") +
+      std::string(!plan.tags ? "structured light"
+                  // An adaptive pass that went on to the full scan (a planar scene after all).
+                  : result.coarse.contains("then") ? "a coarse Gray pass, then structured light"
+                  : plan.coarse ? "a coarse Gray pass (planar) and one AprilTag frame"
+                                : "one AprilTag frame") +
           ", route (b′): " + cameras + ", plane from the " +
           (result.board                ? "board " + plan.board_text
            : result.triangulated_plane ? "cameras " + plan.cameras.at(0).device.name + " and " +

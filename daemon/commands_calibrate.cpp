@@ -198,9 +198,11 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
   replyTo(client, req, "CALIBRATE", started);
   logInfo("calibration " + op_id + ": " + std::to_string(plan->frames()) + " pattern frame(s) on " +
           output_names.dump());
+  // An adaptive scan that goes on to the full set says how many captures the run now takes.
   auto progress = [op_id, captures](const CalibrationProgress& p) {
-    return json{{"operation", op_id}, {"kind", "calibrate"},  {"fraction", p.fraction},
-                {"stage", p.stage},   {"capture", p.capture}, {"captures", captures}};
+    return json{{"operation", op_id},     {"kind", "calibrate"},
+                {"fraction", p.fraction}, {"stage", p.stage},
+                {"capture", p.capture},   {"captures", p.captures > 0 ? p.captures : captures}};
   };
   operationEvent(client, "progress", progress({0, "starting", 0}));
 
@@ -241,6 +243,8 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
           for (std::size_t i = 0; i < plans.size(); ++i) scan.batches.push_back({i});
         }
         int done = scan.captures;
+        int grown = 0;  // captures the run took beyond those planned (adaptive scans)
+        double shown_fraction = 0;
         std::vector<std::optional<CalibrationOutcome>> by_plan(plans.size());
         for (std::size_t b = 0; b < scan.batches.size() && result; ++b) {
           const std::vector<std::size_t>& batch = scan.batches[b];
@@ -254,10 +258,21 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
           }
           const int batch_captures = members.front()->captures();
           const double share = double(batch_captures) / std::max(1, captures);
-          const double before = double(done) / std::max(1, captures);
+          int batch_grown = 0;
           CalibrationHooks one{
-              hooks.cancelled, [&, share, before, done](const CalibrationProgress& p) {
-                hooks.progress({before + share * p.fraction, p.stage, done + p.capture});
+              hooks.cancelled, [&, share, done, batch_captures](const CalibrationProgress& p) {
+                if (p.captures > 0) batch_grown = std::max(0, p.captures - batch_captures);
+                // A batch that grew (an adaptive scan went on to the full set) takes its
+                // share of the grown run; the fraction never goes back.
+                const int total = captures + grown + batch_grown;
+                const double f =
+                    grown + batch_grown == 0
+                        ? double(done) / std::max(1, captures) + share * p.fraction
+                        : (double(done) + double(batch_captures + batch_grown) * p.fraction) /
+                              total;
+                shown_fraction = std::max(shown_fraction, std::min(0.97, f));
+                hooks.progress({shown_fraction, p.stage, done + p.capture,
+                                grown + batch_grown > 0 ? total : 0});
               }};
           auto r = runBatchCalibration(members, footprints, one);
           if (!r) {
@@ -272,7 +287,8 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
               }
             }
           }
-          done += batch_captures;
+          done += batch_captures + batch_grown;
+          grown += batch_grown;
         }
         if (result) {
           for (auto& o : by_plan) result->push_back(std::move(*o));
@@ -280,7 +296,7 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
         // Cameras at several positions: every projector scanned, all solved at once.
         json wall;
         if (result && !cancelled->load() && plans.front()->wallViews()) {
-          hooks.progress({0.97, "solving", done});
+          hooks.progress({0.97, "solving", done, grown > 0 ? captures + grown : 0});
           auto solved = solveWallViewsRun(all, *result);
           if (solved) {
             wall = wallViewsJson(*solved, all);
@@ -302,8 +318,9 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
           batches.push_back(std::move(names));
         }
         const json scanned = {{"batches", std::move(batches)}, {"captures", done}};
-        return [this, client, req, op_id, cancelled, plans, result, progress, captures, scanned,
-                wall, unified] {
+        const int taken = captures + grown;
+        return [this, client, req, op_id, cancelled, plans, result, progress, captures, taken,
+                scanned, wall, unified] {
           auto finish = [this, client, req, op_id](const json& reply, const Failure* failure) {
             endDeviceOp(client, req, op_id, "calibrate", "CALIBRATE", reply, failure);
             refreshOutputs();  // what the outputs showed before the pattern frames
@@ -315,7 +332,8 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
           }
           // From here on the result is written: a cancel no longer finds the operation.
           operations_.erase(op_id);
-          operationEvent(client, "progress", progress({0.98, "writing", captures}));
+          operationEvent(client, "progress",
+                         progress({0.98, "writing", taken, taken != captures ? taken : 0}));
           // Every projector's part merged into one update, written once: all or nothing.
           rig::RigModel update;
           std::map<std::string, std::string> meshes;

@@ -26,6 +26,18 @@ inline Mat3 matrixOf(const nlohmann::json& rows) {
   return H;
 }
 
+// How far a plane [a, b, c, d] (a x + b y + c z + d = 0) a reply reports is from the
+// wall y = `wall_y`: its normal's angle to the wall's (degrees) and its offset (mm).
+struct PlaneOff {
+  double angle_deg = 0, offset_mm = 0;
+};
+inline PlaneOff planeOffTheWall(const nlohmann::json& plane, double wall_y) {
+  const Vec3 n(plane[0].get<double>(), plane[1].get<double>(), plane[2].get<double>());
+  const double sign = n.y() < 0 ? -1.0 : 1.0;
+  return {std::acos(std::min(1.0, sign * n.normalized().y())) * 180 / M_PI,
+          std::abs(sign * plane[3].get<double>() / n.norm() + wall_y) * 1000};
+}
+
 // The content's outer corners (pixel edges) through H: what solveKeystone reports.
 inline std::array<Vec2, 4> outerCorners(const Mat3& H, int w, int h) {
   const std::array<Vec2, 4> c = {Vec2(-0.5, -0.5), Vec2(w - 0.5, -0.5), Vec2(w - 0.5, h - 0.5),

@@ -238,6 +238,59 @@ void calibrateToTheEnd(Connection& c, const DaemonProcess& d, json* reply = null
 // spans ~3.3 projector pixels, and the same tolerances hold.
 // Also: the run merges into a rig that holds another projector and keeps it, and 3D
 // content is then placed on the calibrated, non-planar surface (two walls).
+// "mode": "adaptive" with the two calibrated cameras on the corner: the coarse pass (18
+// frames, both cameras) finds the two walls not planar, and the full scan of route (a)
+// follows (Gray code with 8 phase steps, 44 frames on 640x400), its captures added to the
+// run's count. The projector is judged against the route (a) bounds above.
+TEST(SimCalibrate, AnAdaptiveScanWithTwoCamerasScansACornerFully) {
+  TempDir dir;
+  const std::string scene = sceneFile(dir);
+  DaemonProcess d(dir, sim(dir, scene));
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  // Two cameras with a plane are cameras at several positions: not for the adaptive path.
+  auto refused = c.call({{"cmd", "calibrate"},
+                         {"mode", "adaptive"},
+                         {"cameras", {"cam_left", "cam_right"}},
+                         {"plane", {0.0, 1.0, 0.0, -3.0}}});
+  ASSERT_TRUE(refused);
+  EXPECT_EQ((*refused)["code"], "bad-argument") << refused->dump();
+  auto started =
+      c.call({{"cmd", "calibrate"}, {"id", 1}, {"mode", "adaptive"}, {"settle_frames", 0}});
+  ASSERT_TRUE(started);
+  ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
+  EXPECT_EQ((*started)["mode"], "adaptive");
+  EXPECT_EQ((*started)["route"], "a");
+  EXPECT_EQ((*started)["frames"], 19);
+  EXPECT_EQ((*started)["captures"], 38);
+  CalibrateRun run;
+  follow(c, 1, run, 300s);
+  ASSERT_TRUE(run.reply) << d.log();
+  ASSERT_EQ((*run.reply)["class"], "CALIBRATE") << run.reply->dump();
+  const json& coarse = (*run.reply)["coarse"];
+  std::printf("[ figures  ] adaptive on the corner, two cameras: %s\n", coarse.dump().c_str());
+  EXPECT_FALSE(coarse["planar"].get<bool>());
+  EXPECT_EQ(coarse["frames"], 18);
+  EXPECT_EQ(coarse["full_frames"], 44);
+  EXPECT_NE(coarse["then"].get<std::string>().find("not planar"), std::string::npos);
+  EXPECT_EQ((*run.reply)["route"], "a");
+  // Progress counts every capture, the full scan's after the coarse pass's.
+  const int total = 2 * (18 + 44);
+  int last = 0;
+  double last_fraction = 0;
+  for (const json& e : run.progress) {
+    EXPECT_GE(e["capture"].get<int>(), last);
+    EXPECT_GE(e["fraction"].get<double>(), last_fraction) << e.dump();
+    last = e["capture"].get<int>();
+    last_fraction = e["fraction"].get<double>();
+  }
+  EXPECT_LT(last_fraction, 1.0);
+  EXPECT_EQ(last, total);
+  ASSERT_FALSE(run.progress.empty());
+  EXPECT_EQ(run.progress.back()["captures"], total);
+  ASSERT_NO_FATAL_FAILURE(expectRigMatchesTruth(dir, *run.reply, scene, 640));
+}
+
 TEST(SimCalibrate, CamerasCoarserThanTheProjector) {
   TempDir dir;
   const std::string scene = sceneFile(dir, 1.0);

@@ -14,11 +14,13 @@
 #include <cstdio>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
+#include <sstream>
 
 #include "daemon_harness.hpp"
 #include "keystone_truth.hpp"
 #include "sim/scene_library.hpp"
 #include "truth_rig_file.hpp"
+#include "unit/drift/second_camera.hpp"
 
 namespace procam::itest {
 namespace {
@@ -309,6 +311,65 @@ TEST(SimRigKeystone, AnAdaptiveScanStopsAtOneTagFrameOnAPlaneAndRefusesACorner) 
   const json rig = json::parse(rig_file, nullptr, false);
   ASSERT_TRUE(rig.is_object());
   EXPECT_TRUE(!rig.contains("projectors") || rig["projectors"].empty()) << rig.dump();
+}
+
+// "mode": "adaptive" with two calibrated cameras and no plane (wall_oblique with a second
+// camera 1.5 m to the right of the first): the coarse pass finds the wall planar in both
+// cameras, and the tag frame's corners that both find triangulate its plane, so the
+// projector takes route (b′) on it after 19 frames. The wall's normal must be good to
+// 0.05 degrees (1 degree turns the keystone's corners 8.7 px; they are allowed 0.5 px)
+// and its offset to 1 mm; then the keystone is judged as above.
+TEST(SimRigKeystone, AnAdaptiveScanWithTwoCamerasTriangulatesThePlanarWall) {
+  TempDir dir;
+  std::ifstream in(std::string(std::getenv("PROCAM_SOURCE_DIR") ?: ".") +
+                   "/tests/scenes/wall_oblique.toml");
+  std::stringstream text;
+  text << in.rdbuf();
+  ASSERT_FALSE(text.str().empty()) << "PROCAM_SOURCE_DIR must name the source tree";
+  dir.write("wall_two_cameras.toml", text.str() + "\n" + drift::kSecondCamera);
+  const std::string scene_file = dir.file("wall_two_cameras.toml");
+  auto scene = sim::resolveScene(scene_file);
+  ASSERT_TRUE(scene) << scene.error().message;
+  DaemonProcess d(dir, simWithTruth(dir, scene_file, TruthParts::kCamerasOnly));
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  const auto t0 = std::chrono::steady_clock::now();
+  auto started = c.call({{"cmd", "calibrate"},
+                         {"id", 1},
+                         {"mode", "adaptive"},
+                         {"cameras", {"cam", "cam2"}},
+                         {"settle_frames", 0}});
+  ASSERT_TRUE(started);
+  ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
+  EXPECT_EQ((*started)["mode"], "adaptive");
+  EXPECT_EQ((*started)["frames"], 19);
+  EXPECT_EQ((*started)["captures"], 38);
+  auto done = finalReply(c, 1, 480s);
+  ASSERT_TRUE(done) << d.log();
+  ASSERT_EQ((*done)["class"], "CALIBRATE") << done->dump();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_EQ((*done)["route"], "b'");
+  EXPECT_EQ((*done)["plane_source"], "cameras");
+  const json& coarse = (*done)["coarse"];
+  EXPECT_TRUE(coarse["planar"].get<bool>()) << done->dump();
+  ASSERT_EQ(coarse["views"].size(), 2u) << done->dump();
+  EXPECT_FALSE(coarse.contains("then")) << done->dump();
+  const json& plane = (*done)["surface"]["plane"];
+  ASSERT_EQ(plane.size(), 4u) << done->dump();
+  const auto [angle_deg, offset_mm] = planeOffTheWall(plane, 3.0);
+  std::printf(
+      "[ figures  ] adaptive, two cameras, no plane: calibrate %.1f s; tag corners %d and %d, "
+      "plane from %d (RMS %.3f mm), normal %.4f deg and %.3f mm off the truth; collineation "
+      "%.4f projector px RMS\n",
+      seconds, (*done)["decoded"][0].get<int>(), (*done)["decoded"][1].get<int>(),
+      (*done)["triangulated_plane"]["inliers"].get<int>(),
+      1000 * (*done)["triangulated_plane"]["rms_m"].get<double>(), angle_deg, offset_mm,
+      (*done)["homography"]["rms_projector_px"].get<double>());
+  EXPECT_LT(angle_deg, 0.05);
+  EXPECT_LT(offset_mm, 1.0);
+  ASSERT_NO_FATAL_FAILURE(
+      keystoneFromTheRigMatchesTruth(c, dir, scene->at(0).projectors.at(0).model));
 }
 
 // Nothing from truth but the camera's calibration: the wall is found from a board

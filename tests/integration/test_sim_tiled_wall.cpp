@@ -7,6 +7,7 @@
 // homographies the outputs draw with are judged with the TRUE projectors and wall.
 #include <gtest/gtest.h>
 
+#include "keystone_truth.hpp"
 #include "tiled_wall_checks.hpp"
 
 namespace procam::itest {
@@ -262,9 +263,7 @@ TEST(SimTiledWall, TwoCamerasOnThePlanarWallTakeThePlaneTheyTriangulate) {
   EXPECT_EQ((*done)["plane_source"], "cameras");
   const json& plane = (*done)["surface"]["plane"];
   ASSERT_EQ(plane.size(), 4u) << done->dump();
-  const Vec3 n(plane[0].get<double>(), plane[1].get<double>(), plane[2].get<double>());
-  const double angle_deg = std::acos(std::min(1.0, n.normalized().dot(Vec3::UnitY()))) * 180 / M_PI;
-  const double offset_mm = std::abs(plane[3].get<double>() / n.norm() + 3.0) * 1000;
+  const auto [angle_deg, offset_mm] = planeOffTheWall(plane, 3.0);
   std::printf(
       "[ figures  ] proj_tl, two cameras, no plane: wall triangulated from %d nodes "
       "(RMS %.3f mm), normal %.4f deg and %.3f mm off the truth; collineation RMS %.4f px\n",
