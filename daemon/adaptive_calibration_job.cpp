@@ -133,7 +133,10 @@ Outcome runAdaptiveCalibration(const CalibrationPlan& plan, const CalibrationHoo
   out.coarse["planar"] = planar;
   if (cameras > 1) out.coarse["views"] = std::move(fits);
   if (!planar && !plan.adaptivePair()) {
-    return failed(why_not + ": route (b′) needs a plane; calibrate with two cameras (route (a))");
+    return failed(
+        why_not +
+        ": route (b′) needs a plane; with two calibrated cameras and no plane the adaptive "
+        "path scans it fully (route (a))");
   }
   if (!planar) {
     out.coarse["then"] = "the full scan: " + why_not;

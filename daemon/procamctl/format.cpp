@@ -143,6 +143,28 @@ std::string calibrateText(json r) {
   out += field("reprojection", scalar(r["reprojection_rms_px"]) + " px RMS over " +
                                    scalar(p["points"]) + " points");
   out += field("surface", scalar(r["surface_type"]));
+  // The adaptive path: what its coarse pass found, and where the plane came from.
+  const json coarse = val(r, "coarse", json::object());
+  if (coarse.contains("planar")) {
+    char fit[160];
+    std::snprintf(
+        fit, sizeof fit, "%d blocks fit one homography to %.3f px RMS (a plane allows %.3f)",
+        val(coarse, "blocks", 0), val(coarse, "rms_px", 0.0), val(coarse, "tolerance_px", 0.0));
+    out += field("coarse pass",
+                 (val(coarse, "planar", false) ? "planar, " : "not planar, ") + std::string(fit));
+    if (coarse.contains("then")) out += field("", val(coarse, "then", ""));
+  }
+  if (r.contains("plane_source")) {
+    std::string plane = val(r, "plane_source", "?");
+    const json t = val(r, "triangulated_plane", json::object());
+    if (t.contains("rms_m")) {
+      char fit[96];
+      std::snprintf(fit, sizeof fit, " (%d points, %.3f mm RMS)", val(t, "inliers", 0),
+                    1000 * val(t, "rms_m", 0.0));
+      plane += fit;
+    }
+    out += field("plane from", plane);
+  }
   out += field("written", scalar(r["path"]));
   return out;
 }

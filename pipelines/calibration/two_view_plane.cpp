@@ -41,6 +41,22 @@ Result<TwoViewPlane> planeFromTwoViews(const geom::CameraModel& camera_a,
     gaps.push_back(x->gap);
     sines.push_back(ra->dir.cross(rb->dir).norm());
   }
+  // A feature matched wrongly passes its partner's ray far off: beyond five times the
+  // pairs' own miss distance (the noise, whatever the wall's distance) it is dropped.
+  if (!gaps.empty()) {
+    const double cut = std::max(1e-4, 5 * 1.4826 * median(gaps));
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < world.size(); ++i) {
+      if (gaps[i] > cut) continue;
+      world[kept] = world[i];
+      gaps[kept] = gaps[i];
+      sines[kept] = sines[i];
+      ++kept;
+    }
+    world.resize(kept);
+    gaps.resize(kept);
+    sines.resize(kept);
+  }
   const std::string pair = "cameras '" + a + "' and '" + b + "'";
   if (world.size() < kMinPoints) {
     return fail(ErrorCode::kTooFewPoints, pair + " both saw " + std::to_string(world.size()) +

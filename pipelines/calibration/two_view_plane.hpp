@@ -27,7 +27,8 @@ struct TwoViewPlane {
   double noise_m = 0;            // the points' depth noise, from the rays (metres)
 };
 
-// Rays that pass more than `max_gap` apart (metres) are a mismatch and are dropped; the
+// Rays that pass more than `max_gap` apart (metres), or more than five times the pairs'
+// median miss distance, are a mismatch and are dropped; the
 // plane is a RANSAC fit with five times the points' depth noise (at least 0.5 mm) as its
 // threshold, refitted to its inliers. That noise comes from the rays: the median
 // distance by which they miss each other over the median sine of the angle between them.
@@ -42,6 +43,6 @@ Result<TwoViewPlane> planeFromTwoViews(const geom::CameraModel& camera_a,
                                        std::span<const TwoViewPoint> points, const std::string& a,
                                        const std::string& b,
                                        const std::optional<geom::Plane>& prior = {},
-                                       double max_gap = 0.005);
+                                       double max_gap = 0.5);
 
 }  // namespace procam::calib

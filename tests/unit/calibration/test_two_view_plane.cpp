@@ -88,6 +88,19 @@ TEST(TwoViewPlane, APriorPlaneTheyLieOnIsKept) {
   EXPECT_LT(std::abs(refit->fit.plane.signedDistance(Vec3(0.0, 0.0, 0.5))), 0.001);
 }
 
+// A wall 8 m away seen with 1 px of noise: the rays miss each other by about 2 cm, and
+// every pair is kept (mismatches are told by the pairs' own miss distance, not by a
+// fixed one).
+TEST(TwoViewPlane, AFarWallKeepsEveryPair) {
+  const geom::Plane far = testing::planeThrough(Vec3(0.0, 6.0, 0.5), Vec3(0.2, -1.0, 0.05));
+  const auto points = wallPoints(far, 1.0);
+  ASSERT_GE(points.size(), 60u);
+  auto plane = planeFromTwoViews(testing::camera640(), rightCamera(), points, "a", "b");
+  ASSERT_TRUE(plane) << plane.error().message;
+  EXPECT_EQ(plane->triangulated, points.size());
+  EXPECT_TRUE(plane->fit.plane.n.allFinite() && std::isfinite(plane->fit.plane.d));
+}
+
 TEST(TwoViewPlane, MismatchedPointsAreLeftOut) {
   auto points = wallPoints(kWall, 0.2);
   ASSERT_GE(points.size(), 60u);

@@ -34,12 +34,17 @@ TEST(CtlFormat, ValuesOfAnotherTypeReadAsAbsent) {
   for (const char* cls : kClasses) {
     // Every key a formatter might read, each the wrong type.
     json r = {{"class", cls}};
-    for (const char* key :
-         {"release",      "pid",         "uptime_s",    "sim",     "config",    "devices",
-          "capabilities", "warnings",    "outputs",     "auto",    "corners",   "pattern",
-          "shown",        "content",     "object",      "refined", "path",      "bytes",
-          "level",        "trackers",    "cameras",     "camera",  "cancelled", "events",
-          "enabled",      "proto_major", "proto_minor", "message", "keystone",  "drift"}) {
+    for (const char* key : {"release",      "pid",          "uptime_s",
+                            "sim",          "config",       "devices",
+                            "capabilities", "warnings",     "outputs",
+                            "auto",         "corners",      "pattern",
+                            "shown",        "content",      "object",
+                            "refined",      "path",         "bytes",
+                            "level",        "trackers",     "cameras",
+                            "camera",       "cancelled",    "events",
+                            "enabled",      "proto_major",  "proto_minor",
+                            "message",      "keystone",     "drift",
+                            "coarse",       "plane_source", "triangulated_plane"}) {
       r[key] = json::array({json::object({{"x", 1}}), 2});
     }
     std::string text;
@@ -67,6 +72,38 @@ TEST(CtlFormat, AnObjectRefinementIsShown) {
             std::string::npos)
       << text;
   EXPECT_NE(text.find("slide along 1 0 0 (as placed)"), std::string::npos) << text;
+}
+
+TEST(CtlFormat, AnAdaptiveCalibrationSaysWhatItsCoarsePassFound) {
+  const json planar = {{"class", "CALIBRATE"},
+                       {"route", "b'"},
+                       {"plane_source", "cameras"},
+                       {"triangulated_plane", {{"rms_m", 0.000585}, {"inliers", 128}}},
+                       {"coarse",
+                        {{"frames", 18},
+                         {"planar", true},
+                         {"blocks", 175},
+                         {"rms_px", 0.375},
+                         {"tolerance_px", 1.35}}}};
+  std::string text = formatReply(planar);
+  EXPECT_NE(text.find("planar, 175 blocks fit one homography to 0.375 px RMS (a plane allows "
+                      "1.350)"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("plane from:    cameras (128 points, 0.585 mm RMS)"), std::string::npos)
+      << text;
+  const json full = {{"class", "CALIBRATE"},
+                     {"route", "a"},
+                     {"coarse",
+                      {{"planar", false},
+                       {"blocks", 142},
+                       {"rms_px", 4.21},
+                       {"tolerance_px", 0.74},
+                       {"then", "the full scan: not planar"}}}};
+  text = formatReply(full);
+  EXPECT_NE(text.find("not planar, 142 blocks"), std::string::npos) << text;
+  EXPECT_NE(text.find("the full scan: not planar"), std::string::npos) << text;
+  EXPECT_EQ(text.find("plane from"), std::string::npos) << text;
 }
 
 TEST(CtlFormat, DriftShowsItsFiducialFrames) {
