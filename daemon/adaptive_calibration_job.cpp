@@ -60,7 +60,6 @@ Outcome fullScanAfter(const CalibrationPlan& plan, const CalibrationHooks& hooks
       }};
   auto result = runCalibration(full, counted);
   if (!result) return result;
-  result->settle_frames = coarse_out.settle_frames;
   result->latency = std::move(coarse_out.latency);
   result->coarse = std::move(coarse_out.coarse);
   result->coarse["full_frames"] = static_cast<int>(full.set.frames.size());

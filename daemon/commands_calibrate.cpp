@@ -257,19 +257,16 @@ void Daemon::cmdCalibrate(ClientId client, const proto::Request& req) {
             names += (names.empty() ? "'" : ", '") + plans[i]->output.name + "'";
           }
           const int batch_captures = members.front()->captures();
-          const double share = double(batch_captures) / std::max(1, captures);
           int batch_grown = 0;
           CalibrationHooks one{
-              hooks.cancelled, [&, share, done, batch_captures](const CalibrationProgress& p) {
+              hooks.cancelled, [&, done, batch_captures](const CalibrationProgress& p) {
                 if (p.captures > 0) batch_grown = std::max(0, p.captures - batch_captures);
-                // A batch that grew (an adaptive scan went on to the full set) takes its
-                // share of the grown run; the fraction never goes back.
+                // The batch's share of the run's captures, grown when an adaptive scan
+                // went on to the full set; the fraction never goes back.
                 const int total = captures + grown + batch_grown;
                 const double f =
-                    grown + batch_grown == 0
-                        ? double(done) / std::max(1, captures) + share * p.fraction
-                        : (double(done) + double(batch_captures + batch_grown) * p.fraction) /
-                              total;
+                    (double(done) + double(batch_captures + batch_grown) * p.fraction) /
+                    std::max(1, total);
                 shown_fraction = std::max(shown_fraction, std::min(0.97, f));
                 hooks.progress({shown_fraction, p.stage, done + p.capture,
                                 grown + batch_grown > 0 ? total : 0});

@@ -123,18 +123,10 @@ Result<PlaneShare> bestPlane(const surface::SurfacePoints& points) {
 PlaneShare onPlane(const surface::SurfacePoints& points, const geom::Plane& plane,
                    double threshold) {
   PlaneShare out;
-  out.fit.plane = plane;
+  out.fit = geom::planeInliers(points.world, plane, threshold);
   out.threshold = threshold;
-  double sum = 0;
-  for (std::size_t i = 0; i < points.world.size(); ++i) {
-    const double r = plane.signedDistance(points.world[i]);
-    if (std::abs(r) > threshold) continue;
-    out.fit.inliers.push_back(std::uint32_t(i));
-    sum += r * r;
-  }
-  const std::size_t n = out.fit.inliers.size();
-  out.fit.rms = n ? std::sqrt(sum / double(n)) : 0;
-  out.share = points.world.empty() ? 0 : double(n) / double(points.world.size());
+  out.share =
+      points.world.empty() ? 0 : double(out.fit.inliers.size()) / double(points.world.size());
   return out;
 }
 

@@ -83,18 +83,8 @@ Result<TwoViewPlane> planeFromTwoViews(const geom::CameraModel& camera_a,
   out.triangulated = world.size();
   out.noise_m = noise;
   if (prior && prior->n.allFinite() && std::isfinite(prior->d) && prior->n.norm() > 0.5) {
-    geom::PlaneFit on{*prior, 0, {}};
-    on.plane.d /= on.plane.n.norm();
-    on.plane.n.normalize();
-    double sum = 0;
-    for (std::size_t i = 0; i < world.size(); ++i) {
-      const double r = on.plane.signedDistance(world[i]);
-      if (std::abs(r) > threshold) continue;
-      on.inliers.push_back(static_cast<std::uint32_t>(i));
-      sum += r * r;
-    }
+    geom::PlaneFit on = geom::planeInliers(world, *prior, threshold);
     if (double(on.inliers.size()) >= kOnPlaneShare * double(world.size())) {
-      on.rms = std::sqrt(sum / double(on.inliers.size()));
       out.fit = std::move(on);
       return out;
     }

@@ -122,6 +122,21 @@ Result<PlaneFit> fitPlane(std::span<const Vec3> points) {
   return fitSubset(points, std::move(all));
 }
 
+PlaneFit planeInliers(std::span<const Vec3> points, const Plane& plane, double threshold) {
+  PlaneFit out;
+  const double norm = plane.n.norm();
+  out.plane = norm > 0 ? Plane{plane.n / norm, plane.d / norm} : plane;
+  double sum = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const double r = out.plane.signedDistance(points[i]);
+    if (!(std::abs(r) <= threshold)) continue;
+    out.inliers.push_back(static_cast<std::uint32_t>(i));
+    sum += r * r;
+  }
+  out.rms = out.inliers.empty() ? 0 : std::sqrt(sum / double(out.inliers.size()));
+  return out;
+}
+
 Result<PlaneFit> fitPlaneRansac(std::span<const Vec3> points, const RansacOptions& options) {
   if (auto ok = checkPoints(points); !ok) return tl::unexpected(ok.error());
   if (!(options.threshold > 0) || !std::isfinite(options.threshold) || options.iterations < 1 ||

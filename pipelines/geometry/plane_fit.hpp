@@ -44,6 +44,10 @@ struct RansacOptions {
   std::uint64_t seed = 1;
 };
 
+// `plane` (normal made unit length) with the points within `threshold` of it as inliers
+// and their RMS distance: a plane known beforehand, checked against new points.
+PlaneFit planeInliers(std::span<const Vec3> points, const Plane& plane, double threshold);
+
 // RANSAC on 3-point samples, then a least-squares refit on the inliers.
 Result<PlaneFit> fitPlaneRansac(std::span<const Vec3> points, const RansacOptions& options = {});
 

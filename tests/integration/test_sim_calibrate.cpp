@@ -7,79 +7,17 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 #include <set>
 #include <sstream>
 
-#include "content/mesh_content.hpp"
-#include "content/mesh_placement.hpp"
 #include "daemon_harness.hpp"
-#include "mesh_ray_cast.hpp"
 #include "rig/rig_model.hpp"
 #include "sim/truth_rig.hpp"
+#include "sim_calibrate_run.hpp"
 #include "truth_rig_file.hpp"
-#include "unit/calibration/rig_capture.hpp"
 
 namespace procam::itest {
 namespace {
-
-// Projector 640x400 and cameras 512x384 (corner_stereo's scaled by 1/2, intrinsics
-// with them), as in tests/unit/calibration/test_rig_accuracy.cpp; with
-// projector_scale 1 the projector keeps its 1280x800.
-
-std::string sceneFile(const TempDir& dir, double projector_scale = 0.5) {
-  std::string t = procam::testing::sceneText("corner_stereo");
-  EXPECT_TRUE(procam::testing::scaleDevice(t, 1280, 800, projector_scale));  // proj
-  EXPECT_TRUE(procam::testing::scaleDevice(t, 1024, 768, 0.5));              // cam_left
-  EXPECT_TRUE(procam::testing::scaleDevice(t, 1024, 768, 0.5));              // cam_right
-  dir.write("corner_small.toml", t);
-  return dir.file("corner_small.toml");
-}
-
-geom::CameraModel projectorTruth(const std::string& scene_file) {
-  auto scene = sim::Scene::load(scene_file);
-  EXPECT_TRUE(scene) << scene.error().message;
-  return scene->at(0).projectors.at(0).model;
-}
-
-std::string readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-// The request the tests run: Gray code + 3-step phase, nodes every 8 projector
-// pixels, no settle wait (the mock output shows a frame at once).
-json calibrateRequest(int id) {
-  return {{"cmd", "calibrate"}, {"id", id},  {"mode", "gray+phase"},
-          {"phase_steps", 3},   {"grid", 8}, {"settle_frames", 0}};
-}
-
-struct CalibrateRun {
-  json started;                // the first CALIBRATE reply
-  std::vector<json> progress;  // progress events of the operation, in order
-  std::optional<json> finished;
-  std::optional<json> reply;  // the final CALIBRATE or ERROR
-};
-
-// Reads until the final reply to `id` (none for id < 0: a watcher) and the
-// finished event arrive.
-void follow(Connection& c, int id, CalibrateRun& run, std::chrono::milliseconds timeout = 90s) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout * kSlowdown;
-  while (std::chrono::steady_clock::now() < deadline && !(run.finished && (run.reply || id < 0))) {
-    auto msg = c.next(std::chrono::duration_cast<std::chrono::milliseconds>(
-        deadline - std::chrono::steady_clock::now()));
-    if (!msg) break;
-    if ((*msg)["class"] == "EVENT") {
-      if ((*msg)["event"] == "progress") run.progress.push_back(*msg);
-      if ((*msg)["event"] == "finished") run.finished = *msg;
-    } else if ((*msg)["id"] == id) {
-      run.reply = *msg;
-    }
-  }
-}
 
 // A rig.json from an earlier calibration (the scene's cameras and a projector
 // "old" on another output); returns its bytes.
@@ -221,23 +159,6 @@ TEST(SimCalibrate, WritesRigJsonWithTheProjectorsIntrinsics) {
   EXPECT_EQ((*status)["operations"], json::array());
 }
 
-// Runs calibrate to a successful final reply (fatal test failures otherwise), handed
-// back in `reply` when given.
-void calibrateToTheEnd(Connection& c, const DaemonProcess& d, json* reply = nullptr) {
-  auto started = c.call(calibrateRequest(1));
-  ASSERT_TRUE(started);
-  ASSERT_EQ((*started)["class"], "CALIBRATE") << started->dump();
-  CalibrateRun run;
-  follow(c, 1, run);
-  ASSERT_TRUE(run.reply) << d.log();
-  ASSERT_EQ((*run.reply)["class"], "CALIBRATE") << run.reply->dump();
-  if (reply) *reply = *run.reply;
-}
-
-// The projector at its full 1280x800 with the cameras at 512x384: one camera pixel
-// spans ~3.3 projector pixels, and the same tolerances hold.
-// Also: the run merges into a rig that holds another projector and keeps it, and 3D
-// content is then placed on the calibrated, non-planar surface (two walls).
 // "mode": "adaptive" with the two calibrated cameras on the corner: the coarse pass (18
 // frames, both cameras) finds the two walls not planar, and the full scan of route (a)
 // follows (Gray code with 8 phase steps, 44 frames on 640x400), its captures added to the
@@ -291,6 +212,10 @@ TEST(SimCalibrate, AnAdaptiveScanWithTwoCamerasScansACornerFully) {
   ASSERT_NO_FATAL_FAILURE(expectRigMatchesTruth(dir, *run.reply, scene, 640));
 }
 
+// The projector at its full 1280x800 with the cameras at 512x384: one camera pixel
+// spans ~3.3 projector pixels, and the same tolerances hold.
+// Also: the run merges into a rig that holds another projector and keeps it, and 3D
+// content is then placed on the calibrated, non-planar surface (two walls).
 TEST(SimCalibrate, CamerasCoarserThanTheProjector) {
   TempDir dir;
   const std::string scene = sceneFile(dir, 1.0);
@@ -503,217 +428,6 @@ TEST(SimCalibrate, OneCameraIsUnavailable) {
   EXPECT_EQ((*r)["class"], "ERROR");
   EXPECT_EQ((*r)["code"], "unavailable");
   EXPECT_NE((*r)["message"].get<std::string>().find("two"), std::string::npos);
-}
-
-// The calibrated-corner tests: corner_stereo at half resolution, the viewer configured
-// at kCornerEye, the cameras handed over (as an offline camera calibration gives them).
-const Vec3 kCornerEye(-1.6, 0.4, 1.6);
-
-DaemonProcess::Launch cornerWithViewer(const TempDir& dir, const std::string& scene) {
-  dir.write("procamd.toml",
-            "[sim]\nscene = \"" + scene + "\"\n[content]\nviewer = [-1.6, 0.4, 1.6]\n");
-  return DaemonProcess::Launch{{"--config", dir.file("procamd.toml"), "--rig",
-                                truthRigFile(dir, scene, TruthParts::kCamerasOnly)},
-                               {},
-                               -1,
-                               true};
-}
-
-// The first output's status entry once it shows content through the lookup warp.
-std::optional<json> shownByLookupWarp(Connection& c) {
-  json shown;
-  const bool ok = eventually(
-      [&] {
-        auto s = c.call({{"cmd", "status"}});
-        if (!s || (*s)["outputs"]["shown"].empty()) return false;
-        shown = (*s)["outputs"]["shown"][0];
-        return shown["source"] == "content" && shown.value("path", "") == "lookup-warp" &&
-               shown["lit_fraction"].get<double>() > 0;
-      },
-      20s);
-  if (!ok) {
-    ADD_FAILURE() << "no content through the lookup warp: " << shown.dump();
-    return std::nullopt;
-  }
-  return shown;
-}
-
-Mat34 rowMajor34(const json& j) {
-  Mat34 m;
-  for (int i = 0; i < 12; ++i) m(i / 4, i % 4) = j[i].get<double>();
-  return m;
-}
-
-// `label(surface point)` for every pixel of the scene's TRUE projector whose ray meets a
-// TRUE surface (0 elsewhere), as a CV_16S image of the projector's size.
-template <class Label>
-cv::Mat labelTrueSurface(const std::string& scene, Label label) {
-  auto truth = sim::Scene::load(scene);
-  EXPECT_TRUE(truth) << truth.error().message;
-  if (!truth) return {};
-  const sim::SceneState state = truth->at(0);
-  const auto& proj = state.projectors.at(0);
-  const Mat34 P = proj.model.projectionMatrix();
-  const Mat3 Minv = P.leftCols<3>().inverse();
-  const Vec3 C = -Minv * P.col(3);
-  cv::Mat labels(proj.spec.height, proj.spec.width, CV_16S, cv::Scalar(0));
-  for (int y = 0; y < labels.rows; ++y) {
-    for (int x = 0; x < labels.cols; ++x) {
-      const auto hit = truth->world().intersect({C, (Minv * Vec3(x, y, 1)).normalized()});
-      if (hit) labels.at<int16_t>(y, x) = static_cast<int16_t>(label(hit->hit.point));
-    }
-  }
-  return labels;
-}
-
-// Fraction of pixels within 2 px of a change of label: where two renderings of the same
-// geometry may legitimately differ.
-double edgeBand(const cv::Mat& labels) {
-  cv::Mat lo, hi;
-  const cv::Mat k = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(5, 5));
-  cv::erode(labels, lo, k);
-  cv::dilate(labels, hi, k);
-  return cv::countNonZero(lo != hi) / double(labels.total());
-}
-
-// End to end with nothing taken from truth but the cameras (calibrated beforehand, as
-// procam-calibrate gives them): calibrate finds the projector and the two walls, image
-// content is then drawn for the configured viewer by the lookup warp ([Raskar02] §4.1.5),
-// and the frame the output shows matches a double-precision ray cast of the TRUE projector
-// and walls: each projector pixel shows the content pixel where the viewer's ray through its
-// wall point meets the content's plane (the viewer matrix the daemon reports: where the
-// content is placed is its choice, not a fact of the rig). Tolerance: pixels within 2 px of
-// a colour boundary of the ray cast (1 px of bilinear resampling, 0.5 px of calibration
-// error: 2 mm at 3 m, 0.5 px of linear interpolation between the warp's 8 px nodes).
-TEST(SimCalibrate, ImageContentOnTheCalibratedCornerMatchesTheTrueRig) {
-  TempDir dir;
-  const std::string scene = sceneFile(dir);
-  DaemonProcess d(dir, cornerWithViewer(dir, scene));
-  ASSERT_TRUE(d.started()) << d.log();
-  Connection c(d.socketPath());
-  ASSERT_NO_FATAL_FAILURE(calibrateToTheEnd(c, d));
-
-  // Content: left half red, right half blue.
-  constexpr int kW = 320, kH = 200;
-  cv::Mat bgr(kH, kW, CV_8UC3, cv::Scalar(0, 0, 255));
-  bgr(cv::Rect(kW / 2, 0, kW / 2, kH)).setTo(cv::Scalar(255, 0, 0));
-  const std::string png = contentFile(dir, "halves.png");
-  ASSERT_TRUE(cv::imwrite(png, bgr));
-  auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", png}}, 30s);
-  ASSERT_TRUE(load);
-  ASSERT_EQ((*load)["class"], "CONTENT") << load->dump();
-  const auto shown_now = shownByLookupWarp(c);
-  ASSERT_TRUE(shown_now);
-  const json shown = *shown_now;
-  EXPECT_EQ(shown["chosen_path"], "lookup-warp");
-  ASSERT_EQ(shown["viewer_matrix"].size(), 12u) << shown.dump();
-  const Mat34 V = rowMajor34(shown["viewer_matrix"]);
-
-  // The true rig: 1 red, 2 blue, 0 dark.
-  const cv::Mat cls = labelTrueSurface(scene, [&](const Vec3& point) {
-    const Vec3 q = V * point.homogeneous();
-    if (q.z() <= 0) return 0;
-    const double u = q.x() / q.z(), v = q.y() / q.z();
-    if (u < -0.5 || u >= kW - 0.5 || v < -0.5 || v >= kH - 0.5) return 0;
-    return u < kW / 2 - 0.5 ? 1 : 2;
-  });
-  ASSERT_FALSE(cls.empty());
-  const double n = double(cls.total());
-  const double red = cv::countNonZero(cls == 1) / n, blue = cv::countNonZero(cls == 2) / n;
-  const double band = edgeBand(cls);
-  const double lit = shown["lit_fraction"].get<double>();
-  const double r = shown["mean_rgb"][0].get<double>(), b = shown["mean_rgb"][2].get<double>();
-  std::printf(
-      "[ figures  ] lookup warp on the calibrated corner: lit %.5f (true rig %.5f), red %.3f "
-      "(%.3f), blue %.3f (%.3f), 2 px edge band %.5f\n",
-      lit, red + blue, r, 255 * red, b, 255 * blue, band);
-  EXPECT_GT(red, 0.05);
-  EXPECT_GT(blue, 0.05);
-  EXPECT_NEAR(lit, red + blue, band);
-  EXPECT_NEAR(r, 255 * red, 255 * band);
-  EXPECT_NEAR(b, 255 * blue, 255 * band);
-  EXPECT_EQ(shown["mean_rgb"][1].get<double>(), 0.0);
-}
-
-// 3D content on the calibrated corner, end to end with nothing from truth but the
-// cameras: the cube is placed on the plane through the calibrated surface at the projector's
-// centre, inside the content image the viewer sees (content/mesh_placement.hpp rules; the
-// plane and image reported), drawn from the viewer and shown through the lookup warp; the frame
-// must match a double-precision ray cast of the TRUE projector and walls: each projector pixel
-// shows the cube face the viewer's ray through its wall point meets, Lambert grey. Tolerance:
-// pixels within 2 px of a change of face (resampling the viewer's image 1 px, calibration 0.5 px,
-// warp interpolation 0.5 px), each worth one pixel of lit fraction and 255 grey, plus 0.5 grey of
-// rounding.
-TEST(SimCalibrate, MeshContentOnTheCalibratedCornerMatchesTheTrueRig) {
-  TempDir dir;
-  const std::string scene = sceneFile(dir);
-  writeContent(dir, "cube.obj",
-               "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\n"
-               "v -1 1 1\nf 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 4 7 3\n"
-               "f 4 8 7\nf 1 5 8\nf 1 8 4\nf 2 3 7\nf 2 7 6\n");
-  DaemonProcess d(dir, cornerWithViewer(dir, scene));
-  ASSERT_TRUE(d.started()) << d.log();
-  Connection c(d.socketPath());
-  ASSERT_NO_FATAL_FAILURE(calibrateToTheEnd(c, d));
-  std::optional<json> load;
-  ASSERT_TRUE(eventually(
-      [&] {
-        load = c.call(
-            {{"cmd", "content"}, {"action", "load"}, {"path", contentFile(dir, "cube.obj")}}, 30s);
-        return load && (*load)["class"] == "CONTENT";
-      },
-      10s))
-      << (load ? load->dump() : "no reply");
-  const json placement = (*load)["content"]["mesh"]["placement"]["proj"];
-  ASSERT_TRUE(placement.is_object()) << load->dump();
-  const auto shown_now = shownByLookupWarp(c);
-  ASSERT_TRUE(shown_now);
-  const json shown = *shown_now;
-
-  // The placement the daemon made, from what it reports (placement is the daemon's
-  // choice, not a fact of the rig): the plane and the viewer's content image.
-  auto cube = content::loadMeshContent(contentFile(dir, "cube.obj"));
-  ASSERT_TRUE(cube);
-  auto vec = [](const json& j) {
-    return Vec3(j[0].get<double>(), j[1].get<double>(), j[2].get<double>());
-  };
-  ASSERT_EQ(placement["viewer_matrix"].size(), 12u) << placement.dump();
-  content::PlanarView view;
-  view.projector = rowMajor34(placement["viewer_matrix"]);
-  view.size = {placement["size"][0].get<int>(), placement["size"][1].get<int>()};
-  view.plane_point = vec(placement["plane_point"]);
-  view.plane_normal = vec(placement["plane_normal"]);
-  view.eye = kCornerEye;
-  auto placed = content::placeMeshContent(*cube, view);
-  ASSERT_TRUE(placed) << placed.error().message;
-
-  // The true rig: each projector pixel's wall point, the viewer's ray through it, the
-  // nearest cube face (label face + 1), Lambert grey.
-  const cv::Mat faces = labelTrueSurface(scene, [&](const Vec3& point) {
-    return nearestFace(placed->mesh, kCornerEye, point - kCornerEye) + 1;
-  });
-  ASSERT_FALSE(faces.empty());
-  const double n = double(faces.total());
-  double lit_true = 0, grey_true = 0;
-  for (int y = 0; y < faces.rows; ++y) {
-    for (int x = 0; x < faces.cols; ++x) {
-      const int face = faces.at<int16_t>(y, x) - 1;
-      if (face < 0) continue;
-      lit_true += 1 / n;
-      grey_true += lambertGrey(*placed, face) / n;
-    }
-  }
-  const double band = edgeBand(faces);
-  const double lit = shown["lit_fraction"].get<double>();
-  std::printf(
-      "[ figures  ] cube on the calibrated corner (lookup warp): lit %.5f (true rig %.5f), "
-      "mean grey %.3f (%.3f), 2 px edge band %.5f\n",
-      lit, lit_true, shown["mean_rgb"][0].get<double>(), grey_true, band);
-  ASSERT_GT(lit_true, 0.01);  // the cube is in view
-  EXPECT_NEAR(lit, lit_true, band);
-  for (int ch = 0; ch < 3; ++ch) {
-    EXPECT_NEAR(shown["mean_rgb"][ch].get<double>(), grey_true, 255 * band + 0.5) << ch;
-  }
 }
 
 }  // namespace
