@@ -64,7 +64,11 @@ TEST(SimTracker, PositionsFollowTheSceneTruthWithinItsNoise) {
   double sum_sq = 0;
   int n = 0;
   double last_time = -1;
-  for (int i = 0; i < 25; ++i) {
+  // Distinct samples are collected until 20 or 15 s: a loaded machine may
+  // deliver fewer new readings per poll, which is not what this test measures.
+  const auto deadline = std::chrono::steady_clock::now() + 15s;
+  while (n < 20 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(40ms);
     auto t = trackerEntry(c);
     ASSERT_TRUE(t);
     ASSERT_TRUE((*t)["registration"].is_null());
@@ -79,7 +83,6 @@ TEST(SimTracker, PositionsFollowTheSceneTruthWithinItsNoise) {
     for (int a = 0; a < 3; ++a) EXPECT_LT(std::abs(pos[a] - truth[a]), 5 * kNoiseSigmaM) << a;
     sum_sq += (pos - truth).squaredNorm();
     ++n;
-    std::this_thread::sleep_for(40ms);
   }
   ASSERT_GT(n, 15);
   // 3D error: RMS sqrt(3) sigma; twice that bounds it for 15+ samples.
