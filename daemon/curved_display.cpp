@@ -68,6 +68,10 @@ std::string curvedKey(cv::Size content, const Vec3& eye, const std::vector<Curve
 
 const KeystoneRuntime::Curved* Daemon::curvedDisplay(cv::Size content, const ViewerEye& eye) {
   KeystoneRuntime& k = keystone_rt_;
+  // A new rig model whose meshes are still being read: the display made for the last one
+  // stays until they are (a projector's new pose with its old mesh would be solved and
+  // shown for nothing).
+  if (rig_surfaces_loading_ && k.curved) return k.curved.get();
   std::vector<CurvedInput> inputs;
   for (const auto& e : devices_.entries()) {
     if (e.description.family != PROCAM_FAMILY_OUTPUT || !e.usable()) continue;
@@ -102,8 +106,9 @@ const KeystoneRuntime::Curved* Daemon::curvedDisplay(cv::Size content, const Vie
   k.curving = true;
   const std::string what = dome ? "dome display" : "display";
   logInfo(what + " across " + std::to_string(inputs.size()) + " outputs on the surface: solving");
+  const auto solving = std::chrono::steady_clock::now();
   compute_worker_->submit(
-      [this, key, content, inputs, eye, dome, what] {
+      [this, key, content, inputs, eye, dome, what, solving] {
         auto made = std::make_shared<KeystoneRuntime::Curved>();
         std::vector<blend::SurfaceProjector> projectors;
         std::vector<std::optional<blend::ProjectorResponse>> responses;
@@ -141,14 +146,16 @@ const KeystoneRuntime::Curved* Daemon::curvedDisplay(cv::Size content, const Vie
         } else {
           error = blended.error().message;
         }
-        return [this, key, made, error, what] {
+        const double solved_s =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - solving).count();
+        return [this, key, made, error, what, solved_s] {
           KeystoneRuntime& k = keystone_rt_;
           k.curving = false;
           if (key == k.curved_key) {
             if (error.empty()) {
               k.curved = made;
               logInfo(what + " across " + std::to_string(made->outputs.size()) +
-                      " outputs on the surface: ready");
+                      " outputs on the surface: ready (" + std::to_string(solved_s) + " s)");
             } else {
               k.curved.reset();
               k.curved_error = error;

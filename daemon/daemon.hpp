@@ -282,11 +282,25 @@ class Daemon {
   // daemon_drift.cpp: recalibrate = "on-drift" on a fixed rig.
   void setupDriftCheck();
   void checkDrift();
+  // The check of `out` by `camera` (null: its cameras in turn, a fiducial frame where one
+  // is due); nullopt when it is not checked now (o.unavailable says why when it is not
+  // checked at all).
+  std::optional<std::pair<DriftCheckPlan, DriftKey>> planDriftCheck(DeviceEntry& out,
+                                                                    const std::string* camera);
   void onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, CalibrationFailure> r);
   // Whether a check may start now.
   bool driftMayRun() const;
   void correctDrift(const std::string& output, const std::string& camera,
                     const drift::Misregistration& m);
+  // A projector's own surface mesh told the pixels that light its vertices after the
+  // projector moved from `before` to `after` (`rays`: its pixel rays before); nullopt
+  // when it has no mesh of its own with pixels. kDegenerate for a vertex behind it.
+  struct MeshRewrite {
+    std::string file, text, before;  // the file's name, its new and its old PLY text
+  };
+  Result<std::optional<MeshRewrite>> ownMeshMoved(const rig::RigProjector& before,
+                                                  const rig::RigProjector& after,
+                                                  const render::PixelRays& rays) const;
   // The output left alone until a check finds it registered: `step` could not be made.
   void unresolveDrift(const std::string& output, const std::string& camera, const std::string& step,
                       const std::string& why, const drift::Misregistration& m);
@@ -344,9 +358,9 @@ class Daemon {
                    const drift::Misregistration& m, const CalibrationPlan& plan,
                    const CalibrationOutcome& r, DriftRuntime::Clock::time_point started_at,
                    const std::function<void(const CalibrationFailure*)>& finish);
-  // The cameras that check `projector` (mapped onto the plane by `tile`).
-  std::vector<const rig::RigCamera*> driftCameras(const rig::RigProjector& projector,
-                                                  const geom::PlaneHomography& tile) const;
+  // The cameras that check a projector: those that see `centre`, the surface point the
+  // middle of its frame lights.
+  std::vector<const rig::RigCamera*> driftCameras(const Vec3& centre) const;
   nlohmann::json driftJson(const std::string& output) const;  // null when the policy is off
   nlohmann::json driftPolicyJson() const;
 
@@ -377,6 +391,9 @@ class Daemon {
   rig::RigModel rig_;  // the state directory's rig.json: the only source of geometry
   // rig_'s surface meshes by projector name ("" for the unified mesh).
   std::map<std::string, std::shared_ptr<const RigSurfaceMesh>> rig_surfaces_;
+  // The rig's mesh files are being read for a new rig model: rig_surfaces_ may still be
+  // the old model's, so no display is solved from them and no drift check is made.
+  bool rig_surfaces_loading_ = false;
   uint64_t rig_generation_ = 0;
   // rigResponse's, by projector name, for rig_generation_ rig_responses_generation_.
   mutable std::map<std::string, RigResponse> rig_responses_;

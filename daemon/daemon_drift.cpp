@@ -54,14 +54,10 @@ void Daemon::setupDriftCheck() {
   d.timer = *timer;
 }
 
-std::vector<const rig::RigCamera*> Daemon::driftCameras(const rig::RigProjector& projector,
-                                                        const geom::PlaneHomography& tile) const {
+std::vector<const rig::RigCamera*> Daemon::driftCameras(const Vec3& centre) const {
   // Posed cameras standing on their own (one mounted on a projector moves with it) that
-  // are open and see the centre of the projector's frame.
+  // are open and see the surface point the centre of the projector's frame lights.
   std::vector<const rig::RigCamera*> out;
-  const Vec3 c = tile.H * Vec3((projector.width - 1) / 2.0, (projector.height - 1) / 2.0, 1.0);
-  if (!(std::abs(c.z()) > 1e-12)) return out;
-  const Vec3 centre = tile.basis.toWorld({c.x() / c.z(), c.y() / c.z()});
   for (const rig::RigCamera& cam : rig_.cameras) {
     if (!cam.pose_known || !cam.attached_to.empty()) continue;
     const DeviceEntry* e = const_cast<DeviceSet&>(devices_).find(cam.name);
@@ -82,9 +78,9 @@ bool Daemon::driftMayRun() const {
 
 void Daemon::checkDrift() {
   DriftRuntime& d = drift_rt_;
-  KeystoneRuntime& k = keystone_rt_;
   if (d.checking || d.writing || !driftMayRun()) return;
-  // The outputs in turn, one check at a time: the worker also draws the frames.
+  // One check at a time (the worker also draws the frames), led by the outputs in turn:
+  // the lead's camera (its cameras in turn) captures once for every output it sees.
   std::vector<DeviceEntry*> outputs;
   for (auto& e : devices_.entries()) {
     if (e.description.family == PROCAM_FAMILY_OUTPUT && e.usable()) outputs.push_back(&e);
@@ -95,12 +91,58 @@ void Daemon::checkDrift() {
     it = open ? std::next(it) : d.outputs.erase(it);
   }
   if (outputs.empty()) return;
-  DeviceEntry& out = *outputs[d.next++ % outputs.size()];
+  const std::size_t lead = d.next++ % outputs.size();
+  auto first = planDriftCheck(*outputs[lead], nullptr);
+  if (!first) return;
+  std::vector<DriftCheckPlan> plans;
+  std::vector<DriftKey> keys;
+  plans.push_back(std::move(first->first));
+  keys.push_back(std::move(first->second));
+  const bool fiducial = plans[0].fiducial != nullptr;
+  for (std::size_t i = 1; i < outputs.size() && !fiducial; ++i) {
+    auto more = planDriftCheck(*outputs[(lead + i) % outputs.size()], &keys[0].camera);
+    if (!more) continue;
+    plans.push_back(std::move(more->first));
+    keys.push_back(std::move(more->second));
+  }
+  // The device manager keeps off the camera while the check drives it.
+  d.camera_in_use = keys[0].camera;
+  d.checking = true;
+  const std::string name = keys[0].output;
+  compute_worker_->submit(
+      [this, plans = std::move(plans), keys] {
+        auto r = runDriftChecks(plans);
+        return [this, keys, r = std::move(r)]() mutable {
+          DriftRuntime& d = drift_rt_;
+          d.checking = false;
+          d.camera_in_use.clear();
+          for (std::size_t i = 0; i < keys.size(); ++i) {
+            // A correction or scan one output's check began changes the rig under the
+            // others': theirs wait for the next check.
+            if (i > 0 && (d.writing || !calibration_.op.empty())) break;
+            onDriftChecked(keys[i], std::move(r[i]));
+          }
+          endFiducialFrame(keys[0].output);
+        };
+      },
+      [this, name](const std::string& what) {
+        drift_rt_.checking = false;
+        drift_rt_.camera_in_use.clear();
+        warn("drift check of output '" + name + "' failed: " + what);
+        endFiducialFrame(name);
+      });
+}
+
+std::optional<std::pair<DriftCheckPlan, DriftKey>> Daemon::planDriftCheck(
+    DeviceEntry& out, const std::string* camera) {
+  DriftRuntime& d = drift_rt_;
+  KeystoneRuntime& k = keystone_rt_;
   DriftRuntime::Output& o = d.outputs[out.name];
   const auto unavailable = [&](std::string why) {
     o.unavailable = std::move(why);
     o.camera.clear();
     o.forgetDrift();
+    return std::nullopt;
   };
   const rig::RigProjector* p = rig_.projectorForOutput(out.name);
   if (!p) return unavailable("the rig model has no projector for the output");
@@ -110,9 +152,29 @@ void Daemon::checkDrift() {
   if (live_content_ && !live_content_->ended) {
     return unavailable("streamed content: the frame changes between camera frames");
   }
-  auto tile = blend::displayTile(*p, rig_.surface);
-  if (!tile) return unavailable("not mapped onto a display plane: " + tile.error().message);
-  const auto cams = driftCameras(*p, tile->projector_to_plane);
+  // The surface the output draws on: a plane, or a mesh (sceneTraits, as the frames).
+  const bool curved = sceneTraits(out.name, false).surface == render::SurfaceKind::kNonPlanar;
+  Result<blend::DisplayTile> tile = fail(ErrorCode::kNotFound, "a curved surface");
+  std::shared_ptr<const RigSurfaceMesh> mesh;
+  std::optional<Vec3> centre;
+  const Vec2 middle((p->width - 1) / 2.0, (p->height - 1) / 2.0);
+  if (curved) {
+    if (rig_surfaces_loading_) return std::nullopt;  // the new rig's meshes, not the old
+    mesh = rigSurfaceFor(p->name);
+    if (!mesh) return unavailable("the rig's surface mesh is not loaded");
+    if (!p->pose_known || !p->intrinsics_known) {
+      return unavailable("on a surface mesh the projector's pose and intrinsics are needed");
+    }
+    auto ray = p->model().backproject(middle);
+    auto hit = ray ? mesh->intersector.intersect(*ray) : std::nullopt;
+    if (hit) centre = hit->point;
+  } else {
+    tile = blend::displayTile(*p, rig_.surface);
+    if (!tile) return unavailable("not mapped onto a display plane: " + tile.error().message);
+    const Vec3 c = tile->projector_to_plane.H * middle.homogeneous();
+    if (std::abs(c.z()) > 1e-12) centre = tile->projector_to_plane.basis.toWorld(c.hnormalized());
+  }
+  const auto cams = centre ? driftCameras(*centre) : std::vector<const rig::RigCamera*>{};
   if (cams.empty())
     return unavailable("no open, posed, fixed camera of the rig model sees the frame");
   o.cameras.clear();
@@ -121,7 +183,19 @@ void Daemon::checkDrift() {
     const bool sees = std::find(o.cameras.begin(), o.cameras.end(), v->first) != o.cameras.end();
     v = sees ? std::next(v) : o.views.erase(v);
   }
-  const rig::RigCamera* cam = cams[o.next_camera++ % cams.size()];
+  const rig::RigCamera* cam = nullptr;
+  if (camera) {
+    // Another output's check captures with this camera: this one's is measured too
+    // where the camera sees it.
+    for (const rig::RigCamera* c : cams) {
+      if (c->name == *camera) cam = c;
+    }
+    if (!cam) return std::nullopt;
+  } else {
+    // The cameras in turn from one check to the next, whichever output leads: a drift one
+    // camera saw is confirmed or told apart by another's check soon after.
+    cam = cams[d.next_camera++ % cams.size()];
+  }
   auto st = k.output_state.find(out.name);
   if (st == k.output_state.end() || !st->second.shown_image || !st->second.shown_setup) {
     return unavailable("nothing shown yet");
@@ -129,13 +203,15 @@ void Daemon::checkDrift() {
   // The camera must see the frame drawn, not the one before it: a frame's latency to
   // the camera is a few output frames ([calibration] settle_frames, as calibrate waits).
   const double settle = std::max(0.1, (config_.calibration.settle_frames + 2) / 60.0);
-  if (secondsSince(st->second.shown_at) < settle) return;
+  if (secondsSince(st->second.shown_at) < settle) return std::nullopt;
   // Nor the fiducial frame a check showed before the content came back.
-  if (o.fiducial_at && secondsSince(*o.fiducial_at) < settle) return;
+  if (o.fiducial_at && secondsSince(*o.fiducial_at) < settle) return std::nullopt;
   o.unavailable.clear();
-  o.camera = cam->name;
   DeviceEntry* cam_entry = devices_.find(cam->name);
-  const bool fiducial = fiducialDue(o, o.views[cam->name], st->second, {p->width, p->height});
+  // Fiducial frames are registered through the display plane: none on a mesh, nor for an
+  // output measured in another's capture.
+  const bool fiducial =
+      !mesh && !camera && fiducialDue(o, o.views[cam->name], st->second, {p->width, p->height});
   DriftCheckPlan plan;
   plan.output = out.name;
   plan.camera = {cam->name, cam_entry->device.share()};
@@ -144,7 +220,13 @@ void Daemon::checkDrift() {
   plan.image = st->second.shown_image;
   plan.rig_generation = rig_generation_;
   plan.framebuffer = {p->width, p->height};
-  plan.projector_to_plane = tile->projector_to_plane;
+  if (mesh) {
+    plan.surface_mesh = std::shared_ptr<const geom::MeshIntersector>(mesh, &mesh->intersector);
+    plan.projector_model = p->model();
+    plan.own_mesh = rig_surfaces_.count(p->name) > 0;
+  } else {
+    plan.projector_to_plane = tile->projector_to_plane;
+  }
   plan.camera_model = cam->model;
   plan.frames = config_.drift.frames;
   if (fiducial) {
@@ -154,26 +236,9 @@ void Daemon::checkDrift() {
     plan.settle_s = settle;
     d.fiducial_showing = true;
   }
-  // The device manager keeps off the camera while the check drives it.
-  d.camera_in_use = cam->name;
   plan.fence = device_manager_->readFence({cam->name});
-  const DriftKey key{out.name,   cam->name,           plan.setup,
-                     plan.image, st->second.shown_at, rig_generation_};
-  d.checking = true;
-  compute_worker_->submit(
-      [this, plan = std::move(plan), key] {
-        auto r = runDriftCheck(plan);
-        return [this, key, r = std::move(r)]() mutable {
-          onDriftChecked(key, std::move(r));
-          endFiducialFrame(key.output);
-        };
-      },
-      [this, name = out.name](const std::string& what) {
-        drift_rt_.checking = false;
-        drift_rt_.camera_in_use.clear();
-        warn("drift check of output '" + name + "' failed: " + what);
-        endFiducialFrame(name);
-      });
+  DriftKey key{out.name, cam->name, plan.setup, plan.image, st->second.shown_at, rig_generation_};
+  return std::make_pair(std::move(plan), std::move(key));
 }
 
 bool Daemon::fiducialDue(DriftRuntime::Output& o, const DriftRuntime::View& view,
@@ -286,7 +351,7 @@ void Daemon::onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, Calibr
       if (o.scan != DriftScan::kNone) event["scan"] = driftScanName(o.scan);
       broadcast("drift", event);
       o.passes = 0;
-      o.before.reset();
+      o.forgetBefore();
     }
     if (!m.too_plain && !o.drifted()) o.scan = DriftScan::kNone;
     if (!m.too_plain) o.unresolved = false;

@@ -9,6 +9,7 @@
 #include "drift/fiducial_misregistration.hpp"
 #include "protocol.hpp"
 #include "render/cpu_renderer.hpp"
+#include "render/post_render_warp.hpp"
 
 namespace procam::daemon {
 
@@ -20,6 +21,30 @@ namespace {
 // than the projector, so the full grid adds work and no information.
 constexpr int kGridFactor = 2;
 constexpr double kMinSeenShare = 0.1;
+
+// Where the framebuffer lights the display surface by the rig model: the plane's
+// collineation, or the projector's pixel rays through its post-rendering warp meeting the
+// mesh, the frame drawn by the lookup warp or two-pass path having gone through the same.
+Result<void> litSurface(const DriftCheckPlan& plan, DriftReference& ref) {
+  if (!plan.surface_mesh) {
+    ref.lit = drift::planeLitSurface(plan.projector_to_plane, plan.framebuffer);
+    return {};
+  }
+  auto warp = render::projectorPostRenderWarp(plan.projector_model,
+                                              plan.own_mesh ? &plan.surface_mesh->mesh() : nullptr);
+  if (!warp) return fail(warp.error().code, "post-rendering warp: " + warp.error().message);
+  std::shared_ptr<const render::WarpGrid> grid;
+  if (*warp) grid = std::shared_ptr<const render::WarpGrid>(*warp, &(*warp)->grid);
+  auto rays = render::pixelRays(plan.projector_model.projectionMatrix(), grid);
+  if (!rays) return tl::unexpected(rays.error());
+  ref.rays = std::make_shared<const render::PixelRays>(std::move(*rays));
+  ref.lit.occluder = plan.surface_mesh;
+  ref.lit.point = [rays = ref.rays, mesh = plan.surface_mesh](const Vec2& fb) {
+    auto hit = mesh->intersect(rays->through(fb.x(), fb.y()));
+    return hit ? std::optional<Vec3>(hit->point) : std::nullopt;
+  };
+  return {};
+}
 
 tl::expected<std::shared_ptr<const DriftReference>, CalibrationFailure> makeReference(
     const DriftCheckPlan& plan) {
@@ -56,7 +81,8 @@ tl::expected<std::shared_ptr<const DriftReference>, CalibrationFailure> makeRefe
     cv::erode(full, full, cv::Mat(), cv::Point(-1, -1), kGridFactor);
     cv::resize(full, ref->usable, ref->grid.size(), 0, 0, cv::INTER_NEAREST);
   }
-  auto map = drift::projectorCameraMap(plan.projector_to_plane, plan.camera_model, ref->grid);
+  if (auto lit = litSurface(plan, *ref); !lit) return failed(lit.error().message);
+  auto map = drift::projectorCameraMap(ref->lit, plan.camera_model, ref->grid);
   if (!map) return failed(map.error().message);
   ref->map = std::move(*map);
   cv::Mat x;
@@ -193,6 +219,46 @@ tl::expected<DriftCheck, CalibrationFailure> runDriftCheck(const DriftCheckPlan&
   }
   out.misregistration = std::move(*m);
   out.seconds = since(start);
+  return out;
+}
+
+std::vector<tl::expected<DriftCheck, CalibrationFailure>> runDriftChecks(
+    const std::vector<DriftCheckPlan>& plans) {
+  std::vector<tl::expected<DriftCheck, CalibrationFailure>> out;
+  if (plans.size() == 1 || (!plans.empty() && plans[0].fiducial)) {
+    out.push_back(runDriftCheck(plans[0]));
+    return out;
+  }
+  const auto start = Clock::now();
+  std::vector<DriftCheck> checks(plans.size());
+  std::vector<std::optional<CalibrationFailure>> failed(plans.size());
+  for (std::size_t i = 0; i < plans.size(); ++i) {
+    if (auto ok = reference(plans[i], checks[i], Clock::now()); !ok) failed[i] = ok.error();
+  }
+  const auto capture = Clock::now();
+  auto mean = captureMean(plans[0]);
+  const double capture_s = since(capture);
+  for (std::size_t i = 0; i < plans.size(); ++i) {
+    if (!mean) failed[i] = mean.error();
+    if (failed[i]) {
+      out.push_back(tl::unexpected(*failed[i]));
+      continue;
+    }
+    DriftCheck& c = checks[i];
+    c.capture_s = capture_s;
+    const auto measure = Clock::now();
+    const DriftReference& ref = *c.reference;
+    auto m = drift::measureMisregistration(ref.shown, *mean, ref.map, ref.grid, {}, ref.usable);
+    c.measure_s = since(measure);
+    if (!m) {
+      out.push_back(tl::unexpected(CalibrationFailure{
+          code::kFailed, "drift check of output '" + plans[i].output + "': " + m.error().message}));
+      continue;
+    }
+    c.misregistration = std::move(*m);
+    c.seconds = since(start);
+    out.push_back(std::move(c));
+  }
   return out;
 }
 

@@ -15,6 +15,7 @@
 #include "drift_fiducial.hpp"
 #include "read_fence.hpp"
 #include "render/render_setup.hpp"
+#include "render/viewer_view.hpp"
 
 namespace procam::daemon {
 
@@ -30,6 +31,9 @@ struct DriftReference {
   cv::Mat map;            // grid -> camera pixels
   cv::Mat usable;         // CV_8U of the grid: 0 where the frame is blended with a neighbour's
   double seen_share = 0;  // of the grid the camera sees
+  drift::LitSurface lit;  // where the rig model says the framebuffer lights the surface
+  // On a mesh: the projector's pixel rays (its pinhole and post-rendering warp).
+  std::shared_ptr<const render::PixelRays> rays;
 };
 
 struct DriftCheckPlan {
@@ -41,7 +45,13 @@ struct DriftCheckPlan {
   std::shared_ptr<const cv::Mat> image;  // RGBA content of the frame
   uint64_t rig_generation = 0;
   cv::Size framebuffer;  // the rig model's, which the frame must have
+  // The display surface: a plane by the projector's collineation with it, or, set, a mesh
+  // that the projector's pixel rays meet (through the post-rendering warp of its lens or
+  // of `own_mesh`'s pixels, [Raskar02] §4.1.3, as the output draws it).
   geom::PlaneHomography projector_to_plane;
+  std::shared_ptr<const geom::MeshIntersector> surface_mesh;
+  geom::CameraModel projector_model;
+  bool own_mesh = false;
   geom::CameraModel camera_model;
   int frames = 2;  // camera frames averaged
   // Waited on before the first capture: the device manager's reads of the camera end.
@@ -71,7 +81,14 @@ bool referenceFits(const DriftCheckPlan& plan);
 // The camera's failures (kIo, kNoDevice, ...); the output's, showing a fiducial frame;
 // kFailed when the frame cannot be drawn again, it is not the rig model's framebuffer
 // size, the camera's frames have another size than the rig model's, it sees too little
-// of the frame (under 10 %) or a fiducial frame's tags cannot be looked for.
+// of the frame (under 10 %), a fiducial frame's tags cannot be looked for or a mesh's
+// post-rendering warp cannot be made.
 tl::expected<DriftCheck, CalibrationFailure> runDriftCheck(const DriftCheckPlan& plan);
+
+// The checks of several outputs by one camera (every plan's): the references made, one
+// capture, each output measured in it; one result per plan, in order. A fiducial check
+// (the first plan's) runs alone.
+std::vector<tl::expected<DriftCheck, CalibrationFailure>> runDriftChecks(
+    const std::vector<DriftCheckPlan>& plans);
 
 }  // namespace procam::daemon

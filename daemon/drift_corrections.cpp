@@ -15,6 +15,7 @@
 #include "log.hpp"
 #include "protocol.hpp"
 #include "rig_store.hpp"
+#include "surface/surface_model.hpp"
 
 namespace procam::daemon {
 
@@ -184,7 +185,7 @@ void Daemon::correctSurface(const std::string& output, const std::string& camera
   rig::RigModel update = std::move(*made);
   // The wall is measured, not fitted by passes: what was kept to restore after
   // corrections that do not converge belonged to the old wall and cannot come back.
-  o.before.reset();
+  o.forgetBefore();
   json why = heldOver(m, held, config_.drift.threshold_px);
   why.update({{"wall_offset_mm", 1e3 * wall.offset_m},
               {"wall_offset_se_mm", 1e3 * wall.offset_se_m},
@@ -220,6 +221,32 @@ void Daemon::unresolveDrift(const std::string& output, const std::string& camera
                       {"check", misregistrationJson(m)}});
 }
 
+Result<std::optional<Daemon::MeshRewrite>> Daemon::ownMeshMoved(
+    const rig::RigProjector& before, const rig::RigProjector& after,
+    const render::PixelRays& rays) const {
+  auto file = rig_.surface.meshes.find(before.name);
+  auto loaded = rig_surfaces_.find(before.name);
+  if (file == rig_.surface.meshes.end() || loaded == rig_surfaces_.end()) return std::nullopt;
+  const geom::TriangleMesh& mesh = loaded->second->intersector.mesh();
+  if (mesh.uv.size() != mesh.vertices.size()) return std::nullopt;  // no pixels to move
+  // The lens is the projector's: framebuffer pixel m still shows pinhole pixel W(m)
+  // ([Raskar02] §4.1.3), so the pixel that lights vertex X now is W^-1(P' X).
+  const Mat34 P = after.model().projectionMatrix();
+  surface::SurfaceMesh was, moved;
+  was.vertices = moved.vertices = mesh.vertices;
+  was.faces = moved.faces = mesh.faces;
+  was.projector = mesh.uv;
+  for (const Vec3& X : mesh.vertices) {
+    const Vec3 q = P * X.homogeneous();
+    if (!(q.z() > 0)) {
+      return fail(ErrorCode::kDegenerate,
+                  "a vertex of the projector's mesh is behind it in its new pose");
+    }
+    moved.projector.push_back(rays.toFramebuffer(q.hnormalized()));
+  }
+  return MeshRewrite{file->second, surface::toPly(moved), surface::toPly(was)};
+}
+
 void Daemon::correctDrift(const std::string& output, const std::string& camera,
                           const drift::Misregistration& m) {
   DriftRuntime::Output& o = drift_rt_.outputs[output];
@@ -229,14 +256,30 @@ void Daemon::correctDrift(const std::string& output, const std::string& camera,
   const auto giveUp = [&](const std::string& why) {
     escalateDrift(output, camera, "projector-pose", why, m);
   };
-  auto tile = blend::displayTile(*p, rig_.surface);
-  if (!tile) return giveUp(tile.error().message);
-  auto c = drift::correctProjector(*p, tile->projector_to_plane, m);
-  if (!c) return giveUp("the projector's pose from the content: " + c.error().message);
+  const DriftRuntime::View& v = o.views[camera];
+  std::map<std::string, std::string> meshes;
+  std::optional<MeshRewrite> rewrite;
+  Result<drift::ProjectorCorrection> c = fail(ErrorCode::kNotFound, "");
+  if (v.reference && v.reference->rays) {
+    // A surface mesh: the pose from the points the content landed on, and the
+    // projector's own mesh, if it has one, told the pixels that light it now.
+    c = drift::correctProjector(*p, v.reference->lit, m);
+    if (!c) return giveUp("the projector's pose from the content: " + c.error().message);
+    auto moved = ownMeshMoved(*p, c->projector, *v.reference->rays);
+    if (!moved) return giveUp("the projector's mesh: " + moved.error().message);
+    rewrite = std::move(*moved);
+    if (rewrite) meshes[rewrite->file] = rewrite->text;
+  } else {
+    auto tile = blend::displayTile(*p, rig_.surface);
+    if (!tile) return giveUp(tile.error().message);
+    c = drift::correctProjector(*p, tile->projector_to_plane, m);
+    if (!c) return giveUp("the projector's pose from the content: " + c.error().message);
+  }
   rig::RigModel update;
   update.projectors.push_back(c->projector);
   update.projectors.back().calibrated = fromContent(c->tiles);
   keepBefore(o, *p, nullptr);
+  if (rewrite) o.before_meshes.emplace(rewrite->file, std::move(rewrite->before));
   // Cameras mounted on the projector moved with it.
   for (const rig::RigCamera& cam : rig_.cameras) {
     if (cam.attached_to != p->name || !cam.pose_known || !p->pose_known) continue;
@@ -248,15 +291,16 @@ void Daemon::correctDrift(const std::string& output, const std::string& camera,
   logInfo("drift: output '" + output + "': correcting projector '" + p->name +
           "' from the content (" + std::to_string(m.rms_px) + " px held " + std::to_string(held) +
           " s; " + std::to_string(c->tiles) + " tiles, pose fit " + std::to_string(c->pose_rms_px) +
-          " px)");
-  writeDriftCorrection(output, std::move(update),
-                       {{"output", output},
-                        {"projector", p->name},
-                        {"step", "projector-pose"},
-                        {"why", why},
-                        {"tiles", c->tiles},
-                        {"pose_fit_px", c->pose_rms_px}},
-                       "corrected-pose");
+          " px" + (meshes.empty() ? "" : "; its mesh's pixels moved with it") + ")");
+  json event = {{"output", output},
+                {"projector", p->name},
+                {"step", "projector-pose"},
+                {"why", why},
+                {"tiles", c->tiles},
+                {"pose_fit_px", c->pose_rms_px},
+                {"surface", v.reference && v.reference->rays ? "mesh" : "plane"}};
+  writeDriftCorrection(output, std::move(update), std::move(event), "corrected-pose",
+                       std::move(meshes));
 }
 
 void Daemon::correctCamera(const std::string& output, const std::string& camera,
@@ -271,10 +315,9 @@ void Daemon::correctCamera(const std::string& output, const std::string& camera,
   const auto giveUp = [&](const std::string& why) {
     unresolveDrift(output, camera, "camera-pose", why + "; the rig model stays as it was", m);
   };
-  auto tile = blend::displayTile(*p, rig_.surface);
-  if (!tile) return giveUp(tile.error().message);
-  auto c =
-      drift::correctCamera(*cam, tile->projector_to_plane, m, v.reference->map, v.reference->grid);
+  // The content's surface points: where the rig model says the projector lights them
+  // (its check's, on a plane or a mesh).
+  auto c = drift::correctCamera(*cam, v.reference->lit, m, v.reference->map, v.reference->grid);
   if (!c) return giveUp("the camera's pose from the content: " + c.error().message);
   rig::RigModel update;
   update.cameras.push_back(c->camera);
@@ -310,7 +353,7 @@ void Daemon::abandonDrift(const std::string& output, const std::string& camera,
 void Daemon::restoreBeforeDrift(DriftRuntime::Output& o) {
   if (!o.before) return;
   drift_rt_.writing = true;
-  writeRig(*o.before, {}, [this](const Result<std::string>& written) {
+  writeRig(*o.before, o.before_meshes, [this](const Result<std::string>& written) {
     drift_rt_.writing = false;
     if (!written) {
       warn("drift: the rig model before the corrections: " + written.error().message);
@@ -318,7 +361,7 @@ void Daemon::restoreBeforeDrift(DriftRuntime::Output& o) {
       refreshOutputs();
     }
   });
-  o.before.reset();
+  o.forgetBefore();
 }
 
 void Daemon::writeDriftCorrection(const std::string& output, rig::RigModel update, json event,

@@ -49,7 +49,6 @@ struct DriftRuntime {
     std::string camera;                // the one of the last check
     std::string unavailable;           // why it is not checked (empty: it is)
     std::map<std::string, View> views;
-    uint64_t next_camera = 0;  // round robin over `cameras`
     uint64_t checks = 0;
     uint64_t failures = 0;
     std::string error;        // the last check's failure
@@ -60,6 +59,9 @@ struct DriftRuntime {
     // The projector, cameras mounted on it or a camera re-registered, before the
     // corrections since it was last registered: restored when they do not converge.
     std::optional<rig::RigModel> before;
+    // The surface mesh files those corrections rewrote (a projector's own mesh keeps the
+    // pixels that lit its vertices), as they were: file name -> PLY text.
+    std::map<std::string, std::string> before_meshes;
     // Fiducial frames shown for this output, and when the last one was taken off.
     uint64_t fiducial_checks = 0;
     std::optional<Clock::time_point> fiducial_at;
@@ -79,6 +81,11 @@ struct DriftRuntime {
     void forgetDrift() {
       for (auto& [name, v] : views) v.above.reset();
     }
+    // What was kept to restore is now the rig's own.
+    void forgetBefore() {
+      before.reset();
+      before_meshes.clear();
+    }
   };
   int timer = -1;
   bool checking = false;          // a check on the compute worker
@@ -88,7 +95,8 @@ struct DriftRuntime {
   // The fiducial frames, made once per framebuffer size; why there is none.
   std::map<std::pair<int, int>, std::shared_ptr<const FiducialFrame>> fiducial;
   std::string fiducial_unavailable;
-  uint64_t next = 0;  // round robin over the outputs
+  uint64_t next = 0;         // round robin over the outputs
+  uint64_t next_camera = 0;  // and over the leading output's cameras
   std::map<std::string, Output> outputs;
 };
 

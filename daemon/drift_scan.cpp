@@ -212,7 +212,7 @@ void Daemon::scanForDrift(const std::string& output, const std::string& camera, 
                 }
                 // What was kept to restore is now the scan's.
                 if (auto it = drift_rt_.outputs.find(output); it != drift_rt_.outputs.end()) {
-                  it->second.before.reset();
+                  it->second.forgetBefore();
                 }
                 finish(nullptr);
               });
@@ -288,7 +288,7 @@ void Daemon::scannedWall(const std::string& output, const std::string& camera, D
                          // What was kept to restore is now written with the new wall.
                          if (auto o = drift_rt_.outputs.find(output);
                              o != drift_rt_.outputs.end()) {
-                           o->second.before.reset();
+                           o->second.forgetBefore();
                          }
                          finish(nullptr);
                        });

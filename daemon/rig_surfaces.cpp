@@ -17,8 +17,10 @@ void Daemon::loadRigSurfaces() {
   if (!rig_.surface.unified_mesh.empty()) files[""] = rig_.surface.unified_mesh;
   if (files.empty()) {
     rig_surfaces_.clear();
+    rig_surfaces_loading_ = false;
     return;
   }
+  rig_surfaces_loading_ = true;
   io_worker_->submit(
       [this, generation, files, dir = options_.state_dir] {
         auto loaded =
@@ -50,11 +52,13 @@ void Daemon::loadRigSurfaces() {
           for (const auto& p : *problems) warn(p);
           if (generation != rig_generation_) return;  // the rig changed again meanwhile
           rig_surfaces_ = std::move(*loaded);
+          rig_surfaces_loading_ = false;
           refreshOutputs();
         };
       },
-      [this](const std::string& what) {
+      [this, generation](const std::string& what) {
         warn("the rig's surface meshes were not loaded: " + what);
+        if (generation == rig_generation_) rig_surfaces_loading_ = false;
       });
 }
 

@@ -10,6 +10,16 @@ Result<CameraCorrection> correctCamera(const rig::RigCamera& before,
                                        const geom::PlaneHomography& tile,
                                        const Misregistration& drift, const cv::Mat& map,
                                        const WorkGrid& grid) {
+  if (!tile.H.allFinite()) {
+    return fail(ErrorCode::kInvalidInput, "camera correction: the collineation is not finite");
+  }
+  return correctCamera(before, planeLitSurface(tile, grid.framebuffer), drift, map, grid);
+}
+
+Result<CameraCorrection> correctCamera(const rig::RigCamera& before, const LitSurface& surface,
+                                       const Misregistration& drift, const cv::Mat& map,
+                                       const WorkGrid& grid) {
+  if (!surface.point) return fail(ErrorCode::kInvalidInput, "camera correction: no surface");
   if (!before.pose_known) {
     return fail(ErrorCode::kInvalidInput, "camera correction: the camera has no pose to refine");
   }
@@ -23,12 +33,11 @@ Result<CameraCorrection> correctCamera(const rig::RigCamera& before,
     if (!t.drawn.allFinite() || !t.seen_at.allFinite()) {
       return fail(ErrorCode::kInvalidInput, "camera correction: a tile is not finite");
     }
-    const Vec3 ab = tile.H * Vec3(t.drawn.x(), t.drawn.y(), 1.0);
-    if (!(std::abs(ab.z()) > 1e-12)) continue;
-    const Vec3 X = tile.basis.toWorld({ab.x() / ab.z(), ab.y() / ab.z()});
+    const auto X = surface.point(t.drawn);
+    if (!X || !X->allFinite()) continue;
     auto px = mappedCameraPixel(map, grid.toWork(t.seen_at));
     if (!px) continue;
-    world.push_back(X);
+    world.push_back(*X);
     pixels.push_back(*px);
   }
   if (static_cast<int>(world.size()) < kMinCorrectionTiles) {

@@ -2,9 +2,9 @@
 // A fixed camera that moved, told apart from a moved projector by a second camera that
 // still sees the projector's content where the rig model puts it: the camera's pose is
 // fitted again to the content it sees (PnP from its old pose). The projector is right, so
-// the content drawn at framebuffer pixel p is on the wall where the projector's plane
-// collineation puts p; the moved camera saw it at the camera pixel the drift check's map
-// gives the grid point where it was found. Pure.
+// the content drawn at framebuffer pixel p is on the surface where the rig model puts p
+// (the plane collineation, or p's ray meeting the mesh); the moved camera saw it at the
+// camera pixel the drift check's map gives the grid point where it was found. Pure.
 #include <opencv2/core.hpp>
 
 #include "core/error.hpp"
@@ -27,6 +27,11 @@ struct CameraCorrection {
 // kInvalidInput for a camera without a pose or non-finite input.
 Result<CameraCorrection> correctCamera(const rig::RigCamera& before,
                                        const geom::PlaneHomography& tile,
+                                       const Misregistration& drift, const cv::Mat& map,
+                                       const WorkGrid& grid);
+// `surface`: where the rig model says the projector's pixels light the surface (a mesh's
+// included); errors as above, and kInvalidInput without one.
+Result<CameraCorrection> correctCamera(const rig::RigCamera& before, const LitSurface& surface,
                                        const Misregistration& drift, const cv::Mat& map,
                                        const WorkGrid& grid);
 

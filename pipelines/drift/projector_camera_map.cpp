@@ -1,44 +1,129 @@
 #include "projector_camera_map.hpp"
 
 #include <cmath>
+#include <vector>
 
 namespace procam::drift {
 
-Result<cv::Mat> projectorCameraMap(const geom::PlaneHomography& projector_to_plane,
-                                   const geom::CameraModel& camera, const WorkGrid& grid) {
+namespace {
+
+// A point a camera sees must be the first the surface puts on its ray: a mesh's own
+// points lie on it to rounding, so a hit within this much before the point is the point.
+constexpr double kSelfHitM = 1e-3;
+// A mesh's map: cast every kLattice work pixels, interpolated within kLatticeTolPx camera
+// pixels (a hundredth of the tiles' 0.2 px scatter on a 1 DN camera).
+constexpr int kLattice = 4;
+constexpr double kLatticeTolPx = 0.002;
+
+bool hidden(const geom::MeshIntersector& surface, const geom::CameraModel& camera,
+            const Vec3& point) {
+  const Vec3 c = camera.pose.center();
+  const Vec3 d = point - c;
+  const double dist = d.norm();
+  if (!(dist > 2 * kSelfHitM)) return false;
+  return surface.intersect({c, d / dist}, {1e-9, dist - kSelfHitM}).has_value();
+}
+
+}  // namespace
+
+LitSurface planeLitSurface(const geom::PlaneHomography& projector_to_plane, cv::Size framebuffer) {
+  const Mat3 H = projector_to_plane.H;
+  const geom::PlaneBasis basis = projector_to_plane.basis;
+  // Pixels whose rays miss the plane map to points behind the projector: the
+  // homogeneous scale changes sign from the frame's centre (which lights the plane).
+  const Vec3 centre((framebuffer.width - 1) / 2.0, (framebuffer.height - 1) / 2.0, 1.0);
+  const double lit_sign = (H * centre).z() >= 0 ? 1.0 : -1.0;
+  LitSurface out;
+  out.point = [H, basis, lit_sign](const Vec2& fb) -> std::optional<Vec3> {
+    const Vec3 ab = H * Vec3(fb.x(), fb.y(), 1.0);
+    if (!(ab.z() * lit_sign > 1e-12)) return std::nullopt;  // at or past the plane's horizon
+    return basis.toWorld({ab.x() / ab.z(), ab.y() / ab.z()});
+  };
+  return out;
+}
+
+Result<cv::Mat> projectorCameraMap(const LitSurface& surface, const geom::CameraModel& camera,
+                                   const WorkGrid& grid) {
   if (grid.factor < 1 || grid.factor > 8 || grid.size().width < 1 || grid.size().height < 1) {
     return fail(ErrorCode::kInvalidInput,
                 "drift map: a framebuffer of at least the sampling "
                 "factor (1 to 8) on each side is needed");
   }
-  if (!projector_to_plane.H.allFinite() || !camera.pose.R.allFinite() ||
-      !camera.pose.t.allFinite()) {
+  if (!surface.point) return fail(ErrorCode::kInvalidInput, "drift map: no display surface");
+  if (!camera.pose.R.allFinite() || !camera.pose.t.allFinite()) {
     return fail(ErrorCode::kInvalidInput, "drift map: the rig model's mapping is not finite");
   }
   const cv::Size size = grid.size();
   cv::Mat map(size, CV_32FC2, cv::Scalar(-1, -1));
-  const Mat3& H = projector_to_plane.H;
-  // Pixels whose rays miss the plane map to points behind the projector: the
-  // homogeneous scale changes sign from the frame's centre (which lights the plane).
-  const Vec2 centre = grid.toFramebuffer({size.width / 2.0, size.height / 2.0});
-  const double lit_sign = (H * Vec3(centre.x(), centre.y(), 1.0)).z() >= 0 ? 1.0 : -1.0;
-  for (int y = 0; y < size.height; ++y) {
-    auto* row = map.ptr<cv::Vec2f>(y);
-    for (int x = 0; x < size.width; ++x) {
-      const Vec2 fb = grid.toFramebuffer({x, y});
-      const Vec3 ab = H * Vec3(fb.x(), fb.y(), 1.0);
-      if (!(ab.z() * lit_sign > 1e-12)) continue;  // at or past the plane's horizon
-      const Vec3 world = projector_to_plane.basis.toWorld({ab.x() / ab.z(), ab.y() / ab.z()});
-      const auto px = camera.project(world);
-      // Inside the outermost pixel centres: resampling there reads no pixel off the image.
-      if (!px || !(px->x() >= 0 && px->y() >= 0 && px->x() <= camera.width - 1 &&
-                   px->y() <= camera.height - 1)) {
-        continue;
+  bool finite = true;
+  const auto cast = [&](int x, int y) -> cv::Vec2f {
+    const auto world = surface.point(grid.toFramebuffer({x, y}));
+    if (!world) return {-1, -1};
+    if (!world->allFinite()) {
+      finite = false;
+      return {-1, -1};
+    }
+    const auto px = camera.project(*world);
+    // Inside the outermost pixel centres: resampling there reads no pixel off the image.
+    if (!px || !(px->x() >= 0 && px->y() >= 0 && px->x() <= camera.width - 1 &&
+                 px->y() <= camera.height - 1)) {
+      return {-1, -1};
+    }
+    if (surface.occluder && hidden(*surface.occluder, camera, *world)) return {-1, -1};
+    return {static_cast<float>(px->x()), static_cast<float>(px->y())};
+  };
+  // A plane's map is a collineation, cheap at every pixel. A mesh's costs two ray casts
+  // a pixel: it is cast on a lattice and interpolated inside the cells whose corners are
+  // all seen and whose centre, cast too, lies within kLatticeTolPx of the interpolation
+  // (a smooth surface); other cells are cast at every pixel.
+  const int step = surface.occluder ? kLattice : 1;
+  std::vector<int> xs, ys;
+  for (int x = 0; x < size.width; x += step) xs.push_back(x);
+  if (xs.back() != size.width - 1) xs.push_back(size.width - 1);
+  for (int y = 0; y < size.height; y += step) ys.push_back(y);
+  if (ys.back() != size.height - 1) ys.push_back(size.height - 1);
+  for (int y : ys) {
+    for (int x : xs) map.at<cv::Vec2f>(y, x) = cast(x, y);
+  }
+  if (!finite)
+    return fail(ErrorCode::kInvalidInput, "drift map: the rig model's mapping is not finite");
+  for (std::size_t j = 0; j + 1 < ys.size(); ++j) {
+    for (std::size_t i = 0; i + 1 < xs.size(); ++i) {
+      const int x0 = xs[i], x1 = xs[i + 1], y0 = ys[j], y1 = ys[j + 1];
+      if (x1 - x0 < 2 && y1 - y0 < 2) continue;  // no pixel inside
+      const cv::Vec2f c00 = map.at<cv::Vec2f>(y0, x0), c10 = map.at<cv::Vec2f>(y0, x1),
+                      c01 = map.at<cv::Vec2f>(y1, x0), c11 = map.at<cv::Vec2f>(y1, x1);
+      const auto lerp = [&](int x, int y) {
+        const float fx = static_cast<float>(x - x0) / static_cast<float>(x1 - x0);
+        const float fy = static_cast<float>(y - y0) / static_cast<float>(y1 - y0);
+        return (1 - fy) * ((1 - fx) * c00 + fx * c10) + fy * ((1 - fx) * c01 + fx * c11);
+      };
+      bool smooth = c00[0] >= 0 && c10[0] >= 0 && c01[0] >= 0 && c11[0] >= 0;
+      if (smooth) {
+        const int xm = (x0 + x1) / 2, ym = (y0 + y1) / 2;
+        const cv::Vec2f exact = cast(xm, ym);
+        smooth = exact[0] >= 0 && cv::norm(exact - lerp(xm, ym)) <= kLatticeTolPx;
       }
-      row[x] = cv::Vec2f(static_cast<float>(px->x()), static_cast<float>(px->y()));
+      for (int y = y0; y <= y1; ++y) {
+        auto* row = map.ptr<cv::Vec2f>(y);
+        for (int x = x0; x <= x1; ++x) {
+          const bool node = (x == x0 || x == x1) && (y == y0 || y == y1);
+          if (!node) row[x] = smooth ? lerp(x, y) : cast(x, y);
+        }
+      }
     }
   }
+  if (!finite)
+    return fail(ErrorCode::kInvalidInput, "drift map: the rig model's mapping is not finite");
   return map;
+}
+
+Result<cv::Mat> projectorCameraMap(const geom::PlaneHomography& projector_to_plane,
+                                   const geom::CameraModel& camera, const WorkGrid& grid) {
+  if (!projector_to_plane.H.allFinite()) {
+    return fail(ErrorCode::kInvalidInput, "drift map: the rig model's mapping is not finite");
+  }
+  return projectorCameraMap(planeLitSurface(projector_to_plane, grid.framebuffer), camera, grid);
 }
 
 std::optional<Vec2> mappedCameraPixel(const cv::Mat& map, const Vec2& w) {

@@ -1,12 +1,16 @@
 #pragma once
 // Where a projector's framebuffer pixels land in a camera, by the rig model: the
-// projector's collineation with the display plane ([Raskar02] §4.2.1) and the camera's
-// calibration. The drift check compares what the camera sees there with the frame shown.
+// projector's collineation with the display plane ([Raskar02] §4.2.1), or its pixel rays
+// meeting a surface the rig knows as a mesh (§4.1), and the camera's calibration. The
+// drift check compares what the camera sees there with the frame shown.
+#include <functional>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <optional>
 
 #include "core/error.hpp"
 #include "geometry/camera_model.hpp"
+#include "geometry/intersect.hpp"
 #include "geometry/plane_homography.hpp"
 
 namespace procam::drift {
@@ -27,9 +31,24 @@ struct WorkGrid {
   }
 };
 
+// Where the rig model says a projector's framebuffer pixels light the display surface.
+struct LitSurface {
+  // The world point a framebuffer pixel lights; nullopt where its light meets no surface.
+  std::function<std::optional<Vec3>(const Vec2&)> point;
+  // The surface, when it may hide a lit point from a camera (a mesh); null for a plane.
+  std::shared_ptr<const geom::MeshIntersector> occluder;
+};
+
+// A display plane's: the collineation, pixels past the plane's horizon lighting nothing.
+LitSurface planeLitSurface(const geom::PlaneHomography& projector_to_plane, cv::Size framebuffer);
+
 // For every work pixel, the camera pixel that sees it (CV_32FC2), or (-1, -1) where the
-// camera does not (behind it, outside its image, the plane seen edge-on). kInvalidInput
-// for a factor outside 1..8, an empty framebuffer or a non-finite mapping.
+// camera does not (behind it, outside its image, the plane seen edge-on, hidden by another
+// part of the surface). kInvalidInput for a factor outside 1..8, an empty framebuffer, no
+// surface or a non-finite mapping.
+Result<cv::Mat> projectorCameraMap(const LitSurface& surface, const geom::CameraModel& camera,
+                                   const WorkGrid& grid);
+// The plane's (planeLitSurface).
 Result<cv::Mat> projectorCameraMap(const geom::PlaneHomography& projector_to_plane,
                                    const geom::CameraModel& camera, const WorkGrid& grid);
 

@@ -8,23 +8,56 @@
 
 namespace procam::drift {
 
-Result<ProjectorCorrection> correctProjector(const rig::RigProjector& before,
-                                             const geom::PlaneHomography& tile,
-                                             const Misregistration& drift) {
+namespace {
+
+struct RegisteredTiles {
   std::vector<Vec2> drawn, seen;
+};
+
+// The inlier tiles, refused when too few or not finite.
+Result<RegisteredTiles> registeredTiles(const Misregistration& drift) {
+  RegisteredTiles out;
   for (const TileShift& t : drift.tiles) {
     if (!t.inlier) continue;
     if (!t.drawn.allFinite() || !t.seen_at.allFinite()) {
       return fail(ErrorCode::kInvalidInput, "drift correction: a tile is not finite");
     }
-    drawn.push_back(t.drawn);
-    seen.push_back(t.seen_at);
+    out.drawn.push_back(t.drawn);
+    out.seen.push_back(t.seen_at);
   }
-  if (static_cast<int>(drawn.size()) < kMinCorrectionTiles) {
-    return fail(ErrorCode::kTooFewPoints, "drift correction: " + std::to_string(drawn.size()) +
+  if (static_cast<int>(out.drawn.size()) < kMinCorrectionTiles) {
+    return fail(ErrorCode::kTooFewPoints, "drift correction: " + std::to_string(out.drawn.size()) +
                                               " registered tiles, at least " +
                                               std::to_string(kMinCorrectionTiles) + " needed");
   }
+  return out;
+}
+
+// The pose refitted to the tiles' surface points, refused when it fits them worse than
+// a rigid projector would.
+Result<PoseRefit> refitToTiles(const geom::CameraModel& model, const std::vector<Vec3>& world,
+                               const std::vector<Vec2>& drawn) {
+  auto pose = refitPose(model, world, drawn);
+  if (!pose) return tl::unexpected(pose.error());
+  // The tiles scatter by about 0.2 px about one collineation: a pose that fits them far
+  // worse is not a moved projector (a moved surface, a bad match).
+  if (pose->rms_px > kMaxRefitRmsPx) {
+    return fail(ErrorCode::kIllConditioned, "drift correction: the new pose fits the tiles to " +
+                                                std::to_string(pose->rms_px) + " px RMS (at most " +
+                                                std::to_string(kMaxRefitRmsPx) + ")");
+  }
+  return pose;
+}
+
+}  // namespace
+
+Result<ProjectorCorrection> correctProjector(const rig::RigProjector& before,
+                                             const geom::PlaneHomography& tile,
+                                             const Misregistration& drift) {
+  auto tiles = registeredTiles(drift);
+  if (!tiles) return tl::unexpected(tiles.error());
+  const std::vector<Vec2>& drawn = tiles->drawn;
+  const std::vector<Vec2>& seen = tiles->seen;
   if (!drift.drawn_to_seen.allFinite() || !(std::abs(drift.drawn_to_seen(2, 2)) > 0)) {
     return fail(ErrorCode::kInvalidInput, "drift correction: the shift field is not finite");
   }
@@ -57,19 +90,42 @@ Result<ProjectorCorrection> correctProjector(const rig::RigProjector& before,
       }
       world.push_back(hit->point);
     }
-    auto pose = refitPose(model, world, drawn);
+    auto pose = refitToTiles(model, world, drawn);
     if (!pose) return tl::unexpected(pose.error());
-    // The tiles scatter by about 0.2 px about one collineation: a pose that fits them far
-    // worse is not a moved projector (a non-planar surface moved, a bad match).
-    if (pose->rms_px > kMaxRefitRmsPx) {
-      return fail(ErrorCode::kIllConditioned, "drift correction: the new pose fits the tiles to " +
-                                                  std::to_string(pose->rms_px) +
-                                                  " px RMS (at most " +
-                                                  std::to_string(kMaxRefitRmsPx) + ")");
-    }
     out.projector.pose = pose->pose;
     out.pose_rms_px = pose->rms_px;
   }
+  return out;
+}
+
+Result<ProjectorCorrection> correctProjector(const rig::RigProjector& before,
+                                             const LitSurface& surface,
+                                             const Misregistration& drift) {
+  if (!before.pose_known || !before.intrinsics_known) {
+    return fail(ErrorCode::kInvalidInput,
+                "drift correction: on a curved surface the projector's pose and intrinsics are "
+                "needed");
+  }
+  if (!surface.point) return fail(ErrorCode::kInvalidInput, "drift correction: no surface");
+  auto tiles = registeredTiles(drift);
+  if (!tiles) return tl::unexpected(tiles.error());
+  std::vector<Vec3> world;
+  for (const Vec2& s : tiles->seen) {
+    const auto point = surface.point(s);
+    if (!point || !point->allFinite()) {
+      return fail(ErrorCode::kDegenerate, "drift correction: a tile's pixel lights no surface");
+    }
+    world.push_back(*point);
+  }
+  auto pose = refitToTiles(before.model(), world, tiles->drawn);
+  if (!pose) return tl::unexpected(pose.error());
+  ProjectorCorrection out;
+  out.projector = before;
+  out.tiles = static_cast<int>(world.size());
+  out.fit_rms_px = drift.tile_rms_px;
+  out.drawn_to_seen = drift.drawn_to_seen;
+  out.projector.pose = pose->pose;
+  out.pose_rms_px = pose->rms_px;
   return out;
 }
 

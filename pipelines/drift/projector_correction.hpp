@@ -9,6 +9,7 @@
 #include "core/error.hpp"
 #include "geometry/plane_homography.hpp"
 #include "misregistration.hpp"
+#include "projector_camera_map.hpp"
 #include "rig/rig_model.hpp"
 
 namespace procam::drift {
@@ -27,6 +28,16 @@ struct ProjectorCorrection {
 // non-finite input.
 Result<ProjectorCorrection> correctProjector(const rig::RigProjector& before,
                                              const geom::PlaneHomography& tile,
+                                             const Misregistration& drift);
+
+// On a surface the rig model knows as a mesh (no collineation: [Raskar02] §4.1): the
+// content drawn at a tile's framebuffer pixel d was seen where the rig model's pixel s
+// lights the surface, `surface.point(s)`, so the moved projector's pixel d lights that
+// point; the pose is refitted to those points. The projector needs a pose and intrinsics
+// (kInvalidInput without); kDegenerate when a tile's pixel lights no surface; the other
+// errors as above.
+Result<ProjectorCorrection> correctProjector(const rig::RigProjector& before,
+                                             const LitSurface& surface,
                                              const Misregistration& drift);
 
 }  // namespace procam::drift

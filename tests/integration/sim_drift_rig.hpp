@@ -28,6 +28,12 @@ namespace procam::itest {
 
 using Clock = std::chrono::steady_clock;
 
+// A projector turned at scene time t (seconds) in its own frame (degrees).
+struct Bump {
+  double t;
+  double yaw, pitch;
+};
+
 // Scene events run on the wall clock; under the sanitizers the daemon and the virtual
 // camera are kSlowdown times slower, so the scene's times stretch with them.
 inline double at(double seconds) {

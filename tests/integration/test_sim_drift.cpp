@@ -10,11 +10,6 @@
 namespace procam::itest {
 namespace {
 
-struct Bump {
-  double t;           // scene seconds
-  double yaw, pitch;  // degrees, in the projector's own frame
-};
-
 TEST(SimDrift, ABumpedProjectorIsCorrectedFromTheContentWithoutAScan) {
   // Still for 8 s (about thirty checks), then bumped 0.5 degrees, then 2 degrees more.
   const Bump bumps[] = {{at(8.0), 0.5, 0.0}, {at(18.0), 0.0, -2.0}};

@@ -10,28 +10,13 @@
 #include "blend/curved_display.hpp"
 #include "render/viewer_view.hpp"
 #include "sim/scene_library.hpp"
+#include "unit/common/cylinder_wall.hpp"
 
 namespace procam::blend {
 namespace {
 
-// The cylinder of radius 3 m about the Z axis, 0 to 3.5 m high, as a mesh of 0.25 deg
-// facets over the 240 deg facing +Y (its chords are 7 um from the true wall).
 geom::MeshIntersector cylinderMesh() {
-  geom::TriangleMesh mesh;
-  constexpr int kAround = 960, kUp = 14;
-  for (int i = 0; i <= kAround; ++i) {
-    const double a = (-120.0 + 240.0 * i / kAround) * std::numbers::pi / 180;
-    for (int j = 0; j <= kUp; ++j)
-      mesh.vertices.emplace_back(3 * std::sin(a), 3 * std::cos(a), 3.5 * j / kUp);
-  }
-  for (int i = 0; i < kAround; ++i) {
-    for (int j = 0; j < kUp; ++j) {
-      const int v = i * (kUp + 1) + j;
-      mesh.faces.emplace_back(v, v + kUp + 1, v + 1);
-      mesh.faces.emplace_back(v + 1, v + kUp + 1, v + kUp + 2);
-    }
-  }
-  return *geom::MeshIntersector::build(std::move(mesh));
+  return *geom::MeshIntersector::build(testing_support::cylinderWall());
 }
 
 struct Rig {

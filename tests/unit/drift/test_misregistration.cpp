@@ -240,12 +240,19 @@ TEST(DriftCheck, MismatchedInputIsRefused) {
   cv::Mat map(31, 32, CV_32FC2, cv::Scalar(-1, -1));
   EXPECT_EQ(measureMisregistration(shown, camera, map, grid).error().code,
             ErrorCode::kInvalidInput);
-  EXPECT_EQ(projectorCameraMap({}, {}, WorkGrid{{64, 64}, 0}).error().code,
+  EXPECT_EQ(projectorCameraMap(geom::PlaneHomography{}, {}, WorkGrid{{64, 64}, 0}).error().code,
             ErrorCode::kInvalidInput);
+  EXPECT_EQ(projectorCameraMap(LitSurface{}, {}, grid).error().code, ErrorCode::kInvalidInput);
   Misregistration few;
-  EXPECT_EQ(correctProjector({}, {}, few).error().code, ErrorCode::kTooFewPoints);
+  EXPECT_EQ(correctProjector({}, geom::PlaneHomography{}, few).error().code,
+            ErrorCode::kTooFewPoints);
+  // On a mesh the projector's pose is what is corrected: none, nothing to correct.
+  EXPECT_EQ(correctProjector({}, LitSurface{}, few).error().code, ErrorCode::kInvalidInput);
   rig::RigCamera posed;
-  EXPECT_EQ(correctCamera(posed, {}, few, map, grid).error().code, ErrorCode::kInvalidInput);
+  EXPECT_EQ(correctCamera(posed, geom::PlaneHomography{}, few, map, grid).error().code,
+            ErrorCode::kInvalidInput);
+  EXPECT_EQ(correctCamera(posed, LitSurface{}, few, map, grid).error().code,
+            ErrorCode::kInvalidInput);
 }
 
 }  // namespace
