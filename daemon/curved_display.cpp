@@ -71,7 +71,11 @@ const KeystoneRuntime::Curved* Daemon::curvedDisplay(cv::Size content, const Vie
   // A new rig model whose meshes are still being read: the display made for the last one
   // stays until they are (a projector's new pose with its old mesh would be solved and
   // shown for nothing).
-  if (rig_surfaces_loading_ && k.curved) return k.curved.get();
+  if (rig_surfaces_loading_) {
+    const bool same = k.curved && k.curved->content == content &&
+                      (k.curved->display.eye - eye.position).norm() < 1e-9;
+    return same ? k.curved.get() : nullptr;
+  }
   std::vector<CurvedInput> inputs;
   for (const auto& e : devices_.entries()) {
     if (e.description.family != PROCAM_FAMILY_OUTPUT || !e.usable()) continue;

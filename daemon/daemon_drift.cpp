@@ -192,9 +192,17 @@ std::optional<std::pair<DriftCheckPlan, DriftKey>> Daemon::planDriftCheck(
     }
     if (!cam) return std::nullopt;
   } else {
-    // The cameras in turn from one check to the next, whichever output leads: a drift one
-    // camera saw is confirmed or told apart by another's check soon after.
-    cam = cams[d.next_camera++ % cams.size()];
+    // The camera that looked at it longest ago (one never looked first): the output's
+    // cameras in turn whichever outputs lead and which cameras their checks took, so a
+    // drift one camera saw is confirmed or told apart by another's check soon after.
+    for (const rig::RigCamera* c : cams) {
+      auto v = o.views.find(c->name);
+      if (v == o.views.end()) {
+        cam = c;
+        break;
+      }
+      if (!cam || v->second.checked_at < o.views.at(cam->name).checked_at) cam = c;
+    }
   }
   auto st = k.output_state.find(out.name);
   if (st == k.output_state.end() || !st->second.shown_image || !st->second.shown_setup) {

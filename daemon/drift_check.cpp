@@ -43,6 +43,7 @@ Result<void> litSurface(const DriftCheckPlan& plan, DriftReference& ref) {
     auto hit = mesh->intersect(rays->through(fb.x(), fb.y()));
     return hit ? std::optional<Vec3>(hit->point) : std::nullopt;
   };
+  if (grid) ref.lit.to_pinhole = [rays = ref.rays](const Vec2& fb) { return rays->toPinhole(fb); };
   return {};
 }
 

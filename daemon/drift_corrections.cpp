@@ -299,8 +299,16 @@ void Daemon::correctDrift(const std::string& output, const std::string& camera,
                 {"tiles", c->tiles},
                 {"pose_fit_px", c->pose_rms_px},
                 {"surface", v.reference && v.reference->rays ? "mesh" : "plane"}};
+  // The mesh file is written before rig.json: when rig.json is not, its old text goes back.
+  std::function<void(const Result<std::string>&)> after;
+  if (rewrite) {
+    after = [this, file = rewrite->file,
+             text = o.before_meshes.at(rewrite->file)](const Result<std::string>& written) {
+      if (!written) writeRig({}, {{file, text}}, [](const Result<std::string>&) {});
+    };
+  }
   writeDriftCorrection(output, std::move(update), std::move(event), "corrected-pose",
-                       std::move(meshes));
+                       std::move(meshes), std::move(after));
 }
 
 void Daemon::correctCamera(const std::string& output, const std::string& camera,

@@ -95,8 +95,7 @@ struct DriftRuntime {
   // The fiducial frames, made once per framebuffer size; why there is none.
   std::map<std::pair<int, int>, std::shared_ptr<const FiducialFrame>> fiducial;
   std::string fiducial_unavailable;
-  uint64_t next = 0;         // round robin over the outputs
-  uint64_t next_camera = 0;  // and over the leading output's cameras
+  uint64_t next = 0;  // round robin over the outputs
   std::map<std::string, Output> outputs;
 };
 

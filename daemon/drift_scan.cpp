@@ -28,6 +28,21 @@ namespace {
 constexpr int kCoarseStep = 8;
 constexpr int kCoarseGrid = 16;
 
+// When a scan's rig is written: what was kept to restore is now the scan's (the
+// projector's, or the devices with the new wall), and the operation ends.
+std::function<void(const Result<std::string>&)> whenScanWritten(
+    DriftRuntime& d, const std::string& output,
+    const std::function<void(const CalibrationFailure*)>& finish) {
+  return [&d, output, finish](const Result<std::string>& written) {
+    if (!written) {
+      const CalibrationFailure f{proto::code::kIo, written.error().message};
+      return finish(&f);
+    }
+    if (auto it = d.outputs.find(output); it != d.outputs.end()) it->second.forgetBefore();
+    finish(nullptr);
+  };
+}
+
 }  // namespace
 
 void Daemon::escalateDrift(const std::string& output, const std::string& camera,
@@ -203,19 +218,12 @@ void Daemon::scanForDrift(const std::string& output, const std::string& camera, 
           logInfo("drift: output '" + output + "': the " + step + " measured the projector (" +
                   std::to_string(plan->frames()) + " frames, " +
                   std::to_string(secondsSince(started_at)) + " s)");
-          writeDriftCorrection(
-              output, std::move(update), std::move(event), "corrected-scan",
-              std::move(learnt.meshes), [this, output, finish](const Result<std::string>& written) {
-                if (!written) {
-                  const CalibrationFailure f{proto::code::kIo, written.error().message};
-                  return finish(&f);
-                }
-                // What was kept to restore is now the scan's.
-                if (auto it = drift_rt_.outputs.find(output); it != drift_rt_.outputs.end()) {
-                  it->second.forgetBefore();
-                }
-                finish(nullptr);
-              });
+          // Mesh files the corrections rewrote go back with the devices they belong to,
+          // unless the scan wrote them.
+          std::map<std::string, std::string> meshes = std::move(learnt.meshes);
+          for (const auto& [file, text] : o.before_meshes) meshes.emplace(file, text);
+          writeDriftCorrection(output, std::move(update), std::move(event), "corrected-scan",
+                               std::move(meshes), whenScanWritten(drift_rt_, output, finish));
         };
       },
       [this, output, camera, which, m, finish](const std::string& what) {
@@ -279,19 +287,10 @@ void Daemon::scannedWall(const std::string& output, const std::string& camera, D
           std::to_string(fit.inliers.size()) + " nodes triangulated by " + by + ", " +
           std::to_string(1e3 * offset_m) + " mm from the rig's, turned " +
           std::to_string(turned_deg) + " deg; " + std::to_string(secondsSince(started_at)) + " s)");
-  writeDriftCorrection(output, std::move(update), std::move(event), "corrected-scan", {},
-                       [this, output, finish](const Result<std::string>& written) {
-                         if (!written) {
-                           const CalibrationFailure f{proto::code::kIo, written.error().message};
-                           return finish(&f);
-                         }
-                         // What was kept to restore is now written with the new wall.
-                         if (auto o = drift_rt_.outputs.find(output);
-                             o != drift_rt_.outputs.end()) {
-                           o->second.forgetBefore();
-                         }
-                         finish(nullptr);
-                       });
+  std::map<std::string, std::string> meshes;
+  if (it != drift_rt_.outputs.end()) meshes = it->second.before_meshes;
+  writeDriftCorrection(output, std::move(update), std::move(event), "corrected-scan",
+                       std::move(meshes), whenScanWritten(drift_rt_, output, finish));
 }
 
 }  // namespace procam::daemon

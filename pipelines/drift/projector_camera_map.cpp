@@ -76,7 +76,8 @@ Result<cv::Mat> projectorCameraMap(const LitSurface& surface, const geom::Camera
   // a pixel: it is cast on a lattice and interpolated inside the cells whose corners are
   // all seen and whose centre, cast too, lies within kLatticeTolPx of the interpolation
   // (a smooth surface); other cells are cast at every pixel.
-  const int step = surface.occluder ? kLattice : 1;
+  const int step =
+      surface.occluder && size.width > kLattice && size.height > kLattice ? kLattice : 1;
   std::vector<int> xs, ys;
   for (int x = 0; x < size.width; x += step) xs.push_back(x);
   if (xs.back() != size.width - 1) xs.push_back(size.width - 1);
@@ -85,30 +86,49 @@ Result<cv::Mat> projectorCameraMap(const LitSurface& surface, const geom::Camera
   for (int y : ys) {
     for (int x : xs) map.at<cv::Vec2f>(y, x) = cast(x, y);
   }
-  if (!finite)
-    return fail(ErrorCode::kInvalidInput, "drift map: the rig model's mapping is not finite");
-  for (std::size_t j = 0; j + 1 < ys.size(); ++j) {
-    for (std::size_t i = 0; i + 1 < xs.size(); ++i) {
+  if (step > 1) {
+    // Which cells are smooth, then every pixel between the nodes: inside a smooth cell
+    // interpolated; on a lattice line between two nodes interpolated only when every cell
+    // beside it is smooth (either cell's bilinear is the same line there); else cast.
+    const std::size_t nx = xs.size() - 1, ny = ys.size() - 1;
+    std::vector<char> smooth(nx * ny, 0);
+    const auto at = [&](int x, int y) { return map.at<cv::Vec2f>(y, x); };
+    const auto lerp = [&](std::size_t i, std::size_t j, int x, int y) {
       const int x0 = xs[i], x1 = xs[i + 1], y0 = ys[j], y1 = ys[j + 1];
-      if (x1 - x0 < 2 && y1 - y0 < 2) continue;  // no pixel inside
-      const cv::Vec2f c00 = map.at<cv::Vec2f>(y0, x0), c10 = map.at<cv::Vec2f>(y0, x1),
-                      c01 = map.at<cv::Vec2f>(y1, x0), c11 = map.at<cv::Vec2f>(y1, x1);
-      const auto lerp = [&](int x, int y) {
-        const float fx = static_cast<float>(x - x0) / static_cast<float>(x1 - x0);
-        const float fy = static_cast<float>(y - y0) / static_cast<float>(y1 - y0);
-        return (1 - fy) * ((1 - fx) * c00 + fx * c10) + fy * ((1 - fx) * c01 + fx * c11);
-      };
-      bool smooth = c00[0] >= 0 && c10[0] >= 0 && c01[0] >= 0 && c11[0] >= 0;
-      if (smooth) {
-        const int xm = (x0 + x1) / 2, ym = (y0 + y1) / 2;
-        const cv::Vec2f exact = cast(xm, ym);
-        smooth = exact[0] >= 0 && cv::norm(exact - lerp(xm, ym)) <= kLatticeTolPx;
+      const float fx = static_cast<float>(x - x0) / static_cast<float>(x1 - x0);
+      const float fy = static_cast<float>(y - y0) / static_cast<float>(y1 - y0);
+      return (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x1, y0)) +
+             fy * ((1 - fx) * at(x0, y1) + fx * at(x1, y1));
+    };
+    for (std::size_t j = 0; j < ny; ++j) {
+      for (std::size_t i = 0; i < nx; ++i) {
+        const int x0 = xs[i], x1 = xs[i + 1], y0 = ys[j], y1 = ys[j + 1];
+        bool ok =
+            at(x0, y0)[0] >= 0 && at(x1, y0)[0] >= 0 && at(x0, y1)[0] >= 0 && at(x1, y1)[0] >= 0;
+        if (ok) {
+          const int xm = (x0 + x1) / 2, ym = (y0 + y1) / 2;
+          const cv::Vec2f exact = cast(xm, ym);
+          ok = exact[0] >= 0 && cv::norm(exact - lerp(i, j, xm, ym)) <= kLatticeTolPx;
+        }
+        smooth[j * nx + i] = ok;
       }
-      for (int y = y0; y <= y1; ++y) {
-        auto* row = map.ptr<cv::Vec2f>(y);
-        for (int x = x0; x <= x1; ++x) {
-          const bool node = (x == x0 || x == x1) && (y == y0 || y == y1);
-          if (!node) row[x] = smooth ? lerp(x, y) : cast(x, y);
+    }
+    const auto isSmooth = [&](std::size_t i, std::size_t j) { return smooth[j * nx + i] != 0; };
+    for (std::size_t j = 0; j < ny; ++j) {
+      for (std::size_t i = 0; i < nx; ++i) {
+        const int x0 = xs[i], x1 = xs[i + 1], y0 = ys[j], y1 = ys[j + 1];
+        for (int y = y0; y <= y1; ++y) {
+          auto* row = map.ptr<cv::Vec2f>(y);
+          for (int x = x0; x <= x1; ++x) {
+            if ((x == x0 || x == x1) && (y == y0 || y == y1)) continue;  // a node
+            // A cell fills its top and left edges; its bottom and right ones are the next
+            // cell's, but at the grid's border.
+            if ((x == x1 && i + 1 < nx) || (y == y1 && j + 1 < ny)) continue;
+            bool interpolate = isSmooth(i, j);
+            if (y == y0 && j > 0) interpolate = interpolate && isSmooth(i, j - 1);
+            if (x == x0 && i > 0) interpolate = interpolate && isSmooth(i - 1, j);
+            row[x] = interpolate ? lerp(i, j, x, y) : cast(x, y);
+          }
         }
       }
     }

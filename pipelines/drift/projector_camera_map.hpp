@@ -37,6 +37,10 @@ struct LitSurface {
   std::function<std::optional<Vec3>(const Vec2&)> point;
   // The surface, when it may hide a lit point from a camera (a mesh); null for a plane.
   std::shared_ptr<const geom::MeshIntersector> occluder;
+  // The pinhole pixel a framebuffer pixel shows, when the frames are drawn through a
+  // post-rendering warp ([Raskar02] §4.1.3) that stands for the projector's lens; empty:
+  // the projector's own model has the lens.
+  std::function<Vec2(const Vec2&)> to_pinhole;
 };
 
 // A display plane's: the collineation, pixels past the plane's horizon lighting nothing.

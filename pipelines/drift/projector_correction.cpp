@@ -109,15 +109,25 @@ Result<ProjectorCorrection> correctProjector(const rig::RigProjector& before,
   if (!surface.point) return fail(ErrorCode::kInvalidInput, "drift correction: no surface");
   auto tiles = registeredTiles(drift);
   if (!tiles) return tl::unexpected(tiles.error());
+  // The pose is fitted in the model the points come from: the pinhole, to the pinhole
+  // pixels the drawn pixels show, when a warp stands for the lens.
+  geom::CameraModel model = before.model();
+  if (surface.to_pinhole) model.dist = {};
   std::vector<Vec3> world;
-  for (const Vec2& s : tiles->seen) {
-    const auto point = surface.point(s);
-    if (!point || !point->allFinite()) {
-      return fail(ErrorCode::kDegenerate, "drift correction: a tile's pixel lights no surface");
-    }
+  std::vector<Vec2> drawn;
+  for (std::size_t i = 0; i < tiles->seen.size(); ++i) {
+    // A tile seen where the surface has a hole (a measured mesh's) tells nothing.
+    const auto point = surface.point(tiles->seen[i]);
+    if (!point || !point->allFinite()) continue;
     world.push_back(*point);
+    drawn.push_back(surface.to_pinhole ? surface.to_pinhole(tiles->drawn[i]) : tiles->drawn[i]);
   }
-  auto pose = refitToTiles(before.model(), world, tiles->drawn);
+  if (static_cast<int>(world.size()) < kMinCorrectionTiles) {
+    return fail(ErrorCode::kTooFewPoints, "drift correction: " + std::to_string(world.size()) +
+                                              " tiles light the surface, at least " +
+                                              std::to_string(kMinCorrectionTiles) + " needed");
+  }
+  auto pose = refitToTiles(model, world, drawn);
   if (!pose) return tl::unexpected(pose.error());
   ProjectorCorrection out;
   out.projector = before;

@@ -33,9 +33,11 @@ Result<ProjectorCorrection> correctProjector(const rig::RigProjector& before,
 // On a surface the rig model knows as a mesh (no collineation: [Raskar02] §4.1): the
 // content drawn at a tile's framebuffer pixel d was seen where the rig model's pixel s
 // lights the surface, `surface.point(s)`, so the moved projector's pixel d lights that
-// point; the pose is refitted to those points. The projector needs a pose and intrinsics
-// (kInvalidInput without); kDegenerate when a tile's pixel lights no surface; the other
-// errors as above.
+// point; the pose is refitted to those points (as a pinhole to the pinhole pixels the
+// drawn ones show, when `surface.to_pinhole` stands for the lens). Tiles whose pixel lights
+// no surface (a hole) are left out. The projector needs a pose and intrinsics
+// (kInvalidInput without); kTooFewPoints under 8 tiles on the surface; the other errors as
+// above.
 Result<ProjectorCorrection> correctProjector(const rig::RigProjector& before,
                                              const LitSurface& surface,
                                              const Misregistration& drift);
