@@ -112,6 +112,17 @@ inline json outputDrift(Connection& c) {
   return (*st)["outputs"]["shown"][0].value("drift", json(nullptr));
 }
 
+// Whether an output's drift status (`drift()`) counts `n` checks within `within`.
+template <class DriftOf>
+bool checkedTimes(DriftOf drift, int n, std::chrono::seconds within) {
+  return eventually(
+      [&] {
+        const json dr = drift();
+        return dr.is_object() && dr.value("checks", 0) >= n;
+      },
+      within * kSlowdown);
+}
+
 // The rig model's projector (rig.json as the daemon wrote it) against the true one:
 // the largest distance, in the true projector's pixels, between a framebuffer pixel
 // and where the true projector puts the wall point the rig gives that pixel (by its

@@ -34,12 +34,7 @@ TEST(SimDrift, ABumpedProjectorIsCorrectedFromTheContentWithoutAScan) {
   };
 
   // At rest: registered, no correction.
-  ASSERT_TRUE(eventually(
-      [&] {
-        const json dr = outputDrift(c);
-        return dr.is_object() && dr.value("checks", 0) >= 3;
-      },
-      6s * kSlowdown))
+  ASSERT_TRUE(checkedTimes([&] { return outputDrift(c); }, 3, 6s))
       << outputDrift(c).dump() << d.log();
   for (std::size_t i = 0; i < std::size(bumps); ++i) {
     const Bump& b = bumps[i];
