@@ -216,10 +216,9 @@ std::optional<std::pair<DriftCheckPlan, DriftKey>> Daemon::planDriftCheck(
   if (o.fiducial_at && secondsSince(*o.fiducial_at) < settle) return std::nullopt;
   o.unavailable.clear();
   DeviceEntry* cam_entry = devices_.find(cam->name);
-  // Fiducial frames are registered through the display plane: none on a mesh, nor for an
-  // output measured in another's capture.
+  // No fiducial frame for an output measured in another's capture.
   const bool fiducial =
-      !mesh && !camera && fiducialDue(o, o.views[cam->name], st->second, {p->width, p->height});
+      !camera && fiducialDue(o, o.views[cam->name], st->second, {p->width, p->height});
   DriftCheckPlan plan;
   plan.output = out.name;
   plan.camera = {cam->name, cam_entry->device.share()};

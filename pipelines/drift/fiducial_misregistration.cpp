@@ -57,4 +57,37 @@ Result<Misregistration> fiducialMisregistration(std::span<const Vec2> shown,
   return m;
 }
 
+Result<Misregistration> fiducialMisregistration(std::span<const Vec2> shown,
+                                                std::span<const FiducialCorner> found,
+                                                const cv::Mat& map, const WorkGrid& grid,
+                                                const MisregistrationOptions& options) {
+  if (map.type() != CV_32FC2 || map.size() != grid.size()) {
+    return fail(ErrorCode::kInvalidInput,
+                "fiducial check: the camera's map is not CV_32FC2 of the work grid's size");
+  }
+  Misregistration m;
+  for (const Vec2& p : shown) {
+    if (!p.allFinite())
+      return fail(ErrorCode::kInvalidInput, "fiducial check: a corner is not finite");
+    if (mappedCameraPixel(map, grid.toWork(p))) ++m.tiles_seen;
+  }
+  std::vector<TileShift> tiles;
+  for (const FiducialCorner& c : found) {
+    if (!c.drawn.allFinite() || !c.camera.allFinite()) {
+      return fail(ErrorCode::kInvalidInput, "fiducial check: a corner is not finite");
+    }
+    auto w = workPixelSeenAt(map, c.camera, grid.toWork(c.drawn));
+    if (!w) continue;
+    TileShift t;
+    t.drawn = c.drawn;
+    t.seen_at = grid.toFramebuffer(*w);
+    t.response = 1.0;
+    tiles.push_back(t);
+  }
+  m.tiles_seen = std::max(m.tiles_seen, static_cast<int>(tiles.size()));
+  m.tiles_textured = m.tiles_seen;
+  fitShiftField(std::move(tiles), options, m);
+  return m;
+}
+
 }  // namespace procam::drift

@@ -13,6 +13,7 @@
 #include "geometry/camera_model.hpp"
 #include "geometry/plane_homography.hpp"
 #include "misregistration.hpp"
+#include "projector_camera_map.hpp"
 
 namespace procam::drift {
 
@@ -29,6 +30,16 @@ Result<Misregistration> fiducialMisregistration(std::span<const Vec2> shown,
                                                 std::span<const FiducialCorner> found,
                                                 const geom::PlaneHomography& projector_to_plane,
                                                 const geom::CameraModel& camera,
+                                                const MisregistrationOptions& options = {});
+
+// The same on a surface the rig knows as a mesh (or any): `map` (projectorCameraMap on
+// `grid`) puts the framebuffer in the camera by the rig model; a corner found at camera
+// pixel c was seen at the framebuffer pixel the map puts at c, found from where it was
+// drawn (workPixelSeenAt). Corners the map cannot take back are left out. kInvalidInput
+// for non-finite points or a map that is not CV_32FC2 of the grid's size.
+Result<Misregistration> fiducialMisregistration(std::span<const Vec2> shown,
+                                                std::span<const FiducialCorner> found,
+                                                const cv::Mat& map, const WorkGrid& grid,
                                                 const MisregistrationOptions& options = {});
 
 }  // namespace procam::drift

@@ -74,6 +74,28 @@ TileFit registerTile(const cv::Mat& shown_roi, const cv::Mat& seen, const cv::Po
   return fit;
 }
 
+// The smaller eigenvalue of the tile's windowed structure tensor (sums of gx^2, gx gy,
+// gy^2) over the larger, 0 for a tile with no gradient ([ShiTomasi94]).
+double isotropy(const cv::Mat& tile, const cv::Mat& window) {
+  cv::Mat gx, gy;
+  cv::Sobel(tile, gx, CV_32F, 1, 0, 3);
+  cv::Sobel(tile, gy, CV_32F, 0, 1, 3);
+  double sxx = 0, sxy = 0, syy = 0;
+  for (int y = 1; y + 1 < tile.rows; ++y) {
+    const float* px = gx.ptr<float>(y);
+    const float* py = gy.ptr<float>(y);
+    const float* w = window.ptr<float>(y);
+    for (int x = 1; x + 1 < tile.cols; ++x) {
+      sxx += w[x] * px[x] * px[x];
+      sxy += w[x] * px[x] * py[x];
+      syy += w[x] * py[x] * py[x];
+    }
+  }
+  const double half = (sxx + syy) / 2;
+  const double disc = std::sqrt(std::max(0.0, half * half - (sxx * syy - sxy * sxy)));
+  return half + disc > 0 ? (half - disc) / (half + disc) : 0.0;
+}
+
 // The shift of the whole view, at a quarter of the work grid (a bumped projector moves
 // its content tens of pixels; the tiles then search around it).
 Vec2 globalShift(const cv::Mat& shown, const cv::Mat& seen, const cv::Mat& seen_mask) {
@@ -159,6 +181,9 @@ Result<Misregistration> measureMisregistration(const cv::Mat& shown, const cv::M
   if (options.tile < 16 || options.tile > 512) {
     return fail(ErrorCode::kInvalidInput, "drift check: tiles of 16 to 512 pixels");
   }
+  if (!(options.min_isotropy >= 0 && options.min_isotropy <= 1)) {
+    return fail(ErrorCode::kInvalidInput, "drift check: min_isotropy outside [0, 1]");
+  }
   // The camera's view on the framebuffer grid; -1 where the camera does not see it.
   cv::Mat seen;
   cv::remap(camera, seen, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
@@ -200,7 +225,9 @@ Result<Misregistration> measureMisregistration(const cv::Mat& shown, const cv::M
       const cv::Mat shown_tile = shown(cv::Rect(x0, y0, T, T));
       cv::Scalar mean, sd;
       cv::meanStdDev(shown_tile, mean, sd);
-      if (sd[0] < options.min_texture) continue;
+      if (sd[0] < options.min_texture || isotropy(shown_tile, window) < options.min_isotropy) {
+        continue;
+      }
       ++m.tiles_textured;
       const TileFit fit = registerTile(shown_tile, seen, centre, window, global);
       if (!fit.converged || fit.response < options.min_response ||

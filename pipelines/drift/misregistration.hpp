@@ -23,6 +23,11 @@ struct MisregistrationOptions {
   // A tile whose shown content varies less than this (standard deviation, in code
   // values of 255) has nothing to register: plain.
   double min_texture = 6.0;
+  // A tile whose texture runs one way (an edge alone: the border of a plain image) fixes
+  // its shift across it only, not along it: plain too. The smaller eigenvalue of the
+  // tile's windowed gradient structure tensor must be at least this share of the larger
+  // ([ShiTomasi94]; 0.1 lets the weak direction's noise be at most about 3x the strong one's).
+  double min_isotropy = 0.1;
   // Phase-correlation peak (0..1) below which a tile's shift is not trusted.
   double min_response = 0.08;
   // Fewer registered tiles than this (or under `min_textured_share` of the tiles
@@ -70,7 +75,7 @@ void fitShiftField(std::vector<TileShift> tiles, const MisregistrationOptions& o
 // 0..255); `camera`: the camera's frame (CV_32F, any scale); `map`: from
 // projectorCameraMap for the same grid; `usable` (optional, CV_8U of the grid): tiles
 // with any zero pixel are left out (where another projector adds its light: a blended
-// overlap). kInvalidInput for mismatched sizes or types.
+// overlap). kInvalidInput for mismatched sizes or types, or options out of range.
 Result<Misregistration> measureMisregistration(const cv::Mat& shown, const cv::Mat& camera,
                                                const cv::Mat& map, const WorkGrid& grid,
                                                const MisregistrationOptions& options = {},

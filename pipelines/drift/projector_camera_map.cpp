@@ -1,5 +1,6 @@
 #include "projector_camera_map.hpp"
 
+#include <Eigen/LU>
 #include <cmath>
 #include <vector>
 
@@ -159,6 +160,38 @@ std::optional<Vec2> mappedCameraPixel(const cv::Mat& map, const Vec2& w) {
     }
   }
   return sum;
+}
+
+std::optional<Vec2> workPixelSeenAt(const cv::Mat& map, const Vec2& camera, const Vec2& start) {
+  // The map is smooth where the camera sees the surface (a collineation, or a mesh's
+  // facets seen from afar), so the steps converge in a few; the Jacobian is taken by
+  // differences of a quarter work pixel, one-sided at the edge of the seen part.
+  constexpr double kStep = 0.25, kTolPx = 1e-3, kLongestStep = 16;
+  Vec2 w = start;
+  for (int k = 0; k < 30; ++k) {
+    auto f = mappedCameraPixel(map, w);
+    if (!f) return std::nullopt;
+    const Vec2 r = camera - *f;
+    if (r.norm() < kTolPx) return w;
+    Eigen::Matrix2d J;
+    for (int axis = 0; axis < 2; ++axis) {
+      Vec2 h = Vec2::Zero();
+      h[axis] = kStep;
+      if (auto ahead = mappedCameraPixel(map, w + h)) {
+        J.col(axis) = (*ahead - *f) / kStep;
+      } else if (auto behind = mappedCameraPixel(map, w - h)) {
+        J.col(axis) = (*f - *behind) / kStep;
+      } else {
+        return std::nullopt;
+      }
+    }
+    const double det = J.determinant();
+    if (!std::isfinite(det) || std::abs(det) < 1e-9) return std::nullopt;
+    Vec2 step = J.inverse() * r;
+    if (step.norm() > kLongestStep) step *= kLongestStep / step.norm();
+    w += step;
+  }
+  return std::nullopt;
 }
 
 }  // namespace procam::drift

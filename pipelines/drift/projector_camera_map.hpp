@@ -59,4 +59,9 @@ Result<cv::Mat> projectorCameraMap(const geom::PlaneHomography& projector_to_pla
 // The map's camera pixel at a work-grid point (bilinear); nullopt off the camera's view.
 std::optional<Vec2> mappedCameraPixel(const cv::Mat& map, const Vec2& work);
 
+// The work pixel the map puts at camera pixel `camera`: Newton steps on the map's bilinear
+// interpolation from `start`; nullopt where they leave the part of the grid the camera sees
+// or do not come within 1e-3 camera px of it.
+std::optional<Vec2> workPixelSeenAt(const cv::Mat& map, const Vec2& camera, const Vec2& start);
+
 }  // namespace procam::drift

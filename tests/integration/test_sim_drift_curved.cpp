@@ -7,7 +7,10 @@
 // against the TRUE bumped projector.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <initializer_list>
+#include <span>
 
 #include "content/mesh_content.hpp"
 #include "cylinder_mesh.hpp"
@@ -109,44 +112,100 @@ double meshPixelsAgainstTruth(const TempDir& dir, const geom::CameraModel& truth
   return worst;
 }
 
-TEST(SimDriftCurved, ABumpedProjectorOnTheCylinderIsCorrectedFromTheContent) {
-  // Three outputs share the checks: still for 20 s (each checked about ten times).
-  const Bump bumps[] = {{at(20.0), 0.5, 0.0}, {at(42.0), 0.0, -2.0}};
-  TempDir dir;
+// rig.json's `projectors` and every camera where the scene's truth at rest has them.
+void expectUntouched(const TempDir& dir, const sim::Scene& scene,
+                     std::initializer_list<const char*> projectors) {
+  auto rig = rig::rigFromText(rigText(dir), "rig.json");
+  ASSERT_TRUE(rig) << rig.error().message;
+  const sim::SceneState rest = scene.at(0);
+  for (const char* name : projectors) {
+    const rig::RigProjector* p = rig->projector(name);
+    ASSERT_TRUE(p) << name;
+    const auto truth = std::find_if(rest.projectors.begin(), rest.projectors.end(),
+                                    [&](const auto& q) { return q.spec.name == name; });
+    ASSERT_NE(truth, rest.projectors.end()) << name;
+    EXPECT_LT((p->pose.center() - truth->model.pose.center()).norm(), 1e-9) << name;
+  }
+  for (const sim::CameraState& truth : rest.cameras) {
+    const std::string& name = truth.spec.name;
+    const rig::RigCamera* cam = rig->camera(name);
+    ASSERT_TRUE(cam) << name;
+    EXPECT_LT((cam->model.pose.center() - truth.model.pose.center()).norm(), 1e-9) << name;
+    EXPECT_LT((cam->model.pose.R - truth.model.pose.R).norm(), 1e-9) << name;
+  }
+}
+
+// procamd with recalibrate = "on-drift" (and `more_policy`) on cylinder3 at 1600x1200
+// with `events`, the rig above as its rig model, content shown for the sweet-spot viewer.
+struct CurvedDriftRig {
+  CurvedDriftRig(const TempDir& dir, const std::string& events, const std::string& more_policy = "")
+      : scene_file(sceneFile(dir, events)),
+        scene(sim::resolveScene(scene_file)),
+        wall(geom::MeshIntersector::build(testing_support::cylinderWall())),
+        d(dir, launch(dir, more_policy)),
+        c(d.socketPath()),
+        watcher(d.socketPath()) {}
+  // Fatal failures of the set-up; call first. `panorama` (BGR): the content, which the
+  // display across the three projectors puts on all of them.
+  void start(const TempDir& dir, const cv::Mat& panorama) {
+    ASSERT_TRUE(scene) << scene.error().message;
+    ASSERT_TRUE(wall) << wall.error().message;
+    ASSERT_TRUE(d.started()) << d.log();
+    ASSERT_TRUE(watcher.call({{"cmd", "watch"}}));
+    started = daemonStart(c);
+    const std::string png = contentFile(dir, "panorama.png");
+    ASSERT_TRUE(cv::imwrite(png, panorama));
+    auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", png}}, 30s * kSlowdown);
+    ASSERT_TRUE(load);
+    ASSERT_EQ((*load)["class"], "CONTENT") << load->dump();
+  }
+  double sceneTime() const { return std::chrono::duration<double>(Clock::now() - started).count(); }
+
+  std::string scene_file;
+  Result<sim::Scene> scene;
+  Result<geom::MeshIntersector> wall;
+  DaemonProcess d;
+  Connection c, watcher;
+  Clock::time_point started;
+
+ private:
+  static std::string sceneFile(const TempDir& dir, const std::string& events) {
+    dir.write("cylinder_drift.toml", testing_support::cylinderWithDriftCameras() + "\n" + events);
+    return dir.file("cylinder_drift.toml");
+  }
+  DaemonProcess::Launch launch(const TempDir& dir, const std::string& more_policy) const {
+    dir.write("procamd.toml", "[policy]\nrecalibrate = \"on-drift\"\n" + more_policy +
+                                  "[content]\nviewer = [0.0, -0.6, 1.6]\n");
+    // Without a scene the daemon is started with no rig; start() reports the scene.
+    return {{"--config", dir.file("procamd.toml"), "--sim", scene_file, "--rig",
+             scene ? curvedRigFile(dir, *scene) : dir.file("no-rig.json")},
+            {},
+            -1,
+            true};
+  }
+};
+
+std::string bumpEvents(std::span<const Bump> bumps) {
   std::string events;
   for (const Bump& b : bumps) {
     events += "[[events]]\nt = " + std::to_string(b.t) + "\ntarget = \"proj_c\"\nrotate_deg = [" +
               std::to_string(b.yaw) + ", " + std::to_string(b.pitch) + ", 0.0]\n\n";
   }
-  dir.write("cylinder_drift.toml", testing_support::cylinderWithDriftCameras() + "\n" + events);
-  const std::string scene_file = dir.file("cylinder_drift.toml");
-  auto scene = sim::resolveScene(scene_file);
-  ASSERT_TRUE(scene) << scene.error().message;
-  auto wall = geom::MeshIntersector::build(testing_support::cylinderWall());
-  ASSERT_TRUE(wall);
-  dir.write("procamd.toml",
-            "[policy]\nrecalibrate = \"on-drift\"\n[content]\nviewer = [0.0, -0.6, 1.6]\n");
-  DaemonProcess d(dir, DaemonProcess::Launch{{"--config", dir.file("procamd.toml"), "--sim",
-                                              scene_file, "--rig", curvedRigFile(dir, *scene)},
-                                             {},
-                                             -1,
-                                             true});
-  ASSERT_TRUE(d.started()) << d.log();
-  Connection c(d.socketPath());
-  Connection watcher(d.socketPath());
-  ASSERT_TRUE(watcher.call({{"cmd", "watch"}}));
-  const auto started = daemonStart(c);
-  // A panorama: the display across the three projectors puts it on all of them.
+  return events;
+}
+
+TEST(SimDriftCurved, ABumpedProjectorOnTheCylinderIsCorrectedFromTheContent) {
+  // Three outputs share the checks: still for 20 s (each checked about ten times).
+  const Bump bumps[] = {{at(20.0), 0.5, 0.0}, {at(42.0), 0.0, -2.0}};
+  TempDir dir;
+  CurvedDriftRig r(dir, bumpEvents(bumps));
   cv::Mat panorama;
   cv::cvtColor(drift::texturedContent({4800, 900}, 11, {80, 27, 9}), panorama, cv::COLOR_GRAY2BGR);
-  const std::string png = contentFile(dir, "panorama.png");
-  ASSERT_TRUE(cv::imwrite(png, panorama));
-  auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", png}}, 30s * kSlowdown);
-  ASSERT_TRUE(load);
-  ASSERT_EQ((*load)["class"], "CONTENT") << load->dump();
-  const auto sceneTime = [&] {
-    return std::chrono::duration<double>(Clock::now() - started).count();
-  };
+  ASSERT_NO_FATAL_FAILURE(r.start(dir, panorama));
+  const sim::Scene& scene = *r.scene;
+  DaemonProcess& d = r.d;
+  Connection &c = r.c, &watcher = r.watcher;
+  const auto sceneTime = [&] { return r.sceneTime(); };
   ASSERT_TRUE(checkedTimes([&] { return centreDrift(c); }, 3, 18s))
       << centreDrift(c).dump() << d.log();
   // The virtual camera's capture time of proj_c's checks, summed as status gives each
@@ -211,9 +270,9 @@ TEST(SimDriftCurved, ABumpedProjectorOnTheCylinderIsCorrectedFromTheContent) {
       EXPECT_NE(state, "failed") << e->dump();
       EXPECT_NE(state, "scanning") << e->dump();
     }
-    geom::CameraModel truth = scene->at(b.t + at(1.0)).projectors.at(kCentre).model;
+    geom::CameraModel truth = scene.at(b.t + at(1.0)).projectors.at(kCentre).model;
     ASSERT_TRUE(detected && corrected && registered && at_detect && at_register) << d.log();
-    const double rig_px = centreAgainstTruth(dir, *wall, truth);
+    const double rig_px = centreAgainstTruth(dir, *r.wall, truth);
     const double mesh_px = meshPixelsAgainstTruth(dir, truth);
     const json dr = centreDrift(c);
     std::printf(
@@ -247,19 +306,62 @@ TEST(SimDriftCurved, ABumpedProjectorOnTheCylinderIsCorrectedFromTheContent) {
     EXPECT_LE(rig_px, 0.5);
     EXPECT_LE(mesh_px, 0.5);
   }
-  // The side projectors were left alone, no scan ran and the content stayed on.
+  // No scan ran and the content stayed on; the side projectors and the cameras were left
+  // alone.
   auto st = c.call({{"cmd", "status"}});
   ASSERT_TRUE(st);
   EXPECT_TRUE((*st)["operations"].empty());
-  auto rig = rig::rigFromText(rigText(dir), "rig.json");
-  ASSERT_TRUE(rig);
-  const sim::SceneState rest = scene->at(0);
-  for (const char* side : {"proj_l", "proj_r"}) {
-    const rig::RigProjector* p = rig->projector(side);
-    ASSERT_TRUE(p);
-    const geom::Pose& truth = rest.projectors.at(side[5] == 'l' ? 0 : 2).model.pose;
-    EXPECT_LT((p->pose.center() - truth.center()).norm(), 1e-9) << side;
-  }
+  expectUntouched(dir, scene, {"proj_l", "proj_r"});
+}
+
+// Plain grey content on the cylinder: nothing to register, so each output's checks show
+// a fiducial frame now and then; proj_c bumped 1 deg (as the planar test) is found in its
+// tag corners and corrected from them, on its own mesh.
+TEST(SimDriftCurved, PlainContentOnTheCylinderIsCorrectedFromFiducialFrames) {
+  // Each output leads every third check, its camera's first looks find the content plain.
+  const Bump bump{at(24.0), 1.0, 0.0};
+  TempDir dir;
+  CurvedDriftRig r(dir, bumpEvents({&bump, 1}), "drift_fiducial_period_s = 2\n");
+  ASSERT_NO_FATAL_FAILURE(r.start(dir, cv::Mat(900, 4800, CV_8UC3, cv::Scalar(128, 128, 128))));
+  // At rest: proj_c told too plain by its content, then registered by fiducial frames.
+  json rest;
+  ASSERT_TRUE(eventually(
+      [&] {
+        rest = centreDrift(r.c);
+        return rest.is_object() && rest.value("content_too_plain", false) &&
+               rest.contains("fiducial") && rest["fiducial"].value("frames", 0) >= 1 &&
+               rest["fiducial"].contains("misregistration_px");
+      },
+      22s * kSlowdown))
+      << rest.dump() << r.d.log();
+  ASSERT_LT(r.sceneTime(), bump.t) << "the first fiducial check came after the bump";
+  // Half the threshold: no false trigger.
+  EXPECT_LT(rest["fiducial"]["misregistration_px"].get<double>(), 0.25) << rest.dump();
+  EXPECT_EQ(rest["state"], "registered") << rest.dump();
+  bool registered = false;
+  const std::optional<json> corrected =
+      awaitCorrection(r.watcher, "corrected-pose", "scanning", registered, 60s);
+  ASSERT_TRUE(corrected) << centreDrift(r.c).dump() << r.d.log();
+  EXPECT_TRUE(registered) << centreDrift(r.c).dump();
+  EXPECT_EQ((*corrected)["projector"], "proj_c") << corrected->dump();
+  EXPECT_EQ((*corrected)["surface"], "mesh") << corrected->dump();
+  const json dr = centreDrift(r.c);
+  const geom::CameraModel truth = r.scene->at(bump.t + at(1.0)).projectors.at(kCentre).model;
+  const double rig_px = centreAgainstTruth(dir, *r.wall, truth);
+  const double mesh_px = meshPixelsAgainstTruth(dir, truth);
+  std::printf(
+      "[ figures  ] cylinder, grey content, proj_c bumped 1 deg: at rest %.3f px by %d tag "
+      "frames; corrected from %d tag corners (pose fit %.3f px), the rig against the true "
+      "projector %.3f px, its mesh's pixels %.3f px; %d fiducial frames in all\n",
+      rest["fiducial"]["misregistration_px"].get<double>(), rest["fiducial"].value("frames", 0),
+      (*corrected)["tiles"].get<int>(), (*corrected)["pose_fit_px"].get<double>(), rig_px, mesh_px,
+      dr["fiducial"].value("frames", 0));
+  EXPECT_LE(rig_px, 0.5);
+  EXPECT_LE(mesh_px, 0.5);
+  // A handful of frames, not one at every check.
+  EXPECT_LE(dr["fiducial"].value("frames", 0), 20) << dr.dump();
+  // No false trigger from the plain content (the display's border alone) elsewhere.
+  expectUntouched(dir, *r.scene, {"proj_l", "proj_r"});
 }
 
 }  // namespace

@@ -9,57 +9,18 @@
 #include <memory>
 #include <opencv2/imgproc.hpp>
 
-#include "core/units.hpp"
-#include "curved_drift_scene.hpp"
+#include "curved_drift_rig.hpp"
 #include "drift/camera_correction.hpp"
 #include "drift/misregistration.hpp"
 #include "drift/projector_camera_map.hpp"
 #include "drift/projector_correction.hpp"
-#include "geometry/yaw_pitch_roll.hpp"
 #include "sim/renderer.hpp"
-#include "sim/scene_library.hpp"
-#include "sim/truth_rig.hpp"
 #include "textured_content.hpp"
-#include "unit/common/cylinder_wall.hpp"
 
 namespace procam::drift {
 namespace {
 
-constexpr std::size_t kCentre = 1;  // proj_c
-constexpr std::size_t kCamera = 0;  // cam_a
-
-geom::Pose turned(const geom::Pose& pose, double yaw_deg, double pitch_deg) {
-  geom::YawPitchRoll a;
-  a.yaw = degToRad(yaw_deg);
-  a.pitch = degToRad(pitch_deg);
-  const Mat3 Q = geom::parentFromChild(a);  // as the scene's events turn devices
-  return {Q.transpose() * pose.R, Q.transpose() * pose.t};
-}
-
-struct CurvedRig {
-  sim::Scene scene;
-  rig::RigModel model;
-  std::shared_ptr<const geom::MeshIntersector> wall;
-  LitSurface lit;  // the rig model's centre projector on the mesh
-};
-
-CurvedRig restingRig() {
-  auto scene = sim::Scene::parse(testing_support::cylinderWithDriftCameras(), "cylinder3", {});
-  EXPECT_TRUE(scene) << scene.error().message;
-  auto model = sim::truthRig(*scene, 0.0);
-  EXPECT_TRUE(model) << model.error().message;
-  auto wall = geom::MeshIntersector::build(testing_support::cylinderWall());
-  EXPECT_TRUE(wall) << wall.error().message;
-  CurvedRig r{*scene, *model, std::make_shared<geom::MeshIntersector>(std::move(*wall)), {}};
-  const geom::CameraModel projector = r.model.projectors.at(kCentre).model();
-  r.lit.occluder = r.wall;
-  r.lit.point = [projector, wall = r.wall](const Vec2& fb) -> std::optional<Vec3> {
-    auto ray = projector.backproject(fb);
-    auto hit = ray ? wall->intersect(*ray) : std::nullopt;
-    return hit ? std::optional<Vec3>(hit->point) : std::nullopt;
-  };
-  return r;
-}
+using namespace testing_curved;
 
 struct View {
   cv::Mat shown, camera, map;
@@ -87,22 +48,6 @@ View viewOf(const CurvedRig& rig, const cv::Mat& framebuffer, const geom::Pose& 
   EXPECT_TRUE(map) << map.error().message;
   v.map = *map;
   return v;
-}
-
-// The largest distance, in the true projector's pixels, between a framebuffer pixel and
-// where the true projector puts the wall point `model`'s pixel lights.
-double againstTruth(const CurvedRig& rig, const geom::CameraModel& model,
-                    const geom::CameraModel& truth) {
-  double worst = 0;
-  for (int y = 0; y < model.height; y += 40) {
-    for (int x = 0; x < model.width; x += 40) {
-      auto hit = rig.wall->intersect(*model.backproject({x, y}));
-      EXPECT_TRUE(hit);
-      if (!hit) return 1e9;
-      worst = std::max(worst, (*truth.project(hit->point) - Vec2(x, y)).norm());
-    }
-  }
-  return worst;
 }
 
 TEST(CurvedDrift, TheMeshMapPutsEveryPixelWhereTheCameraSeesIt) {

@@ -14,7 +14,7 @@
 #include "sim/renderer.hpp"
 #include "sim/scene_library.hpp"
 #include "sim/truth_rig.hpp"
-#include "structured_light/apriltag_grid.hpp"
+#include "tag_frame.hpp"
 
 namespace procam::drift {
 namespace {
@@ -43,13 +43,11 @@ double againstTruth(const geom::CameraModel& model, const geom::CameraModel& tru
 }
 
 TEST(FiducialMisregistration, TagCornersGiveTheDriftAndThePose) {
-  auto grid = sl::makeTagGrid({.width = 1920, .height = 1080});
-  ASSERT_TRUE(grid) << grid.error().message;
-  auto image = sl::renderTagGrid(*grid);
-  ASSERT_TRUE(image) << image.error().message;
-  std::vector<Vec2> shown;
-  for (const sl::TagPlacement& t : grid->tags)
-    shown.insert(shown.end(), t.corners.begin(), t.corners.end());
+  const auto tags_shown = testing_tags::tagFrame(1920, 1080);
+  ASSERT_TRUE(tags_shown);
+  const sl::TagGrid& grid = tags_shown->grid;
+  const cv::Mat& image = tags_shown->image;
+  const std::vector<Vec2>& shown = tags_shown->corners;
   struct Case {
     const char* what;
     std::string events;
@@ -70,11 +68,11 @@ TEST(FiducialMisregistration, TagCornersGiveTheDriftAndThePose) {
     ASSERT_TRUE(rest && rest->surface.plane && !rest->cameras.empty());
     auto tile = blend::displayTile(rest->projectors.at(0), rest->surface);
     ASSERT_TRUE(tile) << tile.error().message;
-    auto renderer = sim::Renderer::create(*scene, scene->at(2.0), {{"proj", *image}});
+    auto renderer = sim::Renderer::create(*scene, scene->at(2.0), {{"proj", image}});
     ASSERT_TRUE(renderer) << renderer.error().message;
     auto seen = renderer->renderCamera("cam");
     ASSERT_TRUE(seen) << seen.error().message;
-    auto tags = sl::detectTagGrid(*grid, *seen);
+    auto tags = sl::detectTagGrid(grid, *seen);
     ASSERT_TRUE(tags) << tags.error().message;
     std::vector<FiducialCorner> found;
     for (const sl::TagCorrespondence& c : *tags) found.push_back({c.pattern, c.image});

@@ -123,6 +123,43 @@ TEST(DriftCheck, PlainContentIsTooPlainToTell) {
   }
 }
 
+// A plain image's border alone: grey bands with straight, slanted edges between them.
+// An edge fixes no shift along itself, so its tiles are not textured and the frame is
+// too plain to tell; counted as texture (no isotropy test) they are, and the same bands
+// crossed by others make corners that count.
+TEST(DriftCheck, EdgesAloneAreTooPlainToTell) {
+  const Rig rig = restingRig();
+  const geom::Pose rest = rig.scene.at(0).projectors.at(0).model.pose;
+  cv::Mat bands(1080, 1920, CV_8U, cv::Scalar(40));
+  for (int k = 0; k < 4; ++k) {
+    const int x = 200 + 450 * k;
+    const std::vector<cv::Point> band{{x, 0}, {x + 220, 0}, {x + 120, 1079}, {x - 100, 1079}};
+    cv::fillConvexPoly(bands, band, cv::Scalar(200), cv::LINE_AA);
+  }
+  const View v = viewOf(rig, bands, rest);
+  auto m = measureMisregistration(v.shown, v.camera, v.map, v.grid);
+  ASSERT_TRUE(m) << m.error().message;
+  MisregistrationOptions any_edge;
+  any_edge.min_isotropy = 0;
+  auto counted = measureMisregistration(v.shown, v.camera, v.map, v.grid, any_edge);
+  ASSERT_TRUE(counted) << counted.error().message;
+  cv::Mat crossed = bands.clone();
+  for (int y = 150; y + 120 <= 1080; y += 300) crossed.rowRange(y, y + 120).setTo(cv::Scalar(120));
+  const View x = viewOf(rig, crossed, rest);
+  auto corners = measureMisregistration(x.shown, x.camera, x.map, x.grid);
+  ASSERT_TRUE(corners) << corners.error().message;
+  std::printf(
+      "[ figures  ] edges alone: %d of %d tiles textured (%d counting edges); crossed: %d "
+      "textured, %d used, misregistration %.3f px\n",
+      m->tiles_textured, m->tiles_seen, counted->tiles_textured, corners->tiles_textured,
+      corners->tiles_used, corners->rms_px);
+  EXPECT_TRUE(m->too_plain);
+  EXPECT_EQ(m->tiles_textured, 0);
+  EXPECT_GE(counted->tiles_textured, 0.15 * counted->tiles_seen);
+  // Where the bands cross, tiles hold corners: texture in two directions.
+  EXPECT_GE(corners->tiles_textured, 8);
+}
+
 TEST(DriftCheck, ABumpedProjectorIsMeasuredAndItsPoseCorrectedFromContent) {
   const Rig rig = restingRig();
   const geom::Pose rest = rig.scene.at(0).projectors.at(0).model.pose;
