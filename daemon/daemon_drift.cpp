@@ -208,6 +208,16 @@ std::optional<std::pair<DriftCheckPlan, DriftKey>> Daemon::planDriftCheck(
   if (st == k.output_state.end() || !st->second.shown_image || !st->second.shown_setup) {
     return unavailable("nothing shown yet");
   }
+  if (camera) {
+    // Measured in another output's capture: not when this camera found the frame too
+    // plain already; measured again it would tell nothing, and drift its fiducial frames
+    // saw would be forgotten.
+    const DriftRuntime::View& v = o.views[cam->name];
+    if (v.plain_setup && v.plain_setup == st->second.shown_setup &&
+        v.plain_image == st->second.shown_image) {
+      return std::nullopt;
+    }
+  }
   // The camera must see the frame drawn, not the one before it: a frame's latency to
   // the camera is a few output frames ([calibration] settle_frames, as calibrate waits).
   const double settle = std::max(0.1, (config_.calibration.settle_frames + 2) / 60.0);
@@ -235,6 +245,7 @@ std::optional<std::pair<DriftCheckPlan, DriftKey>> Daemon::planDriftCheck(
     plan.projector_to_plane = tile->projector_to_plane;
   }
   plan.camera_model = cam->model;
+  if (auto response = blend::projectorResponse(*p)) plan.projector_gamma = response->gamma;
   plan.frames = config_.drift.frames;
   if (fiducial) {
     // The frames wait while the fiducial frame is up (refreshOutputs).

@@ -9,6 +9,7 @@
 #include <opencv2/core.hpp>
 #include <tl/expected.hpp>
 
+#include "blend/blend_tables.hpp"
 #include "calibration_job.hpp"
 #include "drift/misregistration.hpp"
 #include "drift/projector_camera_map.hpp"
@@ -27,7 +28,7 @@ struct DriftReference {
   uint64_t rig_generation = 0;
   std::string camera;
   drift::WorkGrid grid;
-  cv::Mat shown;          // the frame's luminance on the grid, CV_32F, code values
+  cv::Mat shown;          // the frame's light on the grid, CV_32F, 0..255 for full white
   cv::Mat map;            // grid -> camera pixels
   cv::Mat usable;         // CV_8U of the grid: 0 where the frame is blended with a neighbour's
   double seen_share = 0;  // of the grid the camera sees
@@ -53,6 +54,8 @@ struct DriftCheckPlan {
   geom::CameraModel projector_model;
   bool own_mesh = false;
   geom::CameraModel camera_model;
+  // The projector's response (light ~ code^gamma): measured, or the one assumed.
+  double projector_gamma = blend::kAssumedGamma;
   int frames = 2;  // camera frames averaged
   // Waited on before the first capture: the device manager's reads of the camera end.
   ReadFence fence;

@@ -20,8 +20,8 @@ namespace procam::drift {
 struct MisregistrationOptions {
   int tile = 48;  // work pixels per side; a tile's shift may differ from the whole view's by a
                   // quarter of it
-  // A tile whose shown content varies less than this (standard deviation, in code
-  // values of 255) has nothing to register: plain.
+  // A tile whose shown content varies less than this (standard deviation, on the 0..255
+  // scale of its light) has nothing to register: plain.
   double min_texture = 6.0;
   // A tile whose texture runs one way (an edge alone: the border of a plain image) fixes
   // its shift across it only, not along it: plain too. The smaller eigenvalue of the
@@ -71,8 +71,8 @@ struct Misregistration {
 void fitShiftField(std::vector<TileShift> tiles, const MisregistrationOptions& options,
                    Misregistration& m);
 
-// `shown`: the frame on the output at the grid's work size (CV_32F, code values
-// 0..255); `camera`: the camera's frame (CV_32F, any scale); `map`: from
+// `shown`: the light of the frame on the output at the grid's work size (shownLight;
+// CV_32F, 0..255 for full white); `camera`: the camera's frame (CV_32F, any scale); `map`: from
 // projectorCameraMap for the same grid; `usable` (optional, CV_8U of the grid): tiles
 // with any zero pixel are left out (where another projector adds its light: a blended
 // overlap). kInvalidInput for mismatched sizes or types, or options out of range.

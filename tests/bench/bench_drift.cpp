@@ -39,6 +39,7 @@
 #include "drift/misregistration.hpp"
 #include "drift/projector_camera_map.hpp"
 #include "drift/projector_correction.hpp"
+#include "drift/shown_light.hpp"
 #include "geometry/intersect.hpp"
 #include "geometry/yaw_pitch_roll.hpp"
 #include "render/cpu_renderer.hpp"
@@ -121,11 +122,10 @@ Camera cameraOf(const Setup& s, const cv::Mat& fb, const geom::Pose& pose) {
   return c;
 }
 
+// The frame's light, through the projector's true response (as the daemon's reference).
 cv::Mat shownOf(const Setup& s, const cv::Mat& fb) {
-  cv::Mat f, out;
-  fb.convertTo(f, CV_32F);
-  cv::resize(f, out, s.grid.size(), 0, 0, cv::INTER_AREA);
-  return out;
+  auto light = drift::shownLight(fb, s.scene.at(0).projectors.at(0).spec.gamma, s.grid);
+  return light ? *light : cv::Mat();
 }
 
 // The true shift, in framebuffer pixels, of the content drawn at `p` when the projector

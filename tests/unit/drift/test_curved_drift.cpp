@@ -14,6 +14,7 @@
 #include "drift/misregistration.hpp"
 #include "drift/projector_camera_map.hpp"
 #include "drift/projector_correction.hpp"
+#include "drift/shown_light.hpp"
 #include "sim/renderer.hpp"
 #include "textured_content.hpp"
 
@@ -41,9 +42,10 @@ View viewOf(const CurvedRig& rig, const cv::Mat& framebuffer, const geom::Pose& 
   View v;
   v.grid = {framebuffer.size(), 2};
   image->convertTo(v.camera, CV_32F);
-  cv::Mat f;
-  framebuffer.convertTo(f, CV_32F);
-  cv::resize(f, v.shown, v.grid.size(), 0, 0, cv::INTER_AREA);
+  // The frame's light, through the projector's true response.
+  auto shown = shownLight(framebuffer, rig.scene.at(0).projectors.at(kCentre).spec.gamma, v.grid);
+  EXPECT_TRUE(shown) << shown.error().message;
+  v.shown = *shown;
   auto map = projectorCameraMap(rig.lit, rig.model.cameras.at(kCamera).model, v.grid);
   EXPECT_TRUE(map) << map.error().message;
   v.map = *map;

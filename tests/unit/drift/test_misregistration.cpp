@@ -14,6 +14,7 @@
 #include "drift/misregistration.hpp"
 #include "drift/projector_camera_map.hpp"
 #include "drift/projector_correction.hpp"
+#include "drift/shown_light.hpp"
 #include "geometry/intersect.hpp"
 #include "geometry/yaw_pitch_roll.hpp"
 #include "sim/renderer.hpp"
@@ -72,9 +73,10 @@ View viewOf(const Rig& rig, const cv::Mat& framebuffer, const geom::Pose& projec
   View v;
   v.grid = {framebuffer.size(), 2};
   image->convertTo(v.camera, CV_32F);
-  cv::Mat f;
-  framebuffer.convertTo(f, CV_32F);
-  cv::resize(f, v.shown, v.grid.size(), 0, 0, cv::INTER_AREA);
+  // The frame's light, through the projector's true response.
+  auto shown = shownLight(framebuffer, rig.scene.at(0).projectors.at(0).spec.gamma, v.grid);
+  EXPECT_TRUE(shown) << shown.error().message;
+  v.shown = *shown;
   auto map = projectorCameraMap(rig.tile, rig.camera, v.grid);
   EXPECT_TRUE(map) << map.error().message;
   v.map = *map;
@@ -269,6 +271,22 @@ TEST(DriftCheck, ABumpedCameraIsReregisteredFromTheContent) {
     // registration bound the corrected rig is held to.
     EXPECT_LT(worst, 0.2);
   }
+}
+
+// The reference is light: code 128 of a gamma-2.2 projector is 255 (128/255)^2.2 = 56.0
+// of full white's 255, in grey and through the luminance of an RGBA frame alike.
+TEST(DriftCheck, TheReferenceIsTheFramesLight) {
+  const WorkGrid grid{{64, 32}, 2};
+  auto grey = shownLight(cv::Mat(32, 64, CV_8UC1, cv::Scalar(128)), 2.2, grid);
+  ASSERT_TRUE(grey) << grey.error().message;
+  ASSERT_EQ(grey->size(), grid.size());
+  EXPECT_NEAR(grey->at<float>(5, 5), 255 * std::pow(128 / 255.0, 2.2), 1e-3);
+  auto rgba = shownLight(cv::Mat(32, 64, CV_8UC4, cv::Scalar(128, 128, 128, 255)), 2.2, grid);
+  ASSERT_TRUE(rgba) << rgba.error().message;
+  EXPECT_NEAR(rgba->at<float>(5, 5), grey->at<float>(5, 5), 1e-3);
+  EXPECT_EQ(shownLight(cv::Mat(32, 64, CV_8UC1), 0.5, grid).error().code, ErrorCode::kInvalidInput);
+  EXPECT_EQ(shownLight(cv::Mat(32, 64, CV_8UC3), 2.2, grid).error().code, ErrorCode::kInvalidInput);
+  EXPECT_EQ(shownLight(cv::Mat(30, 64, CV_8UC1), 2.2, grid).error().code, ErrorCode::kInvalidInput);
 }
 
 TEST(DriftCheck, MismatchedInputIsRefused) {

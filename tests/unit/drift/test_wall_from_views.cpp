@@ -13,6 +13,7 @@
 #include "blend/rig_tiles.hpp"
 #include "drift/misregistration.hpp"
 #include "drift/projector_camera_map.hpp"
+#include "drift/shown_light.hpp"
 #include "drift/wall_from_views.hpp"
 #include "second_camera.hpp"
 #include "sim/renderer.hpp"
@@ -49,10 +50,12 @@ std::vector<Checked> checkBoth(const sim::Scene& scene, const rig::RigModel& res
     EXPECT_TRUE(image) << image.error().message;
     Checked c;
     c.grid = {content.size(), 2};
-    cv::Mat camera, f, shown;
+    cv::Mat camera;
     image->convertTo(camera, CV_32F);
-    content.convertTo(f, CV_32F);
-    cv::resize(f, shown, c.grid.size(), 0, 0, cv::INTER_AREA);
+    // The frame's light, through the projector's true response.
+    auto light = shownLight(content, scene.at(0).projectors.at(0).spec.gamma, c.grid);
+    EXPECT_TRUE(light) << light.error().message;
+    const cv::Mat shown = light ? *light : cv::Mat();
     auto map = projectorCameraMap(tile->projector_to_plane, cam.model, c.grid);
     EXPECT_TRUE(map) << map.error().message;
     c.map = *map;
