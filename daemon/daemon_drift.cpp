@@ -210,8 +210,8 @@ std::optional<std::pair<DriftCheckPlan, DriftKey>> Daemon::planDriftCheck(
   }
   if (camera) {
     // Measured in another output's capture: not when this camera found the frame too
-    // plain already; measured again it would tell nothing, and drift its fiducial frames
-    // saw would be forgotten.
+    // plain at its last look (a too plain result clears the drift its fiducial frames
+    // saw); its own checks with this camera look again.
     const DriftRuntime::View& v = o.views[cam->name];
     if (v.plain_setup && v.plain_setup == st->second.shown_setup &&
         v.plain_image == st->second.shown_image) {

@@ -152,17 +152,34 @@ tl::expected<void, CalibrationFailure> reference(const DriftCheckPlan& plan, Dri
   return {};
 }
 
-// Where the frame on the work grid is plain over a tag corner's neighbourhood (16 work
-// pixels across): its standard deviation under the drift check's texture floor.
-cv::Mat plainAround(const cv::Mat& shown) {
-  constexpr int kWindow = 16;
-  constexpr double kPlainSd = 6.0;  // MisregistrationOptions::min_texture
+// Where the content's light on the work grid is plain over a tag's width around each
+// pixel: its standard deviation under the drift check's texture floor. In a blended
+// overlap the reference holds this projector's share only; the content there is that
+// share over its weight (eq. 4.3 scales the light), where a neighbour draws it at full
+// weight. Where the weight is 0 nothing tells: not plain.
+cv::Mat plainContent(const DriftReference& ref, const render::FinalStage& stage, int tag_work_px) {
+  const double floor = drift::MisregistrationOptions{}.min_texture;
+  cv::Mat content = ref.shown.clone();
+  cv::Mat weighted;  // where the frame is weighted at all
+  if (!stage.alpha.empty()) {
+    cv::Mat weight;
+    cv::resize(stage.alpha, weight, ref.grid.size(), 0, 0, cv::INTER_AREA);
+    weight.convertTo(weight, CV_32F, 1.0 / 255);
+    weighted = weight > 0;
+    cv::divide(content, cv::max(weight, 1.0 / 255), content);
+  }
+  const cv::Size window(std::max(3, tag_work_px), std::max(3, tag_work_px));
   cv::Mat mean, sq, mean_sq;
-  cv::blur(shown, mean, {kWindow, kWindow});
-  cv::multiply(shown, shown, sq);
-  cv::blur(sq, mean_sq, {kWindow, kWindow});
-  cv::Mat var = mean_sq - mean.mul(mean);
-  return var < kPlainSd * kPlainSd;
+  cv::blur(content, mean, window);
+  cv::multiply(content, content, sq);
+  cv::blur(sq, mean_sq, window);
+  cv::Mat plain = (mean_sq - mean.mul(mean)) < floor * floor;
+  if (!weighted.empty()) {
+    cv::Mat none;
+    cv::erode(weighted, none, cv::Mat(), cv::Point(-1, -1), 1);
+    cv::bitwise_and(plain, none, plain);
+  }
+  return plain;
 }
 
 tl::expected<DriftCheck, CalibrationFailure> runFiducialCheck(const DriftCheckPlan& plan) {
@@ -191,12 +208,18 @@ tl::expected<DriftCheck, CalibrationFailure> runFiducialCheck(const DriftCheckPl
   const auto measure = Clock::now();
   auto found = findFiducials(f, *mean);
   if (!found) return failed(found.error());
-  // Corners this projector alone lights, and those in a blended overlap where the frame
-  // is plain: the neighbour draws the same content there, so its light is smooth and
-  // shifts no corner (cylinder3 with the side projectors grey over the tags: 0.11 px at
-  // rest), where a textured neighbour's could.
+  // Corners this projector alone lights, and those in a blended overlap where the content
+  // is plain over a tag: the neighbour draws the same content there, so its light is
+  // smooth and shifts no corner (cylinder3 with the side projectors grey over the tags:
+  // 0.11 px at rest), where a textured neighbour's could.
   const DriftReference& ref = *out.reference;
-  const cv::Mat plain = plainAround(ref.shown);
+  double tag_px = 0;  // a tag's side, framebuffer pixels
+  if (!f.grid.tags.empty()) {
+    const auto& c = f.grid.tags.front().corners;
+    tag_px = (c[1] - c[0]).norm();
+  }
+  const cv::Mat plain = plainContent(ref, ref.setup->final_stage,
+                                     static_cast<int>(std::lround(tag_px / ref.grid.factor)));
   const auto counts = [&](const Vec2& drawn) {
     const Vec2 w = ref.grid.toWork(drawn);
     const int x = std::clamp(static_cast<int>(std::lround(w.x())), 0, ref.shown.cols - 1);

@@ -3,9 +3,10 @@
 // the output shows one frame of markers at a low duty cycle and the camera finds their
 // corners; each corner found is a tile of the drift check (misregistration.hpp), drawn
 // at its framebuffer position and seen where the rig model puts the camera pixel that
-// found it (the camera's ray met with the display plane, through the projector's
-// collineation with it, [Raskar02] §4.2.1). A moved projector moves the corners by one
-// collineation, as it moves content. Pure.
+// found it: the camera's ray met with the display plane, through the projector's
+// collineation with it ([Raskar02] §4.2.1), or, on any surface (a mesh, §4.1), through
+// the check's map of the framebuffer into the camera taken back. A moved projector moves
+// the corners as it moves content. Pure.
 #include <span>
 
 #include "core/error.hpp"

@@ -45,7 +45,7 @@ View viewOf(const CurvedRig& rig, const cv::Mat& framebuffer, const geom::Pose& 
   // The frame's light, through the projector's true response.
   auto shown = shownLight(framebuffer, rig.scene.at(0).projectors.at(kCentre).spec.gamma, v.grid);
   EXPECT_TRUE(shown) << shown.error().message;
-  v.shown = *shown;
+  if (shown) v.shown = *shown;
   auto map = projectorCameraMap(rig.lit, rig.model.cameras.at(kCamera).model, v.grid);
   EXPECT_TRUE(map) << map.error().message;
   v.map = *map;

@@ -76,7 +76,7 @@ View viewOf(const Rig& rig, const cv::Mat& framebuffer, const geom::Pose& projec
   // The frame's light, through the projector's true response.
   auto shown = shownLight(framebuffer, rig.scene.at(0).projectors.at(0).spec.gamma, v.grid);
   EXPECT_TRUE(shown) << shown.error().message;
-  v.shown = *shown;
+  if (shown) v.shown = *shown;
   auto map = projectorCameraMap(rig.tile, rig.camera, v.grid);
   EXPECT_TRUE(map) << map.error().message;
   v.map = *map;
