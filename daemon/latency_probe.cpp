@@ -205,7 +205,10 @@ tl::expected<LatencyResult, CalibrationFailure> runLatencyProbe(const LatencyPla
     if (!stats) return tl::unexpected(CalibrationFailure{code::kFailed, stats.error().message});
     c.stats = *stats;
     c.settle_frames = sl::settleFrames(c.stats.median, plan.refresh_hz, plan.margin_frames);
-    if (auto p = sl::latencyStats(periods)) c.frame_period_s = p->median;
+    if (auto p = sl::latencyStats(periods)) {
+      c.frame_period_s = p->median;
+      c.frame_period_max_s = p->max;
+    }
     result.latency_s = std::max(result.latency_s, c.stats.median);
     result.settle_frames = std::max(result.settle_frames, c.settle_frames);
     result.cameras.push_back(std::move(c));
@@ -225,7 +228,8 @@ json latencyJson(const LatencyResult& result, const LatencyPlan& plan) {
                        {"samples", c.latencies},
                        {"settle_frames", c.settle_frames},
                        {"contrast", c.contrast},
-                       {"frame_period_s", c.frame_period_s}});
+                       {"frame_period_s", c.frame_period_s},
+                       {"frame_period_max_s", c.frame_period_max_s}});
   }
   return {{"output", plan.output.name},
           {"latency_s", result.latency_s},

@@ -44,8 +44,10 @@ struct CameraLatency {
   sl::LatencyStats stats;
   int settle_frames = 0;
   double contrast = 0;  // |white - black| of the frame mean, camera DN
-  // Median time between the frames it captured: the resolution of the latency.
+  // Median time between the frames it captured: the resolution of the latency; and the
+  // longest, which bounds one switch's error on a camera that drops frames.
   double frame_period_s = 0;
+  double frame_period_max_s = 0;
 };
 
 struct LatencyResult {
@@ -61,7 +63,7 @@ tl::expected<LatencyResult, CalibrationFailure> runLatencyProbe(const LatencyPla
 
 // {latency_s, settle_frames, refresh_hz, margin_frames, cameras: [{name,
 // latency_s: {median, spread, min, max}, samples, settle_frames, contrast,
-// frame_period_s}]}.
+// frame_period_s, frame_period_max_s}]}.
 nlohmann::json latencyJson(const LatencyResult& result, const LatencyPlan& plan);
 
 }  // namespace procam::daemon

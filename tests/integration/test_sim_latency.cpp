@@ -45,7 +45,11 @@ void checkCamera(const json& cam, double truth, int margin_frames, double max_pe
   EXPECT_GT(period, 0);
   EXPECT_LT(period, max_period) << cam.dump();
   EXPECT_LE(std::abs(median - truth), period) << cam.dump();
-  for (const auto& s : cam["samples"]) EXPECT_LE(std::abs(s.get<double>() - truth), period);
+  // One switch's error is within the frames around it: the longest interval between
+  // two captures (a loaded machine delays some).
+  const double longest = cam["frame_period_max_s"].get<double>();
+  EXPECT_GE(longest, period);
+  for (const auto& s : cam["samples"]) EXPECT_LE(std::abs(s.get<double>() - truth), longest);
   EXPECT_EQ(cam["settle_frames"],
             static_cast<int>(std::ceil(median * kRefreshHz - 1e-9)) + margin_frames);
   EXPECT_GT(cam["contrast"].get<double>(), 10) << cam.dump();
