@@ -212,9 +212,7 @@ std::optional<std::pair<DriftCheckPlan, DriftKey>> Daemon::planDriftCheck(
     // Measured in another output's capture: not when this camera found the frame too
     // plain at its last look (a too plain result clears the drift its fiducial frames
     // saw); its own checks with this camera look again.
-    const DriftRuntime::View& v = o.views[cam->name];
-    if (v.plain_setup && v.plain_setup == st->second.shown_setup &&
-        v.plain_image == st->second.shown_image) {
+    if (o.views[cam->name].foundPlain(st->second.shown_setup, st->second.shown_image)) {
       return std::nullopt;
     }
   }
@@ -266,9 +264,8 @@ bool Daemon::fiducialDue(DriftRuntime::Output& o, const DriftRuntime::View& view
   // with "on-drift-silent"; at the period, and sooner (every camera's check) while drift
   // a camera saw is confirmed or a correction of it checked: at most kQuickFiducials
   // frames between two at the period, none while the output is unresolved.
-  const bool plain = view.plain_setup && view.plain_setup == shown.shown_setup &&
-                     view.plain_image == shown.shown_image;
-  if (!plain || config_.recalibrate != RecalibratePolicy::kOnDrift ||
+  if (!view.foundPlain(shown.shown_setup, shown.shown_image) ||
+      config_.recalibrate != RecalibratePolicy::kOnDrift ||
       !(config_.drift.fiducial_period_s > 0)) {
     return false;
   }

@@ -43,6 +43,11 @@ struct DriftRuntime {
     // The frame the last content check found too plain to register (null: none was).
     std::shared_ptr<const render::RenderSetup> plain_setup;
     std::shared_ptr<const cv::Mat> plain_image;
+    // Whether the last content check found this frame too plain.
+    bool foundPlain(const std::shared_ptr<const render::RenderSetup>& setup,
+                    const std::shared_ptr<const cv::Mat>& image) const {
+      return plain_setup && plain_setup == setup && plain_image == image;
+    }
   };
   struct Output {
     std::vector<std::string> cameras;  // the fixed cameras that see it

@@ -11,6 +11,7 @@
 #include "curved_drift_scene.hpp"
 #include "drift/projector_camera_map.hpp"
 #include "geometry/yaw_pitch_roll.hpp"
+#include "sim/renderer.hpp"
 #include "sim/scene_library.hpp"
 #include "sim/truth_rig.hpp"
 #include "unit/common/cylinder_wall.hpp"
@@ -68,6 +69,16 @@ inline double againstTruth(const CurvedRig& rig, const geom::CameraModel& model,
     }
   }
   return worst;
+}
+
+// cam_a's frame of `state` with the centre projector showing `centre` and the side ones
+// `sides` (8-bit, the framebuffer's size).
+inline Result<cv::Mat> centreSeen(const CurvedRig& rig, const sim::SceneState& state,
+                                  const cv::Mat& centre, const cv::Mat& sides) {
+  auto renderer = sim::Renderer::create(rig.scene, state,
+                                        {{"proj_l", sides}, {"proj_c", centre}, {"proj_r", sides}});
+  if (!renderer) return tl::unexpected(renderer.error());
+  return renderer->renderCamera("cam_a");
 }
 
 }  // namespace procam::drift::testing_curved

@@ -33,11 +33,8 @@ View viewOf(const CurvedRig& rig, const cv::Mat& framebuffer, const geom::Pose& 
   sim::SceneState state = rig.scene.at(0);
   state.projectors.at(kCentre).model.pose = projector_pose;
   if (camera_pose) state.cameras.at(kCamera).model.pose = *camera_pose;
-  const cv::Mat black(framebuffer.size(), CV_8U, cv::Scalar(0));
-  auto renderer = sim::Renderer::create(
-      rig.scene, state, {{"proj_l", black}, {"proj_c", framebuffer}, {"proj_r", black}});
-  EXPECT_TRUE(renderer) << renderer.error().message;
-  auto image = renderer->renderCamera("cam_a");
+  auto image =
+      centreSeen(rig, state, framebuffer, cv::Mat(framebuffer.size(), CV_8U, cv::Scalar(0)));
   EXPECT_TRUE(image) << image.error().message;
   View v;
   v.grid = {framebuffer.size(), 2};

@@ -45,11 +45,7 @@ TEST(CurvedFiducial, TagCornersOnTheMeshGiveTheDriftAndThePose) {
     sim::SceneState state = rig.scene.at(0);
     state.projectors.at(kCentre).model.pose = truth.pose;
     // The side projectors show grey: their light adds to the tags in the overlaps.
-    const cv::Mat others(image.size(), CV_8U, cv::Scalar(128));
-    auto renderer = sim::Renderer::create(
-        rig.scene, state, {{"proj_l", others}, {"proj_c", image}, {"proj_r", others}});
-    ASSERT_TRUE(renderer) << renderer.error().message;
-    auto seen = renderer->renderCamera("cam_a");
+    auto seen = centreSeen(rig, state, image, cv::Mat(image.size(), CV_8U, cv::Scalar(128)));
     ASSERT_TRUE(seen) << seen.error().message;
     // cylinder3's cameras give more than 8 bits: stretched as the daemon does.
     cv::Mat grey = *seen;
