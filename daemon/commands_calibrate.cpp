@@ -60,8 +60,11 @@ void Daemon::writeRig(rig::RigModel update, std::map<std::string, std::string> m
           }
           rig_ = *merged;
           logInfo("rig model written to " + path);
-          done(path);
+          // The new rig's meshes are read before `done` can redraw: a display solved now
+          // would pair the new poses with the old meshes, and be solved again once they
+          // are read.
           onRigChanged();
+          done(path);
         };
       },
       [done](const std::string& what) {

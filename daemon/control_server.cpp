@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <sys/epoll.h>
+#include <sys/resource.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -87,6 +88,10 @@ void ControlServer::resumeAccepting() {
 
 Result<void> ControlServer::start() {
   reserve_fd_.reset(::open("/dev/null", O_RDONLY | O_CLOEXEC));
+  rlimit limit{};
+  if (::getrlimit(RLIMIT_NOFILE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) {
+    descriptor_limit_ = static_cast<size_t>(limit.rlim_cur);
+  }
   return loop_.add(listen_fd_.get(), EPOLLIN, [this](uint32_t) { onAccept(); });
 }
 
@@ -153,6 +158,19 @@ void ControlServer::onAccept() {
                                       std::to_string(clients_.size()) +
                                       " clients connected (daemon.max_clients)");
       refuse(proto::code::kBusy, "too many clients");
+      continue;
+    }
+    // Descriptors are given lowest first, so every one below this client's is in use:
+    // fewer than the headroom would be left for the daemon's own.
+    if (descriptor_limit_ > 0 &&
+        static_cast<size_t>(fd.get()) + options_.descriptor_headroom >= descriptor_limit_) {
+      throttledWarning(busy_log_, "refused client pid " + std::to_string(cred.pid) + ": " +
+                                      std::to_string(clients_.size()) +
+                                      " clients connected, the last " +
+                                      std::to_string(options_.descriptor_headroom) + " of " +
+                                      std::to_string(descriptor_limit_) +
+                                      " file descriptors are kept for devices");
+      refuse(proto::code::kBusy, "too many clients for procamd's file descriptor limit");
       continue;
     }
     const ClientId id = next_id_++;

@@ -36,6 +36,9 @@ struct ServerOptions {
   size_t queue_limit_bytes = 1024 * 1024;
   std::chrono::milliseconds stall_timeout{10000};
   gid_t group = static_cast<gid_t>(-1);  // the procam group; -1 when it does not exist
+  // Descriptors kept from clients under RLIMIT_NOFILE: a device reopened after an
+  // unplug, a content stream or a timer must not fail because clients hold them all.
+  size_t descriptor_headroom = 32;
 };
 
 struct ServerStats {
@@ -121,7 +124,8 @@ class ControlServer {
 
   EventLoop& loop_;
   UniqueFd listen_fd_;
-  UniqueFd reserve_fd_;  // /dev/null, closed when accept() finds no descriptor free
+  UniqueFd reserve_fd_;          // /dev/null, closed when accept() finds no descriptor free
+  size_t descriptor_limit_ = 0;  // RLIMIT_NOFILE's soft limit at start(); 0: none
   bool accept_paused_ = false;
   // Warnings that a storm of clients could repeat without end: a few per 10 s, one
   // throttle per kind of warning (its count of held-back lines is about that kind).
