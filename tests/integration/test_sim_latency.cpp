@@ -94,6 +94,24 @@ TEST(SimLatency, MeasuredWithinOneFramePeriod) {
   auto done = finalReply(c, 4, 60s);
   ASSERT_TRUE(done) << d.log();
   ASSERT_EQ((*done)["class"], "LATENCY") << done->dump();
+  // A capture every 0.05 s or more says little of 0.1 s (checkCamera): a loaded machine
+  // delays the virtual camera's ray casting now and then, so measure again, twice at most.
+  for (int id = 6; id < 8 && (*done)["cameras"].size() == 1u &&
+                   (*done)["cameras"][0].value("frame_period_s", 1.0) >= 0.5 * kLatency;
+       ++id) {
+    std::printf("frame period %.4f s: measured again\n",
+                (*done)["cameras"][0].value("frame_period_s", 1.0));
+    r = c.call({{"cmd", "latency"},
+                {"id", id},
+                {"repeats", 3},
+                {"margin_frames", 2},
+                {"timeout_s", 1.0 * kSlowdown}});
+    ASSERT_TRUE(r);
+    ASSERT_EQ((*r)["class"], "LATENCY") << r->dump();
+    done = finalReply(c, id, 60s);
+    ASSERT_TRUE(done) << d.log();
+    ASSERT_EQ((*done)["class"], "LATENCY") << done->dump();
+  }
   EXPECT_EQ((*done)["state"], "done");
   EXPECT_EQ((*done)["refresh_hz"], kRefreshHz);
   ASSERT_EQ((*done)["cameras"].size(), 1u);

@@ -487,6 +487,8 @@ TEST_F(ManagerTest, DeviceReopenedDuringAReadIsWatchedWhenTheReadEnds) {
   // Only the new device's readings (numbered from 1 again) reach the hooks.
   EXPECT_EQ(poses[0], 1);
   EXPECT_EQ(poses[1], 2);
+  // The old device, released by its read's end, is closed on the closer thread.
+  ASSERT_TRUE(runUntil([&] { return fake::trackers_destroyed >= 1; }));
   EXPECT_EQ(fake::trackers_destroyed, 1);
 }
 
