@@ -27,6 +27,12 @@ using nlohmann::json;
 
 namespace {
 
+// What a view's fitted blur depends on: the framebuffer (work pixels are half its pixels)
+// and the camera's lens (a camera pixel in work pixels).
+Vec3 blurKey(const rig::RigProjector& p, const rig::RigCamera& c) {
+  return {static_cast<double>(p.width), c.model.K.fx, c.model.K.fy};
+}
+
 // Fiducial frames an output may show between two at drift_fiducial_period_s, to confirm
 // drift and check corrections: the bump on wall_oblique under grey content took 4 (a
 // settle of 0.5 s, one correction); three more passes, room to spare.
@@ -230,7 +236,11 @@ std::optional<std::pair<DriftCheckPlan, DriftKey>> Daemon::planDriftCheck(
   DriftCheckPlan plan;
   plan.output = out.name;
   plan.camera = {cam->name, cam_entry->device.share()};
-  plan.reference = o.views[cam->name].reference;
+  DriftRuntime::View& view = o.views[cam->name];
+  plan.reference = view.reference;
+  // A blur fitted for another framebuffer or camera lens is fitted again.
+  if (view.blur_for != blurKey(*p, *cam)) view.reference_blur.reset();
+  plan.reference_blur = view.reference_blur;
   plan.setup = st->second.shown_setup;
   plan.image = st->second.shown_image;
   plan.rig_generation = rig_generation_;
@@ -339,6 +349,18 @@ void Daemon::onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, Calibr
     return;
   }
   ++o.checks;
+  // Fitted where the content registered well: a frame with few tiles scores the
+  // candidates too noisily to keep the pick for good.
+  const rig::RigProjector* projector = rig_.projectorForOutput(key.output);
+  const rig::RigCamera* camera = rig_.camera(key.camera);
+  if (r->fitted_blur && !v.reference_blur && projector && camera &&
+      r->misregistration.tiles_used >= 2 * drift::MisregistrationOptions{}.min_tiles) {
+    v.reference_blur = r->fitted_blur;
+    v.blur_for = blurKey(*projector, *camera);
+    logInfo("drift: camera '" + key.camera + "' sees output '" + key.output + "' blurred by " +
+            std::to_string(*r->fitted_blur) +
+            " work px; its frames' light is compared blurred alike");
+  }
   const drift::Misregistration& m = r->misregistration;
   v.last = m;
   v.last_generation = key.rig_generation;
@@ -472,12 +494,14 @@ json Daemon::driftJson(const std::string& output) const {
     checked = true;
     plain = plain && v.last->too_plain;
     content_plain = content_plain || v.plain_image;
-    cameras.push_back({{"camera", name},
-                       {"misregistration_px", v.last->rms_px},
-                       {"too_plain", v.last->too_plain},
-                       {"from", v.last_fiducial ? "fiducial" : "content"},
-                       {"drifted", v.above.has_value()},
-                       {"age_s", secondsSince(v.checked_at)}});
+    cameras.push_back(
+        {{"camera", name},
+         {"misregistration_px", v.last->rms_px},
+         {"too_plain", v.last->too_plain},
+         {"from", v.last_fiducial ? "fiducial" : "content"},
+         {"drifted", v.above.has_value()},
+         {"age_s", secondsSince(v.checked_at)},
+         {"reference_blur_px", v.reference_blur ? json(*v.reference_blur) : json(nullptr)}});
   }
   j["cameras"] = std::move(cameras);
   j["content_too_plain"] = content_plain;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "drift/fiducial_misregistration.hpp"
+#include "drift/reference_blur.hpp"
 #include "drift/shown_light.hpp"
 #include "protocol.hpp"
 #include "render/cpu_renderer.hpp"
@@ -98,6 +99,21 @@ tl::expected<std::shared_ptr<const DriftReference>, CalibrationFailure> makeRefe
                   " % of the frame by the rig model (at least 10 % needed)");
   }
   return ref;
+}
+
+// The camera's frame against the reference, blurred as the plan's view sees it, or as a
+// fit over the candidates finds it when the view has none yet.
+Result<drift::Misregistration> measured(const DriftCheckPlan& plan, const DriftReference& ref,
+                                        const cv::Mat& frame, DriftCheck& out) {
+  drift::MisregistrationOptions options;
+  if (plan.reference_blur) {
+    options.reference_blur_px = *plan.reference_blur;
+    return drift::measureMisregistration(ref.shown, frame, ref.map, ref.grid, options, ref.usable);
+  }
+  auto fit = drift::fitReferenceBlur(ref.shown, frame, ref.map, ref.grid, options, ref.usable);
+  if (!fit) return tl::unexpected(fit.error());
+  out.fitted_blur = fit->sigma_px;
+  return std::move(fit->at_best);
 }
 
 }  // namespace
@@ -255,8 +271,7 @@ tl::expected<DriftCheck, CalibrationFailure> runDriftCheck(const DriftCheckPlan&
   if (!sum) return tl::unexpected(sum.error());
   out.capture_s = since(capture);
   const auto measure = Clock::now();
-  const DriftReference& ref = *out.reference;
-  auto m = drift::measureMisregistration(ref.shown, *sum, ref.map, ref.grid, {}, ref.usable);
+  auto m = measured(plan, *out.reference, *sum, out);
   out.measure_s = since(measure);
   if (!m) {
     return tl::unexpected(CalibrationFailure{
@@ -292,8 +307,7 @@ std::vector<tl::expected<DriftCheck, CalibrationFailure>> runDriftChecks(
     DriftCheck& c = checks[i];
     c.capture_s = capture_s;
     const auto measure = Clock::now();
-    const DriftReference& ref = *c.reference;
-    auto m = drift::measureMisregistration(ref.shown, *mean, ref.map, ref.grid, {}, ref.usable);
+    auto m = measured(plans[i], *c.reference, *mean, c);
     c.measure_s = since(measure);
     if (!m) {
       out.push_back(tl::unexpected(CalibrationFailure{

@@ -7,6 +7,7 @@
 // Never touches daemon state.
 #include <memory>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <tl/expected.hpp>
 
 #include "blend/blend_tables.hpp"
@@ -57,6 +58,9 @@ struct DriftCheckPlan {
   // The projector's response (light ~ code^gamma): measured, or the one assumed.
   double projector_gamma = blend::kAssumedGamma;
   int frames = 2;  // camera frames averaged
+  // How blurred this camera sees the output's frame (work pixels, drift/reference_blur.hpp),
+  // fitted by an earlier check; unset: this check fits it.
+  std::optional<double> reference_blur;
   // Waited on before the first capture: the device manager's reads of the camera end.
   ReadFence fence;
   // Set: a fiducial check. The frame is shown on `output_device` (its size the
@@ -71,11 +75,12 @@ struct DriftCheckPlan {
 struct DriftCheck {
   std::shared_ptr<const DriftReference> reference;
   drift::Misregistration misregistration;
-  double seconds = 0;      // the whole check, capture included
-  double reference_s = 0;  // making the reference (0: reused)
-  double capture_s = 0;    // the camera frames
-  double measure_s = 0;    // the registration
-  bool fiducial = false;   // measured from a fiducial frame
+  double seconds = 0;                 // the whole check, capture included
+  double reference_s = 0;             // making the reference (0: reused)
+  double capture_s = 0;               // the camera frames
+  double measure_s = 0;               // the registration
+  bool fiducial = false;              // measured from a fiducial frame
+  std::optional<double> fitted_blur;  // the reference blur this check fitted
 };
 
 // The plan's reference when it still fits (same setup, content, rig and camera).

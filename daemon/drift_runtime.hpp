@@ -40,6 +40,11 @@ struct DriftRuntime {
     nlohmann::json timing =
         nullptr;                 // the last check's: {check_s, reference_s, capture_s, measure_s}
     bool last_fiducial = false;  // `last` came from a fiducial frame
+    // How blurred this camera sees the output's frames (work pixels), fitted once from
+    // content it registered well: the optics, not the frame or the rig model. Fitted again
+    // for another framebuffer size or camera focal length (`blur_for`).
+    std::optional<double> reference_blur;
+    Vec3 blur_for = Vec3::Zero();  // framebuffer width, camera fx, fy when fitted
     // The frame the last content check found too plain to register (null: none was).
     std::shared_ptr<const render::RenderSetup> plain_setup;
     std::shared_ptr<const cv::Mat> plain_image;

@@ -164,12 +164,12 @@ void fitShiftField(std::vector<TileShift> tiles, const MisregistrationOptions& o
   m.tiles = std::move(tiles);
 }
 
-Result<Misregistration> measureMisregistration(const cv::Mat& shown, const cv::Mat& camera,
+Result<Misregistration> measureMisregistration(const cv::Mat& frame_light, const cv::Mat& camera,
                                                const cv::Mat& map, const WorkGrid& grid,
                                                const MisregistrationOptions& options,
                                                const cv::Mat& usable) {
   const cv::Size size = grid.size();
-  if (shown.type() != CV_32F || shown.size() != size || map.type() != CV_32FC2 ||
+  if (frame_light.type() != CV_32F || frame_light.size() != size || map.type() != CV_32FC2 ||
       map.size() != size || camera.type() != CV_32F || camera.empty()) {
     return fail(ErrorCode::kInvalidInput,
                 "drift check: the shown frame and the map must be CV_32F / CV_32FC2 of the work "
@@ -184,6 +184,16 @@ Result<Misregistration> measureMisregistration(const cv::Mat& shown, const cv::M
   if (!(options.min_isotropy >= 0 && options.min_isotropy <= 1)) {
     return fail(ErrorCode::kInvalidInput, "drift check: min_isotropy outside [0, 1]");
   }
+  if (!(options.reference_blur_px >= 0 && options.reference_blur_px <= kMaxReferenceBlurPx)) {
+    return fail(ErrorCode::kInvalidInput, "drift check: reference blur outside [0, 8] work pixels");
+  }
+  // What the camera should see: the frame's light through the blur it is seen with.
+  cv::Mat blurred;
+  if (options.reference_blur_px > 0) {
+    cv::GaussianBlur(frame_light, blurred, cv::Size(), options.reference_blur_px,
+                     options.reference_blur_px, cv::BORDER_REPLICATE);
+  }
+  const cv::Mat& shown = blurred.empty() ? frame_light : blurred;
   // The camera's view on the framebuffer grid; -1 where the camera does not see it.
   cv::Mat seen;
   cv::remap(camera, seen, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,

@@ -35,7 +35,13 @@ struct MisregistrationOptions {
   int min_tiles = 8;
   double min_textured_share = 0.15;
   double ransac_px = 1.5;  // framebuffer pixels
+  // Gaussian sigma, work pixels, applied to the shown frame's light before it is compared:
+  // the camera sees the frame through the projector's pixel footprint, its own lens and
+  // pixels and the resampling onto the grid (reference_blur.hpp finds it). 0 to 8.
+  double reference_blur_px = 0;
 };
+
+inline constexpr double kMaxReferenceBlurPx = 8.0;
 
 // One tile: the content drawn at framebuffer point `drawn` (the tile's centre) lands on
 // the surface where the rig model puts framebuffer point `seen_at`; the phase
@@ -71,12 +77,13 @@ struct Misregistration {
 void fitShiftField(std::vector<TileShift> tiles, const MisregistrationOptions& options,
                    Misregistration& m);
 
-// `shown`: the light of the frame on the output at the grid's work size (shownLight;
-// CV_32F, 0..255 for full white); `camera`: the camera's frame (CV_32F, any scale); `map`: from
-// projectorCameraMap for the same grid; `usable` (optional, CV_8U of the grid): tiles
-// with any zero pixel are left out (where another projector adds its light: a blended
-// overlap). kInvalidInput for mismatched sizes or types, or options out of range.
-Result<Misregistration> measureMisregistration(const cv::Mat& shown, const cv::Mat& camera,
+// `frame_light`: the light of the frame on the output at the grid's work size (shownLight;
+// CV_32F, 0..255 for full white), blurred by options.reference_blur_px before use; `camera`: the
+// camera's frame (CV_32F, any scale); `map`: from projectorCameraMap for the same grid; `usable`
+// (optional, CV_8U of the grid): tiles with any zero pixel are left out (where another projector
+// adds its light: a blended overlap). kInvalidInput for mismatched sizes or types, or options out
+// of range.
+Result<Misregistration> measureMisregistration(const cv::Mat& frame_light, const cv::Mat& camera,
                                                const cv::Mat& map, const WorkGrid& grid,
                                                const MisregistrationOptions& options = {},
                                                const cv::Mat& usable = {});

@@ -1,8 +1,10 @@
 // The drift check of a fixed rig (recalibrate = "on-drift") on wall_oblique (one 1920x1080
 // projector, a fixed 1280x960 camera with 0.8 DN read noise), per content type (a natural
 // image's multi-octave noise, text, a smooth gradient):
-//  - cost: making the reference (the frame drawn again on the CPU, mapped into the camera)
-//    and one registration (drift::measureMisregistration), against the frame period of a
+//  - cost: making the reference (the frame drawn again on the CPU, mapped into the camera),
+//    fitting the blur the camera sees it with once (drift::fitReferenceBlur, as the daemon
+//    does at a view's first check; every registration below uses it) and one registration
+//    (drift::measureMisregistration), against the frame period of a
 //    30 fps camera; beside it OpenCV's findTransformECC (homography) registering the same
 //    camera view with the frame shown, the library's whole-image alternative, with its
 //    error against the true shift;
@@ -39,6 +41,7 @@
 #include "drift/misregistration.hpp"
 #include "drift/projector_camera_map.hpp"
 #include "drift/projector_correction.hpp"
+#include "drift/reference_blur.hpp"
 #include "drift/shown_light.hpp"
 #include "geometry/intersect.hpp"
 #include "geometry/yaw_pitch_roll.hpp"
@@ -254,7 +257,8 @@ int main(int argc, char** argv) {
   const geom::Pose rest = s.scene.at(0).projectors.at(0).model.pose;
 
   std::ofstream csv(out / "drift.csv");
-  csv << "content,reference_ms,measure_ms,ecc_ms,frame_period_ms,floor_p99_px,bump_deg,true_px,"
+  csv << "content,reference_ms,measure_ms,ecc_ms,frame_period_ms,blur_px,floor_p99_px,bump_deg,"
+         "true_px,"
          "measured_px,ecc_error_px,correct_ms\n";
   std::printf(
       "Drift check on wall_oblique (1920x1080 projector, 1280x960 camera, 0.8 DN), grid "
@@ -286,10 +290,17 @@ int main(int argc, char** argv) {
     const Camera at_rest = cameraOf(s, c.fb, rest);
     std::vector<double> floor;
     const cv::Mat frame0 = at_rest.frame(1, 2);
+    // As the daemon does: the blur the camera sees the frame with, fitted once at rest.
+    drift::MisregistrationOptions options;
+    const bench::Timing fit = bench::measure(std::max(3, runs / 4), [&] {
+      auto b = drift::fitReferenceBlur(shown, frame0, s.map, s.grid);
+      options.reference_blur_px = b && b->sigma_px ? *b->sigma_px : 0.0;
+    });
     const bench::Timing meas = bench::measure(
-        runs, [&] { (void)drift::measureMisregistration(shown, frame0, s.map, s.grid); });
+        runs, [&] { (void)drift::measureMisregistration(shown, frame0, s.map, s.grid, options); });
     for (int i = 0; i < 4 * runs; ++i) {
-      auto m = drift::measureMisregistration(shown, at_rest.frame(100 + i, 2), s.map, s.grid);
+      auto m =
+          drift::measureMisregistration(shown, at_rest.frame(100 + i, 2), s.map, s.grid, options);
       floor.push_back(m && !m->too_plain ? m->rms_px : std::nan(""));
     }
     const bool plain =
@@ -301,14 +312,16 @@ int main(int argc, char** argv) {
         bench::measure(std::max(3, runs / 4), [&] { (void)eccError(s, shown, frame0, rest); });
     std::printf(
         "  %-9s reference %.1f ms, check %.1f ms (a 30 fps camera: 33.3 ms per frame); "
-        "OpenCV ECC homography %.1f ms (%.1fx); at rest %s\n",
+        "OpenCV ECC homography %.1f ms (%.1fx); blur %.2f work px (fitted once in %.0f ms); at "
+        "rest %s\n",
         c.name, ref.median_ms, meas.median_ms, ecc.median_ms, ecc.median_ms / meas.median_ms,
+        options.reference_blur_px, fit.median_ms,
         plain ? "too plain to tell" : ("p99 " + std::to_string(p99) + " px").c_str());
     for (double bump : {0.0, 0.005, 0.01, 0.02, 0.05, 0.5}) {
       const geom::Pose pose = turned(rest, bump);
       const Camera moved = cameraOf(s, c.fb, pose);
       const cv::Mat frame = moved.frame(7, 2);
-      auto m = drift::measureMisregistration(shown, frame, s.map, s.grid);
+      auto m = drift::measureMisregistration(shown, frame, s.map, s.grid, options);
       const double truth = trueRms(s, pose);
       const double ecc_err = eccError(s, shown, frame, pose);
       double correct_ms = std::nan("");
@@ -324,8 +337,8 @@ int main(int argc, char** argv) {
                       ? ""
                       : (", correction " + std::to_string(correct_ms) + " ms").c_str());
       csv << c.name << "," << ref.median_ms << "," << meas.median_ms << "," << ecc.median_ms
-          << ",33.3," << p99 << "," << bump << "," << truth << "," << measured << "," << ecc_err
-          << "," << correct_ms << std::endl;
+          << ",33.3," << options.reference_blur_px << "," << p99 << "," << bump << "," << truth
+          << "," << measured << "," << ecc_err << "," << correct_ms << std::endl;
     }
   }
 
@@ -366,6 +379,11 @@ int main(int argc, char** argv) {
   const Content& natural = contents[0];
   const cv::Mat shown = shownOf(s, natural.fb);
   const Camera at_rest = cameraOf(s, natural.fb, rest);
+  drift::MisregistrationOptions soak_options;
+  if (auto b = drift::fitReferenceBlur(shown, at_rest.frame(1, 2), s.map, s.grid);
+      b && b->sigma_px) {
+    soak_options.reference_blur_px = *b->sigma_px;
+  }
   std::ofstream soak(out / "drift_soak.csv");
   soak << "check,misregistration_px\n";
   const int checks = 10 * 60 * 4;
@@ -374,7 +392,8 @@ int main(int argc, char** argv) {
   int run = 0, false_triggers = 0;
   const auto t0 = std::chrono::steady_clock::now();
   for (int i = 0; i < checks; ++i) {
-    auto m = drift::measureMisregistration(shown, at_rest.frame(10'000 + i, 2), s.map, s.grid);
+    auto m = drift::measureMisregistration(shown, at_rest.frame(10'000 + i, 2), s.map, s.grid,
+                                           soak_options);
     const double v = m && !m->too_plain ? m->rms_px : 0.0;
     worst = std::max(worst, v);
     run = v > 0.5 ? run + 1 : 0;

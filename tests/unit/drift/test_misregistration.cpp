@@ -14,6 +14,7 @@
 #include "drift/misregistration.hpp"
 #include "drift/projector_camera_map.hpp"
 #include "drift/projector_correction.hpp"
+#include "drift/reference_blur.hpp"
 #include "drift/shown_light.hpp"
 #include "geometry/intersect.hpp"
 #include "geometry/yaw_pitch_roll.hpp"
@@ -125,6 +126,24 @@ TEST(DriftCheck, PlainContentIsTooPlainToTell) {
   }
 }
 
+// Grey bands with straight, slanted edges between them: a plain image's borders.
+cv::Mat slantedBands() {
+  cv::Mat bands(1080, 1920, CV_8U, cv::Scalar(40));
+  for (int k = 0; k < 4; ++k) {
+    const int x = 200 + 450 * k;
+    const std::vector<cv::Point> band{{x, 0}, {x + 220, 0}, {x + 120, 1079}, {x - 100, 1079}};
+    cv::fillConvexPoly(bands, band, cv::Scalar(200), cv::LINE_AA);
+  }
+  return bands;
+}
+
+// The same bands crossed by horizontal ones: sharp corners, which the camera sees blurred.
+cv::Mat crossedBands() {
+  cv::Mat crossed = slantedBands();
+  for (int y = 150; y + 120 <= 1080; y += 300) crossed.rowRange(y, y + 120).setTo(cv::Scalar(120));
+  return crossed;
+}
+
 // A plain image's border alone: grey bands with straight, slanted edges between them.
 // An edge fixes no shift along itself, so its tiles are not textured and the frame is
 // too plain to tell; counted as texture (no isotropy test) they are, and the same bands
@@ -132,22 +151,14 @@ TEST(DriftCheck, PlainContentIsTooPlainToTell) {
 TEST(DriftCheck, EdgesAloneAreTooPlainToTell) {
   const Rig rig = restingRig();
   const geom::Pose rest = rig.scene.at(0).projectors.at(0).model.pose;
-  cv::Mat bands(1080, 1920, CV_8U, cv::Scalar(40));
-  for (int k = 0; k < 4; ++k) {
-    const int x = 200 + 450 * k;
-    const std::vector<cv::Point> band{{x, 0}, {x + 220, 0}, {x + 120, 1079}, {x - 100, 1079}};
-    cv::fillConvexPoly(bands, band, cv::Scalar(200), cv::LINE_AA);
-  }
-  const View v = viewOf(rig, bands, rest);
+  const View v = viewOf(rig, slantedBands(), rest);
   auto m = measureMisregistration(v.shown, v.camera, v.map, v.grid);
   ASSERT_TRUE(m) << m.error().message;
   MisregistrationOptions any_edge;
   any_edge.min_isotropy = 0;
   auto counted = measureMisregistration(v.shown, v.camera, v.map, v.grid, any_edge);
   ASSERT_TRUE(counted) << counted.error().message;
-  cv::Mat crossed = bands.clone();
-  for (int y = 150; y + 120 <= 1080; y += 300) crossed.rowRange(y, y + 120).setTo(cv::Scalar(120));
-  const View x = viewOf(rig, crossed, rest);
+  const View x = viewOf(rig, crossedBands(), rest);
   auto corners = measureMisregistration(x.shown, x.camera, x.map, x.grid);
   ASSERT_TRUE(corners) << corners.error().message;
   std::printf(
@@ -160,6 +171,74 @@ TEST(DriftCheck, EdgesAloneAreTooPlainToTell) {
   EXPECT_GE(counted->tiles_textured, 0.15 * counted->tiles_seen);
   // Where the bands cross, tiles hold corners: texture in two directions.
   EXPECT_GE(corners->tiles_textured, 8);
+}
+
+// The blur the virtual camera sees the frame with, in work pixels at the grid's centre:
+// the projector's pixel footprint, the camera's lens, its pixel (a box: variance 1/12)
+// and the bilinear resampling onto the grid (a tent: 1/6).
+double theoreticalBlur(const Rig& rig, const View& v) {
+  const cv::Point c(v.map.cols / 2, v.map.rows / 2);
+  const cv::Vec2f m0 = v.map.at<cv::Vec2f>(c), mx = v.map.at<cv::Vec2f>(c + cv::Point(1, 0)),
+                  my = v.map.at<cv::Vec2f>(c + cv::Point(0, 1));
+  const double camera_px_per_work = std::sqrt(
+      std::abs(double(mx[0] - m0[0]) * (my[1] - m0[1]) - double(mx[1] - m0[1]) * (my[0] - m0[0])));
+  const double s = 1.0 / camera_px_per_work;  // a camera pixel, in work pixels
+  const double projector = rig.scene.at(0).projectors.at(0).spec.blur_sigma_px / v.grid.factor;
+  const double lens = rig.scene.at(0).cameras.at(0).spec.psf_sigma_px;
+  return std::sqrt(projector * projector + s * s * (lens * lens + 1.0 / 12 + 1.0 / 6));
+}
+
+TEST(DriftCheck, TheReferenceIsBlurredAsTheCameraSeesTheFrame) {
+  const Rig rig = restingRig();
+  const geom::Pose rest = rig.scene.at(0).projectors.at(0).model.pose;
+  for (const auto& [name, content] :
+       {std::pair{"crossed bands", crossedBands()},
+        std::pair{"textured", texturedContent({1920, 1080}, 3, {96, 32, 12})}}) {
+    SCOPED_TRACE(name);
+    const View v = viewOf(rig, content, rest);
+    auto sharp = measureMisregistration(v.shown, v.camera, v.map, v.grid);
+    auto fitted = fitReferenceBlur(v.shown, v.camera, v.map, v.grid);
+    ASSERT_TRUE(sharp) << sharp.error().message;
+    ASSERT_TRUE(fitted) << fitted.error().message;
+    ASSERT_TRUE(fitted->sigma_px);
+    const Misregistration& m = fitted->at_best;
+    const double theory = theoreticalBlur(rig, v);
+    std::printf(
+        "[ figures  ] %s at rest: sharp reference %.3f px (tiles scatter %.3f, %d used); "
+        "blurred by %.2f work px (theory %.2f) %.3f px (scatter %.3f, %d used)\n",
+        name, sharp->rms_px, sharp->tile_rms_px, sharp->tiles_used, *fitted->sigma_px, theory,
+        m.rms_px, m.tile_rms_px, m.tiles_used);
+    // Within the candidates' spacing of what the scene's optics give.
+    EXPECT_NEAR(*fitted->sigma_px, theory, 0.5);
+    EXPECT_FALSE(m.too_plain);
+    // Half the 0.5 px the daemon acts on (the sharp reference reads the bands 0.33 px off).
+    EXPECT_LT(m.rms_px, 0.25);
+    // The fit's own measure: the collineation's standard error, no worse than unblurred.
+    const auto standardError = [](const Misregistration& r) {
+      return r.tile_rms_px / std::sqrt(static_cast<double>(r.tiles_used));
+    };
+    EXPECT_LE(standardError(m), standardError(*sharp));
+  }
+  // Nothing to register: no blur is found, and the frame is too plain.
+  const View plain = viewOf(rig, cv::Mat(1080, 1920, CV_8U, cv::Scalar(128)), rest);
+  auto none = fitReferenceBlur(plain.shown, plain.camera, plain.map, plain.grid);
+  ASSERT_TRUE(none);
+  EXPECT_FALSE(none->sigma_px);
+  EXPECT_TRUE(none->at_best.too_plain);
+  MisregistrationOptions out_of_range;
+  out_of_range.reference_blur_px = 9;
+  EXPECT_EQ(measureMisregistration(plain.shown, plain.camera, plain.map, plain.grid, out_of_range)
+                .error()
+                .code,
+            ErrorCode::kInvalidInput);
+  EXPECT_EQ(
+      fitReferenceBlur(plain.shown, plain.camera, plain.map, plain.grid, {}, {}, {}).error().code,
+      ErrorCode::kInvalidInput);
+  const double descending[] = {1.0, 0.5};
+  EXPECT_EQ(fitReferenceBlur(plain.shown, plain.camera, plain.map, plain.grid, {}, {}, descending)
+                .error()
+                .code,
+            ErrorCode::kInvalidInput);
 }
 
 TEST(DriftCheck, ABumpedProjectorIsMeasuredAndItsPoseCorrectedFromContent) {
