@@ -86,12 +86,21 @@ void ControlServer::resumeAccepting() {
   accept_paused_ = false;
 }
 
+void ControlServer::readDescriptorLimit() {
+  rlimit limit{};
+  descriptor_limit_ = ::getrlimit(RLIMIT_NOFILE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY
+                          ? static_cast<size_t>(limit.rlim_cur)
+                          : 0;
+}
+
+void ControlServer::setOptions(const ServerOptions& options) {
+  options_ = options;
+  readDescriptorLimit();
+}
+
 Result<void> ControlServer::start() {
   reserve_fd_.reset(::open("/dev/null", O_RDONLY | O_CLOEXEC));
-  rlimit limit{};
-  if (::getrlimit(RLIMIT_NOFILE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) {
-    descriptor_limit_ = static_cast<size_t>(limit.rlim_cur);
-  }
+  readDescriptorLimit();
   return loop_.add(listen_fd_.get(), EPOLLIN, [this](uint32_t) { onAccept(); });
 }
 
@@ -161,14 +170,14 @@ void ControlServer::onAccept() {
       continue;
     }
     // Descriptors are given lowest first, so every one below this client's is in use:
-    // fewer than the headroom would be left for the daemon's own.
-    if (descriptor_limit_ > 0 &&
-        static_cast<size_t>(fd.get()) + options_.descriptor_headroom >= descriptor_limit_) {
+    // fewer than the headroom would be left for the daemon's own. At most a quarter of a
+    // small limit, so that clients still get in under it.
+    const size_t headroom = std::min(options_.descriptor_headroom, descriptor_limit_ / 4);
+    if (descriptor_limit_ > 0 && static_cast<size_t>(fd.get()) + headroom >= descriptor_limit_) {
       throttledWarning(busy_log_, "refused client pid " + std::to_string(cred.pid) + ": " +
                                       std::to_string(clients_.size()) +
-                                      " clients connected, the last " +
-                                      std::to_string(options_.descriptor_headroom) + " of " +
-                                      std::to_string(descriptor_limit_) +
+                                      " clients connected, the last " + std::to_string(headroom) +
+                                      " of " + std::to_string(descriptor_limit_) +
                                       " file descriptors are kept for devices");
       refuse(proto::code::kBusy, "too many clients for procamd's file descriptor limit");
       continue;

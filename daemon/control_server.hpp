@@ -36,8 +36,9 @@ struct ServerOptions {
   size_t queue_limit_bytes = 1024 * 1024;
   std::chrono::milliseconds stall_timeout{10000};
   gid_t group = static_cast<gid_t>(-1);  // the procam group; -1 when it does not exist
-  // Descriptors kept from clients under RLIMIT_NOFILE: a device reopened after an
-  // unplug, a content stream or a timer must not fail because clients hold them all.
+  // Descriptors kept from clients under RLIMIT_NOFILE (at most a quarter of it): a device
+  // reopened after an unplug, a content stream or a timer must not fail because clients
+  // hold them all.
   size_t descriptor_headroom = 32;
 };
 
@@ -61,7 +62,8 @@ class ControlServer {
   ~ControlServer();
 
   Result<void> start();
-  void setOptions(const ServerOptions& options) { options_ = options; }
+  // New options; the descriptor limit is read again too.
+  void setOptions(const ServerOptions& options);
 
   // Queues one line for a client; false when the client is gone or was just
   // dropped for exceeding its queue bound.
@@ -101,6 +103,7 @@ class ControlServer {
     std::vector<UniqueFd> passed_fds;  // for the next request that completes
   };
 
+  void readDescriptorLimit();  // RLIMIT_NOFILE's soft limit into descriptor_limit_
   void onAccept();
   // accept() failed for want of descriptors: refuse one client with `busy`.
   void refuseWithoutDescriptors();
@@ -125,7 +128,7 @@ class ControlServer {
   EventLoop& loop_;
   UniqueFd listen_fd_;
   UniqueFd reserve_fd_;          // /dev/null, closed when accept() finds no descriptor free
-  size_t descriptor_limit_ = 0;  // RLIMIT_NOFILE's soft limit at start(); 0: none
+  size_t descriptor_limit_ = 0;  // RLIMIT_NOFILE's soft limit; 0: none
   bool accept_paused_ = false;
   // Warnings that a storm of clients could repeat without end: a few per 10 s, one
   // throttle per kind of warning (its count of held-back lines is about that kind).

@@ -129,11 +129,11 @@ TEST(SimCameraYaw, TheCameraOnTheProjectorGivesTheYawOfEachHold) {
   // behind under load still integrates every one.
   EXPECT_EQ(gyro["gaps"], 0) << gyro.dump();
   // Every solution reaches the output, and the daemon says how long after its reading:
-  // at least as many frames as the solutions judged while turning (how many frames the
-  // whole run draws depends on the machine's load, not on procamd).
+  // frames that show solutions, at least ten a second over the 5 s of turning as the
+  // solutions judged above (solutions that come faster than frames share one frame).
   const json& latency = (*status)["latency"];
   ASSERT_TRUE(latency.is_object()) << status->dump();
-  EXPECT_GE(latency["frames"].get<int>(), static_cast<int>(turning_px.size()));
+  EXPECT_GE(latency["frames"].get<int>(), 50);
   EXPECT_GT(latency["median_ms"].get<double>(), 0.0);
   EXPECT_LE(latency["median_ms"].get<double>(), latency["max_ms"].get<double>());
   std::printf("tilt reading to shown: median %.1f ms, 95 %% %.1f ms, max %.1f ms\n",

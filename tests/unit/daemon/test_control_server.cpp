@@ -175,16 +175,11 @@ TEST(ControlServerDescriptors, AcceptWithoutADescriptorRefusesEachClientWithBusy
 }
 
 TEST(ControlServerDescriptors, AClientLeavingLessThanTheHeadroomIsRefusedWithBusy) {
-  rlimit limit{};
-  ASSERT_EQ(::getrlimit(RLIMIT_NOFILE, &limit), 0);
-  ASSERT_NE(limit.rlim_cur, RLIM_INFINITY);
-  const size_t limit_now = static_cast<size_t>(limit.rlim_cur);
+  rlimit saved{};
+  ASSERT_EQ(::getrlimit(RLIMIT_NOFILE, &saved), 0);
   Served s(0);
   ASSERT_TRUE(s.ok());
   ASSERT_TRUE(s.arm(300ms));
-  // Descriptors are given lowest first: the server's end of `first` takes the lowest
-  // one free once both clients hold theirs, and a headroom that leaves exactly that one
-  // under the limit lets one client in.
   UniqueFd first = connectTo(s.path);
   UniqueFd second = connectTo(s.path);
   ASSERT_TRUE(first.valid() && second.valid());
@@ -194,12 +189,18 @@ TEST(ControlServerDescriptors, AClientLeavingLessThanTheHeadroomIsRefusedWithBus
     ASSERT_TRUE(probe.valid());
     next_free = probe.get();
   }
-  ASSERT_GT(limit_now, static_cast<size_t>(next_free) + 2);
+  // Descriptors are given lowest first: the server's end of `first` takes next_free, of
+  // `second` the one after it, the last under a limit just above them. A headroom of one
+  // lets the first client in and refuses the second.
+  rlimit lower = saved;
+  lower.rlim_cur = static_cast<rlim_t>(next_free + 2);
+  ASSERT_EQ(::setrlimit(RLIMIT_NOFILE, &lower), 0);
   ServerOptions options;
   options.release = "test";
-  options.descriptor_headroom = limit_now - static_cast<size_t>(next_free) - 1;
-  s.server->setOptions(options);
+  options.descriptor_headroom = 1;
+  s.server->setOptions(options);  // reads the lowered limit
   s.loop->run();
+  ::setrlimit(RLIMIT_NOFILE, &saved);
   auto a = firstLine(first.get());
   auto b = firstLine(second.get());
   ASSERT_TRUE(a && b);
