@@ -27,6 +27,21 @@ namespace {
 using nlohmann::json;
 using namespace std::chrono_literals;
 
+// UBSan tests whether memory is readable through a pipe before it checks a vptr: with no
+// descriptor left it reports every virtual call as one through a bad vptr, so under the
+// sanitizers (built together here) these cases say nothing about the server.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kSanitized = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(undefined_behavior_sanitizer)
+constexpr bool kSanitized = true;
+#else
+constexpr bool kSanitized = false;
+#endif
+#else
+constexpr bool kSanitized = false;
+#endif
+
 // A server on a socket in a fresh directory, run by hand with runFor().
 struct Served {
   explicit Served(size_t headroom) {
@@ -133,6 +148,7 @@ double processCpuSeconds() {
 }
 
 TEST(ControlServerDescriptors, AcceptWithoutADescriptorRefusesEachClientWithBusy) {
+  if (kSanitized) GTEST_SKIP() << "runs without sanitizers (they need descriptors too)";
   Served s(0);  // no headroom: the clients take the descriptors to the last
   ASSERT_TRUE(s.ok());
   // Waiting in the backlog while the process has no descriptor free.
@@ -175,6 +191,7 @@ TEST(ControlServerDescriptors, AcceptWithoutADescriptorRefusesEachClientWithBusy
 }
 
 TEST(ControlServerDescriptors, AClientLeavingLessThanTheHeadroomIsRefusedWithBusy) {
+  if (kSanitized) GTEST_SKIP() << "runs without sanitizers (they need descriptors too)";
   rlimit saved{};
   ASSERT_EQ(::getrlimit(RLIMIT_NOFILE, &saved), 0);
   Served s(0);
