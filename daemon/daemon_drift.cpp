@@ -241,6 +241,10 @@ std::optional<std::pair<DriftCheckPlan, DriftKey>> Daemon::planDriftCheck(
   // A blur fitted for another framebuffer or camera lens is fitted again.
   if (view.blur_for != blurKey(*p, *cam)) view.reference_blur.reset();
   plan.reference_blur = view.reference_blur;
+  // A frame a fit already found too little in is measured sharp, not fitted every check.
+  if (!plan.reference_blur && view.blur_tried.is(st->second.shown_setup, st->second.shown_image)) {
+    plan.reference_blur = 0.0;
+  }
   plan.setup = st->second.shown_setup;
   plan.image = st->second.shown_image;
   plan.rig_generation = rig_generation_;
@@ -349,12 +353,10 @@ void Daemon::onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, Calibr
     return;
   }
   ++o.checks;
-  // Fitted where the content registered well: a frame with few tiles scores the
-  // candidates too noisily to keep the pick for good.
   const rig::RigProjector* projector = rig_.projectorForOutput(key.output);
   const rig::RigCamera* camera = rig_.camera(key.camera);
-  if (r->fitted_blur && !v.reference_blur && projector && camera &&
-      r->misregistration.tiles_used >= 2 * drift::MisregistrationOptions{}.min_tiles) {
+  if (r->blur_fitted && !r->fitted_blur) v.blur_tried = {key.setup, key.image};
+  if (r->fitted_blur && projector && camera) {
     v.reference_blur = r->fitted_blur;
     v.blur_for = blurKey(*projector, *camera);
     logInfo("drift: camera '" + key.camera + "' sees output '" + key.output + "' blurred by " +
@@ -368,8 +370,7 @@ void Daemon::onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, Calibr
   if (r->fiducial && !m.too_plain) o.fiducial_px = m.rms_px;
   if (!r->fiducial) {
     // Whether this frame's content can be registered: fiducialDue asks.
-    v.plain_setup = m.too_plain ? key.setup : nullptr;
-    v.plain_image = m.too_plain ? key.image : nullptr;
+    v.plain = m.too_plain ? DriftRuntime::Frame{key.setup, key.image} : DriftRuntime::Frame{};
   }
   const double threshold = config_.drift.threshold_px;
   if (m.too_plain || m.rms_px <= threshold) {
@@ -493,7 +494,7 @@ json Daemon::driftJson(const std::string& output) const {
     if (!v.last) continue;
     checked = true;
     plain = plain && v.last->too_plain;
-    content_plain = content_plain || v.plain_image;
+    content_plain = content_plain || v.plain.image;
     cameras.push_back(
         {{"camera", name},
          {"misregistration_px", v.last->rms_px},

@@ -112,6 +112,7 @@ Result<drift::Misregistration> measured(const DriftCheckPlan& plan, const DriftR
   }
   auto fit = drift::fitReferenceBlur(ref.shown, frame, ref.map, ref.grid, options, ref.usable);
   if (!fit) return tl::unexpected(fit.error());
+  out.blur_fitted = true;
   out.fitted_blur = fit->sigma_px;
   return std::move(fit->at_best);
 }

@@ -80,7 +80,8 @@ struct DriftCheck {
   double capture_s = 0;               // the camera frames
   double measure_s = 0;               // the registration
   bool fiducial = false;              // measured from a fiducial frame
-  std::optional<double> fitted_blur;  // the reference blur this check fitted
+  bool blur_fitted = false;           // this check fitted the reference blur
+  std::optional<double> fitted_blur;  // what it found (unset: too little to tell)
 };
 
 // The plan's reference when it still fits (same setup, content, rig and camera).

@@ -31,6 +31,15 @@ struct DriftKey {
 struct DriftRuntime {
   using Clock = std::chrono::steady_clock;
   // One camera's view of an output: its reference and last check.
+  // One frame an output showed: its render setup and content, by identity.
+  struct Frame {
+    std::shared_ptr<const render::RenderSetup> setup;
+    std::shared_ptr<const cv::Mat> image;
+    bool is(const std::shared_ptr<const render::RenderSetup>& s,
+            const std::shared_ptr<const cv::Mat>& i) const {
+      return setup && setup == s && image == i;
+    }
+  };
   struct View {
     std::shared_ptr<const DriftReference> reference;
     std::optional<drift::Misregistration> last;
@@ -45,13 +54,12 @@ struct DriftRuntime {
     // for another framebuffer size or camera focal length (`blur_for`).
     std::optional<double> reference_blur;
     Vec3 blur_for = Vec3::Zero();  // framebuffer width, camera fx, fy when fitted
-    // The frame the last content check found too plain to register (null: none was).
-    std::shared_ptr<const render::RenderSetup> plain_setup;
-    std::shared_ptr<const cv::Mat> plain_image;
-    // Whether the last content check found this frame too plain.
+    // The frame the last content check found too plain to register, and the one a fit of
+    // the blur found too little in (null: none): neither is looked at again for it.
+    Frame plain, blur_tried;
     bool foundPlain(const std::shared_ptr<const render::RenderSetup>& setup,
                     const std::shared_ptr<const cv::Mat>& image) const {
-      return plain_setup && plain_setup == setup && plain_image == image;
+      return plain.is(setup, image);
     }
   };
   struct Output {

@@ -35,6 +35,8 @@ Result<ReferenceBlur> fitReferenceBlur(const cv::Mat& shown, const cv::Mat& came
       out.at_best = std::move(*m);
     }
   }
+  // A pick from a few tiles is too noisy to keep for the view's life.
+  if (out.sigma_px && out.at_best.tiles_used < 2 * options.min_tiles) out.sigma_px.reset();
   return out;
 }
 

@@ -21,8 +21,9 @@ inline constexpr double kBlurCandidates[] = {0.0, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0
 // `candidates` by the least standard error of the tiles about their collineation
 // (tile_rms_px / sqrt(tiles_used)); `sigma_px` is nullopt when every candidate found the
 // frame too plain (`at_best` is then the first candidate's; with too few textured tiles
-// there the others are not tried). kInvalidInput as measureMisregistration, or for no
-// candidates, candidates not ascending or one outside [0, 8].
+// there the others are not tried), or the best registered under twice
+// options.min_tiles tiles (`at_best` is then still its measurement). kInvalidInput as
+// measureMisregistration, or for no candidates, candidates not ascending or one outside [0, 8].
 struct ReferenceBlur {
   std::optional<double> sigma_px;
   Misregistration at_best;

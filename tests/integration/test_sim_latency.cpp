@@ -75,11 +75,14 @@ TEST(SimLatency, MeasuredWithinOneFramePeriod) {
   ASSERT_TRUE(r);
   EXPECT_EQ((*r)["code"], "unavailable") << r->dump();
 
-  r = c.call({{"cmd", "latency"},
-              {"id", 4},
-              {"repeats", 3},
-              {"margin_frames", 2},
-              {"timeout_s", 1.0 * kSlowdown}});
+  const auto measurement = [](int id) {
+    return json{{"cmd", "latency"},
+                {"id", id},
+                {"repeats", 3},
+                {"margin_frames", 2},
+                {"timeout_s", 1.0 * kSlowdown}};
+  };
+  r = c.call(measurement(4));
   ASSERT_TRUE(r);
   ASSERT_EQ((*r)["class"], "LATENCY") << r->dump();
   EXPECT_EQ((*r)["state"], "started");
@@ -101,11 +104,7 @@ TEST(SimLatency, MeasuredWithinOneFramePeriod) {
        ++id) {
     std::printf("frame period %.4f s: measured again\n",
                 (*done)["cameras"][0].value("frame_period_s", 1.0));
-    r = c.call({{"cmd", "latency"},
-                {"id", id},
-                {"repeats", 3},
-                {"margin_frames", 2},
-                {"timeout_s", 1.0 * kSlowdown}});
+    r = c.call(measurement(id));
     ASSERT_TRUE(r);
     ASSERT_EQ((*r)["class"], "LATENCY") << r->dump();
     done = finalReply(c, id, 60s);
