@@ -290,6 +290,8 @@ class Daemon {
   void onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, CalibrationFailure> r);
   // Whether a check may start now.
   bool driftMayRun() const;
+  bool streamPlaying() const;     // a shared or streamed source that has not ended
+  bool fiducialFramesOn() const;  // on-drift with a fiducial period
   void correctDrift(const std::string& output, const std::string& camera,
                     const drift::Misregistration& m);
   // A projector's own surface mesh told the pixels that light its vertices after the

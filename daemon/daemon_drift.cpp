@@ -82,9 +82,24 @@ bool Daemon::driftMayRun() const {
          !k.yaw.measuring && !k.rendering && !k.render_again;
 }
 
+bool Daemon::streamPlaying() const {
+  return live_content_ && !live_content_->ended;
+}
+
+bool Daemon::fiducialFramesOn() const {
+  return config_.recalibrate == RecalibratePolicy::kOnDrift && config_.drift.fiducial_period_s > 0;
+}
+
 void Daemon::checkDrift() {
   DriftRuntime& d = drift_rt_;
-  if (d.checking || d.writing || !driftMayRun()) return;
+  d.check_after_frame = false;
+  if (d.checking || d.writing) return;
+  if (!driftMayRun()) {
+    // A stream's frames follow each other closely: the check goes in after this one.
+    const KeystoneRuntime& k = keystone_rt_;
+    d.check_after_frame = (k.rendering || k.render_again) && streamPlaying();
+    return;
+  }
   // One check at a time (the worker also draws the frames), led by the outputs in turn:
   // the lead's camera (its cameras in turn) captures once for every output it sees.
   std::vector<DeviceEntry*> outputs;
@@ -155,8 +170,17 @@ std::optional<std::pair<DriftCheckPlan, DriftKey>> Daemon::planDriftCheck(
   if (settings_.auto_keystone) {
     return unavailable("auto keystone corrects the projector from its tilt sensor");
   }
-  if (live_content_ && !live_content_->ended) {
-    return unavailable("streamed content: the frame changes between camera frames");
+  // A stream's frame changes between camera frames: its checks are fiducial frames
+  // (their own frame, shown for one capture), which on-drift-silent never shows.
+  const bool streamed = streamPlaying();
+  if (streamed && !fiducialFramesOn()) {
+    return unavailable(
+        "streamed content: the frame changes between camera frames, and fiducial frames are "
+        "off (" +
+        std::string(config_.recalibrate == RecalibratePolicy::kOnDrift
+                        ? "drift_fiducial_period_s = 0"
+                        : "recalibrate = \"on-drift-silent\"") +
+        ")");
   }
   // The surface the output draws on: a plane, or a mesh (sceneTraits, as the frames).
   const bool curved = sceneTraits(out.name, false).surface == render::SurfaceKind::kNonPlanar;
@@ -217,15 +241,16 @@ std::optional<std::pair<DriftCheckPlan, DriftKey>> Daemon::planDriftCheck(
   if (camera) {
     // Measured in another output's capture: not when this camera found the frame too
     // plain at its last look (a too plain result clears the drift its fiducial frames
-    // saw); its own checks with this camera look again.
-    if (o.views[cam->name].foundPlain(st->second.shown_setup, st->second.shown_image)) {
+    // saw), nor a stream's; its own checks with this camera look again.
+    if (streamed || o.views[cam->name].foundPlain(st->second.shown_setup, st->second.shown_image)) {
       return std::nullopt;
     }
   }
   // The camera must see the frame drawn, not the one before it: a frame's latency to
   // the camera is a few output frames ([calibration] settle_frames, as calibrate waits).
+  // A fiducial frame over a stream waits as long after it is shown.
   const double settle = std::max(0.1, (config_.calibration.settle_frames + 2) / 60.0);
-  if (secondsSince(st->second.shown_at) < settle) return std::nullopt;
+  if (!streamed && secondsSince(st->second.shown_at) < settle) return std::nullopt;
   // Nor the fiducial frame a check showed before the content came back.
   if (o.fiducial_at && secondsSince(*o.fiducial_at) < settle) return std::nullopt;
   o.unavailable.clear();
@@ -233,6 +258,7 @@ std::optional<std::pair<DriftCheckPlan, DriftKey>> Daemon::planDriftCheck(
   // No fiducial frame for an output measured in another's capture.
   const bool fiducial =
       !camera && fiducialDue(o, o.views[cam->name], st->second, {p->width, p->height});
+  if (streamed && !fiducial) return std::nullopt;  // the next fiducial frame's turn
   DriftCheckPlan plan;
   plan.output = out.name;
   plan.camera = {cam->name, cam_entry->device.share()};
@@ -274,13 +300,13 @@ std::optional<std::pair<DriftCheckPlan, DriftKey>> Daemon::planDriftCheck(
 bool Daemon::fiducialDue(DriftRuntime::Output& o, const DriftRuntime::View& view,
                          const KeystoneRuntime::OutputState& shown, cv::Size framebuffer) {
   DriftRuntime& d = drift_rt_;
-  // Only where the content this camera last looked at was too plain to register, never
-  // with "on-drift-silent"; at the period, and sooner (every camera's check) while drift
-  // a camera saw is confirmed or a correction of it checked: at most kQuickFiducials
-  // frames between two at the period, none while the output is unresolved.
-  if (!view.foundPlain(shown.shown_setup, shown.shown_image) ||
-      config_.recalibrate != RecalibratePolicy::kOnDrift ||
-      !(config_.drift.fiducial_period_s > 0)) {
+  // Only where the content this camera last looked at was too plain to register, or is
+  // a stream, never with "on-drift-silent"; at the period, and sooner (every camera's
+  // check) while drift a camera saw is confirmed or a correction of it checked: at most
+  // kQuickFiducials frames between two at the period, none while the output is
+  // unresolved.
+  if (!(streamPlaying() || view.foundPlain(shown.shown_setup, shown.shown_image)) ||
+      !fiducialFramesOn()) {
     return false;
   }
   const bool due =
@@ -470,6 +496,7 @@ json Daemon::driftJson(const std::string& output) const {
             {"corrections", o.corrections},
             {"last_correction", o.last_correction}};
   if (!o.error.empty()) j["error"] = o.error;
+  j["content_streamed"] = streamPlaying();
   if (config_.recalibrate == RecalibratePolicy::kOnDrift) {
     json f = {{"frames", o.fiducial_checks}, {"period_s", config_.drift.fiducial_period_s}};
     if (o.fiducial_at) f["age_s"] = secondsSince(*o.fiducial_at);

@@ -326,6 +326,8 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done, bool supersede
           if (k.render_again) {
             k.render_again = false;
             refreshOutputs();
+          } else if (drift_rt_.check_after_frame) {
+            checkDrift();
           }
         };
       },

@@ -110,6 +110,9 @@ struct DriftRuntime {
   std::string camera_in_use;      // the camera it drives: the device manager keeps off it
   bool writing = false;           // a corrected rig model on its way to rig.json
   bool fiducial_showing = false;  // a fiducial frame is on an output: frames wait
+  // A check the frame in flight held back: begun as soon as it is shown (a stream's
+  // frames may leave the drift timer no gap of its own).
+  bool check_after_frame = false;
   // The fiducial frames, made once per framebuffer size; why there is none.
   std::map<std::pair<int, int>, std::shared_ptr<const FiducialFrame>> fiducial;
   std::string fiducial_unavailable;

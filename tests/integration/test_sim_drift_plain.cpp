@@ -69,63 +69,14 @@ TEST(SimDrift, PlainContentIsReportedWhenSilentAndOffDoesNothing) {
 // the next fiducial frame and corrected from the tag corners.
 TEST(SimDrift, PlainContentIsCheckedWithFiducialFramesAndABumpCorrected) {
   TempDir dir;
-  // The first fiducial frame comes 3 to 4 s after the daemon starts on two idle cores
-  // (start, content, the first checks), then one every 3 s or so (a 2 s period, and a
-  // second for the virtual camera to render each new frame); on two busy cores a capture
-  // takes 3 s.
-  const double bump_t = at(14.0);
-  const std::string scene_file =
-      sceneWithEvents(dir, "[[events]]\nt = " + std::to_string(bump_t) +
-                               "\ntarget = \"proj\"\nrotate_deg = [1.0, 0.0, 0.0]\n");
-  auto scene = sim::resolveScene(scene_file);
-  ASSERT_TRUE(scene) << scene.error().message;
-  DaemonProcess d(dir,
-                  driftDaemon(dir, "on-drift", scene_file, {}, "drift_fiducial_period_s = 2\n"));
-  ASSERT_TRUE(d.started()) << d.log();
-  Connection c(d.socketPath());
-  Connection watcher(d.socketPath());
-  ASSERT_TRUE(watcher.call({{"cmd", "watch"}}));
-  const auto start = daemonStart(c);
-  const auto sceneTime = [&] {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-  };
+  FiducialBump r(dir);
+  ASSERT_NO_FATAL_FAILURE(r.start());
   const std::string png = contentFile(dir, "grey.png");
   cv::imwrite(png, cv::Mat(900, 1600, CV_8UC3, cv::Scalar(128, 128, 128)));
-  ASSERT_NO_FATAL_FAILURE(showContent(c, png));
-  const std::string before = rigText(dir);
-  // Before the bump (the scene's clock starts after the daemon's: a margin of 1 s).
-  while (sceneTime() < bump_t - 1.0) std::this_thread::sleep_for(100ms);
-  json still = outputDrift(c);
-  ASSERT_TRUE(still.is_object()) << still.dump();
-  std::printf(
-      "[ figures  ] still, grey content: %d fiducial frames in %.1f s, misregistration %.3f "
-      "px; %d corrections\n",
-      still["fiducial"].value("frames", 0), sceneTime(),
-      still["fiducial"].value("misregistration_px", -1.0), still.value("corrections", -1));
+  ASSERT_NO_FATAL_FAILURE(showContent(r.c, png));
+  const json still = r.still(dir, rigText(dir), "grey content");
   EXPECT_TRUE(still.value("content_too_plain", false)) << still.dump();
-  EXPECT_GE(still["fiducial"].value("frames", 0), 2) << still.dump();
-  EXPECT_EQ(still.value("corrections", -1), 0) << still.dump();
-  // Under half the 0.5 px threshold: no false trigger.
-  EXPECT_LT(still["fiducial"].value("misregistration_px", 1e9), 0.25) << still.dump();
-  EXPECT_EQ(before, rigText(dir));
-  // The bump.
-  bool registered = false;
-  const std::optional<json> corrected =
-      awaitCorrection(watcher, "corrected-pose", "corrected-surface", registered);
-  ASSERT_TRUE(corrected) << outputDrift(c).dump() << d.log();
-  const double corrected_after = sceneTime() - bump_t;
-  EXPECT_TRUE(registered) << outputDrift(c).dump();
-  const json dr = outputDrift(c);
-  const double rig_px = rigAgainstTruth(dir, scene->at(bump_t + at(1.0)).projectors.at(0).model);
-  std::printf(
-      "[ figures  ] projector bumped 1 deg under grey content: seen at %.2f px in a fiducial "
-      "frame, corrected from %d tag corners (pose fit %.3f px), registered within %.1f s of "
-      "the bump (fiducial period 2 s); the rig against the true projector %.3f px; %d "
-      "fiducial frames in all\n",
-      (*corrected)["why"]["misregistration_px"].get<double>(), (*corrected)["tiles"].get<int>(),
-      (*corrected)["pose_fit_px"].get<double>(), corrected_after, rig_px,
-      dr["fiducial"].value("frames", 0));
-  EXPECT_LE(rig_px, 0.5);
+  r.corrected(dir, "grey content");
 }
 
 // Two fixed cameras and uniform grey content: the projector bumped 1 degree is found in a

@@ -1,0 +1,157 @@
+// recalibrate = "on-drift" end to end while a stream plays (sim_drift_rig.hpp: wall_oblique,
+// the truth at rest as the rig model): a stream's frame changes between camera frames, so
+// its checks are fiducial frames, shown between the stream's frames; "on-drift-silent",
+// which shows none, reports the output unavailable.
+#include <fcntl.h>
+#include <poll.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <csignal>
+#include <thread>
+
+#include "sim_drift_rig.hpp"
+
+namespace procam::itest {
+namespace {
+
+constexpr int kWidth = 1600, kHeight = 900;
+
+// Raw RGB frames written into a FIFO in turn, `fps` a second (the daemon reads a FIFO
+// whenever bytes arrive: the writer sets the pace); closing the FIFO ends the stream.
+class FifoFrames {
+ public:
+  FifoFrames(const std::string& fifo, std::vector<cv::Mat> frames, double fps)
+      : frames_(std::move(frames)), fps_(fps), thread_([this, fifo] { run(fifo); }) {}
+  ~FifoFrames() {
+    stop_ = true;
+    thread_.join();
+  }
+  int written() const { return written_; }
+
+ private:
+  void run(const std::string& fifo) {
+    // Opened once the daemon reads it (ENXIO before), not blocking on a reader gone.
+    int fd = -1;
+    while (!stop_ && fd < 0) {
+      fd = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
+      if (fd < 0) std::this_thread::sleep_for(20ms);
+    }
+    const auto start = Clock::now();
+    for (std::size_t i = 0; fd >= 0 && !stop_; ++i) {
+      std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(
+                                                std::chrono::duration<double>(i / fps_)));
+      const cv::Mat& f = frames_[i % frames_.size()];
+      const std::size_t n = f.total() * f.elemSize();
+      for (std::size_t done = 0; done < n && !stop_;) {
+        pollfd p{fd, POLLOUT, 0};
+        if (::poll(&p, 1, 100) <= 0) continue;
+        const ssize_t k = ::write(fd, f.data + done, n - done);
+        if (k < 0 && errno != EAGAIN) {
+          stop_ = true;  // the daemon closed it
+          break;
+        }
+        if (k > 0) done += std::size_t(k);
+      }
+      if (!stop_) ++written_;
+    }
+    if (fd >= 0) ::close(fd);
+  }
+  std::vector<cv::Mat> frames_;
+  double fps_;
+  std::atomic<bool> stop_{false};
+  std::atomic<int> written_{0};
+  std::thread thread_;
+};
+
+// Three textured frames (a natural image's spectrum, three seeds), RGB.
+std::vector<cv::Mat> texturedFrames() {
+  std::vector<cv::Mat> out;
+  for (int seed : {11, 12, 13}) {
+    cv::Mat rgb;
+    cv::cvtColor(drift::texturedContent({kWidth, kHeight}, seed, {80, 27, 9}), rgb,
+                 cv::COLOR_GRAY2RGB);
+    out.push_back(rgb);
+  }
+  return out;
+}
+
+// `content stream` of raw RGB frames from a new FIFO in `dir`.
+std::string streamFrom(Connection& c, const TempDir& dir) {
+  const std::string fifo = contentFile(dir, "frames");
+  EXPECT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  auto reply = c.call({{"cmd", "content"},
+                       {"action", "stream"},
+                       {"path", fifo},
+                       {"width", kWidth},
+                       {"height", kHeight},
+                       {"format", "rgb8"}});
+  EXPECT_TRUE(reply && (*reply)["class"] == "CONTENT") << (reply ? reply->dump() : "");
+  return fifo;
+}
+
+int contentFrames(Connection& c) {
+  auto r = c.call({{"cmd", "content"}});
+  return r ? (*r)["content"].value("frames", 0) : 0;
+}
+
+// A stream of textured frames at 10 per second under "on-drift": still, the fiducial
+// frames find the output registered and nothing is corrected; the projector bumped 1
+// degree is found at the next fiducial frame and corrected from its tag corners, and the
+// stream plays on throughout.
+TEST(SimDrift, StreamedContentIsCheckedWithFiducialFramesAndABumpCorrected) {
+  std::signal(SIGPIPE, SIG_IGN);
+  TempDir dir;
+  FiducialBump r(dir);
+  ASSERT_NO_FATAL_FAILURE(r.start());
+  // The rig's keystone on, then the stream through it.
+  ASSERT_NO_FATAL_FAILURE(showContent(r.c, texturedContent(dir)));
+  const std::string before = rigText(dir);
+  FifoFrames frames(streamFrom(r.c, dir), texturedFrames(), 10.0);
+  const json still = r.still(dir, before, "a stream of textured frames");
+  const int shown_still = contentFrames(r.c);
+  EXPECT_TRUE(still.value("content_streamed", false)) << still.dump();
+  EXPECT_FALSE(still.contains("unavailable")) << still.dump();
+  // The stream plays between the fiducial frames: at least a third of its 10 frames a
+  // second after the first 4 s (each fiducial frame holds the frames back while the
+  // virtual camera renders its capture, up to a second on a loaded machine).
+  EXPECT_GE(shown_still, static_cast<int>(10.0 / 3.0 * (r.bump_t - 1.0 - at(4.0)))) << shown_still;
+  r.corrected(dir, "a stream");
+  const int shown_end = contentFrames(r.c);
+  std::printf("[ figures  ] stream frames shown: %d before the bump, %d in all\n", shown_still,
+              shown_end);
+  EXPECT_GT(shown_end, shown_still);
+}
+
+// "on-drift-silent" shows no fiducial frame: a stream leaves the output unavailable, and
+// nothing changes.
+TEST(SimDrift, StreamedContentIsUnavailableWhenSilent) {
+  std::signal(SIGPIPE, SIG_IGN);
+  TempDir dir;
+  const std::string scene_file = sceneWithEvents(dir, "");
+  DaemonProcess d(dir, driftDaemon(dir, "on-drift-silent", scene_file));
+  ASSERT_TRUE(d.started()) << d.log();
+  Connection c(d.socketPath());
+  ASSERT_NO_FATAL_FAILURE(showContent(c, texturedContent(dir)));
+  const std::string before = rigText(dir);
+  const std::string fifo = streamFrom(c, dir);
+  FifoFrames frames(fifo, texturedFrames(), 10.0);
+  json dr;
+  EXPECT_TRUE(eventually(
+      [&] {
+        dr = outputDrift(c);
+        return dr.is_object() &&
+               dr.value("unavailable", "").find("streamed content") != std::string::npos;
+      },
+      10s * kSlowdown))
+      << dr.dump();
+  EXPECT_TRUE(dr.value("content_streamed", false)) << dr.dump();
+  EXPECT_FALSE(dr.contains("fiducial")) << dr.dump();
+  EXPECT_GE(contentFrames(c), 2);
+  EXPECT_EQ(before, rigText(dir));
+}
+
+}  // namespace
+}  // namespace procam::itest
