@@ -132,9 +132,10 @@ void parseDaemon(Checker& c, const toml::table& t, Config& cfg) {
 }
 
 void parsePolicy(Checker& c, const toml::table& t, Config& cfg) {
-  c.onlyKnown(t, "policy.",
-              {"auto_keystone", "recalibrate", "drift_period_s", "drift_threshold_px",
-               "drift_settle_s", "drift_frames", "drift_fiducial_period_s"});
+  c.onlyKnown(
+      t, "policy.",
+      {"auto_keystone", "recalibrate", "drift_period_s", "drift_threshold_px", "drift_settle_s",
+       "drift_frames", "drift_fiducial_period_s", "drift_stream_period_s"});
   if (auto* n = t.get("auto_keystone")) c.boolean(*n, "policy.auto_keystone", cfg.auto_keystone);
   if (auto* n = t.get("recalibrate")) {
     std::string s;
@@ -164,6 +165,9 @@ void parsePolicy(Checker& c, const toml::table& t, Config& cfg) {
     c.integer(*n, "policy.drift_frames", 1, 16, cfg.drift.frames);
   if (auto* n = t.get("drift_fiducial_period_s")) {
     c.number(*n, "policy.drift_fiducial_period_s", 0.0, 3600.0, cfg.drift.fiducial_period_s);
+  }
+  if (auto* n = t.get("drift_stream_period_s")) {
+    c.number(*n, "policy.drift_stream_period_s", 0.0, 3600.0, cfg.drift.stream_period_s);
   }
 }
 

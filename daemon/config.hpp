@@ -76,6 +76,10 @@ struct DriftConfig {
   // "on-drift" with content too plain to register: a fiducial frame at most this often
   // per output (and at every check while drift it saw is being confirmed); 0: never.
   double fiducial_period_s = 10.0;
+  // "on-drift-silent" while a stream plays: its frame held on the outputs for a content
+  // check at most this often per output (and at every check while drift it saw is being
+  // confirmed); 0: never.
+  double stream_period_s = 5.0;
 };
 
 struct Config {

@@ -292,6 +292,7 @@ class Daemon {
   bool driftMayRun() const;
   bool streamPlaying() const;     // a shared or streamed source that has not ended
   bool fiducialFramesOn() const;  // on-drift with a fiducial period
+  bool heldFramesOn() const;      // on-drift-silent with a stream period
   void correctDrift(const std::string& output, const std::string& camera,
                     const drift::Misregistration& m);
   // A projector's own surface mesh told the pixels that light its vertices after the
@@ -315,6 +316,7 @@ class Daemon {
   // content (made here for `framebuffer` when needed).
   bool fiducialDue(DriftRuntime::Output& o, const DriftRuntime::View& view,
                    const KeystoneRuntime::OutputState& shown, cv::Size framebuffer);
+  bool holdDue(DriftRuntime::Output& o);
   // A check's fiducial frame is over: the content is drawn again.
   void endFiducialFrame(const std::string& output);
   // The wall as the output's projector and its one camera triangulate it, when the

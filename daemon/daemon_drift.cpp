@@ -90,6 +90,11 @@ bool Daemon::fiducialFramesOn() const {
   return config_.recalibrate == RecalibratePolicy::kOnDrift && config_.drift.fiducial_period_s > 0;
 }
 
+bool Daemon::heldFramesOn() const {
+  return config_.recalibrate == RecalibratePolicy::kOnDriftSilent &&
+         config_.drift.stream_period_s > 0;
+}
+
 void Daemon::checkDrift() {
   DriftRuntime& d = drift_rt_;
   d.check_after_frame = false;
@@ -170,17 +175,17 @@ std::optional<std::pair<DriftCheckPlan, DriftKey>> Daemon::planDriftCheck(
   if (settings_.auto_keystone) {
     return unavailable("auto keystone corrects the projector from its tilt sensor");
   }
-  // A stream's frame changes between camera frames: its checks are fiducial frames
-  // (their own frame, shown for one capture), which on-drift-silent never shows.
+  // A stream's frame changes between camera frames: under on-drift its checks are
+  // fiducial frames (their own frame, shown for one capture); under on-drift-silent,
+  // which shows none, the stream's frame is held on the outputs for a capture now and
+  // then and compared as content is.
   const bool streamed = streamPlaying();
-  if (streamed && !fiducialFramesOn()) {
-    return unavailable(
-        "streamed content: the frame changes between camera frames, and fiducial frames are "
-        "off (" +
-        std::string(config_.recalibrate == RecalibratePolicy::kOnDrift
-                        ? "drift_fiducial_period_s = 0"
-                        : "recalibrate = \"on-drift-silent\"") +
-        ")");
+  const bool held = streamed && heldFramesOn();
+  if (streamed && !fiducialFramesOn() && !held) {
+    return unavailable("streamed content: the frame changes between camera frames, and " +
+                       std::string(config_.recalibrate == RecalibratePolicy::kOnDrift
+                                       ? "fiducial frames are off (drift_fiducial_period_s = 0)"
+                                       : "held frames are off (drift_stream_period_s = 0)"));
   }
   // The surface the output draws on: a plane, or a mesh (sceneTraits, as the frames).
   const bool curved = sceneTraits(out.name, false).surface == render::SurfaceKind::kNonPlanar;
@@ -258,7 +263,8 @@ std::optional<std::pair<DriftCheckPlan, DriftKey>> Daemon::planDriftCheck(
   // No fiducial frame for an output measured in another's capture.
   const bool fiducial =
       !camera && fiducialDue(o, o.views[cam->name], st->second, {p->width, p->height});
-  if (streamed && !fiducial) return std::nullopt;  // the next fiducial frame's turn
+  // A stream is checked by the next fiducial frame, or in its turn by a held frame.
+  if (streamed && !fiducial && !(held && holdDue(o))) return std::nullopt;
   DriftCheckPlan plan;
   plan.output = out.name;
   plan.camera = {cam->name, cam_entry->device.share()};
@@ -285,6 +291,13 @@ std::optional<std::pair<DriftCheckPlan, DriftKey>> Daemon::planDriftCheck(
   plan.camera_model = cam->model;
   if (auto response = blend::projectorResponse(*p)) plan.projector_gamma = response->gamma;
   plan.frames = config_.drift.frames;
+  if (held) {
+    // Held from now: the worker draws no frame while the check runs.
+    plan.hold_until =
+        st->second.shown_at + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                  std::chrono::duration<double>(settle));
+    ++o.held_checks;
+  }
   if (fiducial) {
     // The frames wait while the fiducial frame is up (refreshOutputs).
     plan.fiducial = d.fiducial.at({p->width, p->height});
@@ -326,6 +339,23 @@ bool Daemon::fiducialDue(DriftRuntime::Output& o, const DriftRuntime::View& view
     d.fiducial_unavailable.clear();
   }
   o.quick_fiducials = due ? 0 : o.quick_fiducials + 1;
+  return true;
+}
+
+bool Daemon::holdDue(DriftRuntime::Output& o) {
+  // At the period, and sooner (every check) while drift is confirmed or a correction of
+  // it checked: at most kQuickFiducials between two at the period, none while the output
+  // is unresolved (as fiducial frames).
+  const bool due = !o.held_at || secondsSince(*o.held_at) >= config_.drift.stream_period_s;
+  const bool quick =
+      !o.unresolved && (o.drifted() || o.passes > 0) && o.quick_holds < kQuickFiducials;
+  if (!due && !quick) return false;
+  if (due) {
+    o.held_at = DriftRuntime::Clock::now();
+    o.quick_holds = 0;
+  } else {
+    ++o.quick_holds;
+  }
   return true;
 }
 
@@ -497,6 +527,11 @@ json Daemon::driftJson(const std::string& output) const {
             {"last_correction", o.last_correction}};
   if (!o.error.empty()) j["error"] = o.error;
   j["content_streamed"] = streamPlaying();
+  if (heldFramesOn() && streamPlaying()) {
+    json h = {{"checks", o.held_checks}, {"period_s", config_.drift.stream_period_s}};
+    if (o.held_at) h["age_s"] = secondsSince(*o.held_at);
+    j["held"] = std::move(h);
+  }
   if (config_.recalibrate == RecalibratePolicy::kOnDrift) {
     json f = {{"frames", o.fiducial_checks}, {"period_s", config_.drift.fiducial_period_s}};
     if (o.fiducial_at) f["age_s"] = secondsSince(*o.fiducial_at);

@@ -267,6 +267,7 @@ tl::expected<DriftCheck, CalibrationFailure> runDriftCheck(const DriftCheckPlan&
   const auto start = Clock::now();
   DriftCheck out;
   if (auto ok = reference(plan, out, start); !ok) return tl::unexpected(ok.error());
+  if (plan.hold_until) std::this_thread::sleep_until(*plan.hold_until);
   const auto capture = Clock::now();
   auto sum = captureMean(plan);
   if (!sum) return tl::unexpected(sum.error());

@@ -5,6 +5,7 @@
 // (drift/misregistration.hpp); or, for content too plain to register, a fiducial frame
 // shown on the output and its tag corners found (drift/fiducial_misregistration.hpp).
 // Never touches daemon state.
+#include <chrono>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <optional>
@@ -70,6 +71,10 @@ struct DriftCheckPlan {
   std::shared_ptr<const FiducialFrame> fiducial;
   CalibrationDevice output_device;
   double settle_s = 0.1;
+  // Set: the frame is a stream's, held on the outputs while the check runs (the worker
+  // that draws them runs the check): the capture waits until this time, the frame's
+  // latency to the camera, which the reference is made in.
+  std::optional<std::chrono::steady_clock::time_point> hold_until;
 };
 
 struct DriftCheck {

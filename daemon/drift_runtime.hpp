@@ -85,6 +85,10 @@ struct DriftRuntime {
     std::optional<Clock::time_point> fiducial_at;
     std::optional<double> fiducial_px;  // the last fiducial check's misregistration
     int quick_fiducials = 0;            // shown since the last one at the period
+    // Checks of a stream's frame held on the outputs (on-drift-silent), as above.
+    uint64_t held_checks = 0;
+    std::optional<Clock::time_point> held_at;
+    int quick_holds = 0;
     // The scan made since the output was last registered (kNone: none); a check that
     // still finds it drifted escalates at once. Cleared when registered or unresolved.
     DriftScan scan = DriftScan::kNone;

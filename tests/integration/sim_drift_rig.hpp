@@ -213,18 +213,22 @@ struct DriftRig {
   Connection c, watcher;
 };
 
-// The fiducial frame tests' course on wall_oblique under "on-drift" with one fiducial
-// frame every 2 s: the projector turned 1 degree at 14 s. The first fiducial frame comes 3
-// to 4 s after the daemon starts on two idle cores (start, content, the first checks),
-// then one every 3 s or so (a 2 s period, and a second for the virtual camera to render
-// each new frame); on two busy cores a capture takes 3 s.
-struct FiducialBump {
-  explicit FiducialBump(const TempDir& dir)
-      : bump_t(at(14.0)),
+// The course of the tests that check an output now and then (fiducial frames, a stream's
+// held frames) on wall_oblique, one check every 2 s: the projector turned 1 degree at 14
+// s. Under "on-drift" (`held` false) the checks are fiducial frames, under
+// "on-drift-silent" a stream's frames held for a capture. The first comes 3 to 4 s after
+// the daemon starts on two idle cores (start, content, the first checks), then one every
+// 3 s or so (a 2 s period, and a second for the virtual camera to render each new frame);
+// on two busy cores a capture takes 3 s.
+struct BumpCourse {
+  explicit BumpCourse(const TempDir& dir, bool held = false)
+      : held(held),
+        bump_t(at(14.0)),
         scene_file(sceneWithEvents(dir, "[[events]]\nt = " + std::to_string(bump_t) +
                                             "\ntarget = \"proj\"\nrotate_deg = [1.0, 0.0, 0.0]\n")),
         scene(sim::resolveScene(scene_file)),
-        d(dir, driftDaemon(dir, "on-drift", scene_file, {}, "drift_fiducial_period_s = 2\n")),
+        d(dir, driftDaemon(dir, held ? "on-drift-silent" : "on-drift", scene_file, {},
+                           held ? "drift_stream_period_s = 2\n" : "drift_fiducial_period_s = 2\n")),
         c(d.socketPath()),
         watcher(d.socketPath()) {}
   // Fatal failures of the set-up; call first.
@@ -236,26 +240,29 @@ struct FiducialBump {
   }
   double sceneTime() const { return std::chrono::duration<double>(Clock::now() - started).count(); }
   // The drift status just before the bump (the scene's clock starts after the daemon's: a
-  // margin of 1 s), checked against `before` (rig.json once the content showed): fiducial
-  // frames, under half the 0.5 px threshold (no false trigger), nothing corrected.
+  // margin of 1 s), checked against `before` (rig.json once the content showed): two
+  // checks or more, under half the 0.5 px threshold (no false trigger), nothing corrected.
   json still(const TempDir& dir, const std::string& before, const std::string& content) {
     while (sceneTime() < bump_t - 1.0) std::this_thread::sleep_for(100ms);
     const json dr = outputDrift(c);
     EXPECT_TRUE(dr.is_object()) << dr.dump();
     if (!dr.is_object()) return dr;
+    const int checks = held ? dr["held"].value("checks", 0) : dr["fiducial"].value("frames", 0);
+    const double px = held ? dr.value("misregistration_px", 1e9)
+                           : dr["fiducial"].value("misregistration_px", 1e9);
     std::printf(
-        "[ figures  ] still, %s: %d fiducial frames in %.1f s, misregistration %.3f px; %d "
-        "corrections\n",
-        content.c_str(), dr["fiducial"].value("frames", 0), sceneTime(),
-        dr["fiducial"].value("misregistration_px", -1.0), dr.value("corrections", -1));
-    EXPECT_GE(dr["fiducial"].value("frames", 0), 2) << dr.dump();
+        "[ figures  ] still, %s: %d %s in %.1f s, misregistration %.3f px; %d corrections\n",
+        content.c_str(), checks, held ? "held frames" : "fiducial frames", sceneTime(), px,
+        dr.value("corrections", -1));
+    EXPECT_GE(checks, 2) << dr.dump();
     EXPECT_EQ(dr.value("corrections", -1), 0) << dr.dump();
-    EXPECT_LT(dr["fiducial"].value("misregistration_px", 1e9), 0.25) << dr.dump();
+    EXPECT_LT(px, 0.25) << dr.dump();
     EXPECT_EQ(before, rigText(dir));
     return dr;
   }
-  // The bump found in a fiducial frame, the projector corrected from the tag corners and
-  // registered again: the rig against the true projector within the 0.5 px threshold.
+  // The bump found at a check, the projector corrected from its correspondences (tag
+  // corners or content tiles) and registered again: the rig against the true projector
+  // within the 0.5 px threshold.
   void corrected(const TempDir& dir, const std::string& content) {
     bool registered = false;
     const std::optional<json> corrected =
@@ -266,15 +273,17 @@ struct FiducialBump {
     const json dr = outputDrift(c);
     const double rig_px = rigAgainstTruth(dir, scene->at(bump_t + at(1.0)).projectors.at(0).model);
     std::printf(
-        "[ figures  ] projector bumped 1 deg under %s: seen at %.2f px in a fiducial frame, "
-        "corrected from %d tag corners (pose fit %.3f px), registered within %.1f s of the "
-        "bump (fiducial period 2 s); the rig against the true projector %.3f px; %d fiducial "
-        "frames in all\n",
+        "[ figures  ] projector bumped 1 deg under %s: seen at %.2f px, corrected from %d "
+        "%s (pose fit %.3f px), registered within %.1f s of the bump (a check every 2 s); "
+        "the rig against the true projector %.3f px; %d %s in all\n",
         content.c_str(), (*corrected)["why"]["misregistration_px"].get<double>(),
-        (*corrected)["tiles"].get<int>(), (*corrected)["pose_fit_px"].get<double>(),
-        corrected_after, rig_px, dr["fiducial"].value("frames", 0));
+        (*corrected)["tiles"].get<int>(), held ? "content tiles" : "tag corners",
+        (*corrected)["pose_fit_px"].get<double>(), corrected_after, rig_px,
+        held ? dr["held"].value("checks", 0) : dr["fiducial"].value("frames", 0),
+        held ? "held frames" : "fiducial frames");
     EXPECT_LE(rig_px, 0.5);
   }
+  bool held;
   double bump_t;
   std::string scene_file;
   Result<sim::Scene> scene;

@@ -69,7 +69,7 @@ TEST(SimDrift, PlainContentIsReportedWhenSilentAndOffDoesNothing) {
 // the next fiducial frame and corrected from the tag corners.
 TEST(SimDrift, PlainContentIsCheckedWithFiducialFramesAndABumpCorrected) {
   TempDir dir;
-  FiducialBump r(dir);
+  BumpCourse r(dir);
   ASSERT_NO_FATAL_FAILURE(r.start());
   const std::string png = contentFile(dir, "grey.png");
   cv::imwrite(png, cv::Mat(900, 1600, CV_8UC3, cv::Scalar(128, 128, 128)));

@@ -1,7 +1,8 @@
-// recalibrate = "on-drift" end to end while a stream plays (sim_drift_rig.hpp: wall_oblique,
-// the truth at rest as the rig model): a stream's frame changes between camera frames, so
-// its checks are fiducial frames, shown between the stream's frames; "on-drift-silent",
-// which shows none, reports the output unavailable.
+// recalibrate = "on-drift" and "on-drift-silent" end to end while a stream plays
+// (sim_drift_rig.hpp: wall_oblique, the truth at rest as the rig model): a stream's frame
+// changes between camera frames, so under "on-drift" its checks are fiducial frames, shown
+// between the stream's frames; "on-drift-silent", which shows none, holds a stream frame on
+// the output for each check's capture.
 #include <fcntl.h>
 #include <poll.h>
 #include <sys/stat.h>
@@ -97,53 +98,72 @@ int contentFrames(Connection& c) {
   return r ? (*r)["content"].value("frames", 0) : 0;
 }
 
-// A stream of textured frames at 10 per second under "on-drift": still, the fiducial
-// frames find the output registered and nothing is corrected; the projector bumped 1
-// degree is found at the next fiducial frame and corrected from its tag corners, and the
-// stream plays on throughout.
-TEST(SimDrift, StreamedContentIsCheckedWithFiducialFramesAndABumpCorrected) {
+// A stream of textured frames at 10 per second through the rig's keystone, checked every
+// 2 s (BumpCourse: fiducial frames, or `held` frames): still, the checks find the output
+// registered and nothing is corrected; the projector bumped 1 degree is found at the next
+// check and corrected, and the stream plays on throughout.
+void streamCourse(bool held) {
   std::signal(SIGPIPE, SIG_IGN);
   TempDir dir;
-  FiducialBump r(dir);
+  BumpCourse r(dir, held);
   ASSERT_NO_FATAL_FAILURE(r.start());
-  // The rig's keystone on, then the stream through it.
   ASSERT_NO_FATAL_FAILURE(showContent(r.c, texturedContent(dir)));
   const std::string before = rigText(dir);
   FifoFrames frames(streamFrom(r.c, dir), texturedFrames(), 10.0);
-  const json still = r.still(dir, before, "a stream of textured frames");
+  const std::string what = held ? "a stream, silent" : "a stream";
+  const json still = r.still(dir, before, what);
   const int shown_still = contentFrames(r.c);
   EXPECT_TRUE(still.value("content_streamed", false)) << still.dump();
   EXPECT_FALSE(still.contains("unavailable")) << still.dump();
-  // The stream plays between the fiducial frames: at least a third of its 10 frames a
-  // second after the first 4 s (each fiducial frame holds the frames back while the
-  // virtual camera renders its capture, up to a second on a loaded machine).
+  if (held) {
+    std::printf("[ figures  ] the last held frame: capture %.3f s, its check %.3f s\n",
+                still.value("capture_s", -1.0), still.value("check_s", -1.0));
+    EXPECT_FALSE(still.contains("fiducial")) << still.dump();  // silent: none shown
+    EXPECT_FALSE(still.value("too_plain", true)) << still.dump();
+  }
+  // The stream plays between the checks: at least a third of its 10 frames a second after
+  // the first 4 s (each check holds the frames back while the virtual camera renders its
+  // capture, up to a second on a loaded machine).
   EXPECT_GE(shown_still, static_cast<int>(10.0 / 3.0 * (r.bump_t - 1.0 - at(4.0)))) << shown_still;
-  r.corrected(dir, "a stream");
+  r.corrected(dir, what);
   const int shown_end = contentFrames(r.c);
   std::printf("[ figures  ] stream frames shown: %d before the bump, %d in all\n", shown_still,
               shown_end);
   EXPECT_GT(shown_end, shown_still);
 }
 
-// "on-drift-silent" shows no fiducial frame: a stream leaves the output unavailable, and
+// "on-drift": the checks are fiducial frames shown between the stream's frames, the bump
+// corrected from their tag corners.
+TEST(SimDrift, StreamedContentIsCheckedWithFiducialFramesAndABumpCorrected) {
+  streamCourse(false);
+}
+
+// "on-drift-silent" shows no fiducial frame: the stream's frame is held on the output for
+// each check (the frame's latency to the camera and the capture) and compared as content
+// is, the bump corrected from the content's tiles.
+TEST(SimDrift, StreamedContentIsCheckedFromHeldFramesWhenSilent) {
+  streamCourse(true);
+}
+
+// "on-drift-silent" with held frames off: a stream leaves the output unavailable, and
 // nothing changes.
-TEST(SimDrift, StreamedContentIsUnavailableWhenSilent) {
+TEST(SimDrift, StreamedContentIsUnavailableWhenSilentWithoutHeldFrames) {
   std::signal(SIGPIPE, SIG_IGN);
   TempDir dir;
   const std::string scene_file = sceneWithEvents(dir, "");
-  DaemonProcess d(dir, driftDaemon(dir, "on-drift-silent", scene_file));
+  DaemonProcess d(
+      dir, driftDaemon(dir, "on-drift-silent", scene_file, {}, "drift_stream_period_s = 0\n"));
   ASSERT_TRUE(d.started()) << d.log();
   Connection c(d.socketPath());
   ASSERT_NO_FATAL_FAILURE(showContent(c, texturedContent(dir)));
   const std::string before = rigText(dir);
-  const std::string fifo = streamFrom(c, dir);
-  FifoFrames frames(fifo, texturedFrames(), 10.0);
+  FifoFrames frames(streamFrom(c, dir), texturedFrames(), 10.0);
   json dr;
   EXPECT_TRUE(eventually(
       [&] {
         dr = outputDrift(c);
         return dr.is_object() &&
-               dr.value("unavailable", "").find("streamed content") != std::string::npos;
+               dr.value("unavailable", "").find("held frames are off") != std::string::npos;
       },
       10s * kSlowdown))
       << dr.dump();

@@ -307,11 +307,12 @@ TEST(Config, DriftPolicyHasDefaultsAndBounds) {
   EXPECT_DOUBLE_EQ(defaults->drift.settle_s, 0.5);
   EXPECT_EQ(defaults->drift.frames, 2);
   EXPECT_DOUBLE_EQ(defaults->drift.fiducial_period_s, 10.0);
+  EXPECT_DOUBLE_EQ(defaults->drift.stream_period_s, 5.0);
   EXPECT_EQ(defaults->recalibrate, RecalibratePolicy::kOnDrift);
   auto set = parseConfig(
       "[policy]\nrecalibrate = \"on-drift-silent\"\ndrift_period_s = 1\n"
       "drift_threshold_px = 0.3\ndrift_settle_s = 0\ndrift_frames = 4\n"
-      "drift_fiducial_period_s = 0\n",
+      "drift_fiducial_period_s = 0\ndrift_stream_period_s = 30\n",
       "rig.toml");
   ASSERT_TRUE(set) << set.error().message;
   EXPECT_EQ(set->recalibrate, RecalibratePolicy::kOnDriftSilent);
@@ -323,9 +324,13 @@ TEST(Config, DriftPolicyHasDefaultsAndBounds) {
   EXPECT_DOUBLE_EQ(set->drift.settle_s, 0.0);
   EXPECT_EQ(set->drift.frames, 4);
   EXPECT_DOUBLE_EQ(set->drift.fiducial_period_s, 0.0);
+  EXPECT_DOUBLE_EQ(set->drift.stream_period_s, 30.0);
   auto bad = parseConfig("[policy]\ndrift_fiducial_period_s = -1\n", "rig.toml");
   ASSERT_FALSE(bad);
   EXPECT_NE(bad.error().message.find("policy.drift_fiducial_period_s"), std::string::npos);
+  bad = parseConfig("[policy]\ndrift_stream_period_s = 4000\n", "rig.toml");
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("policy.drift_stream_period_s"), std::string::npos);
 }
 
 TEST(Config, ExampleConfigParses) {
