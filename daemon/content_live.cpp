@@ -261,6 +261,12 @@ void Daemon::startStream(ClientId client, const proto::Request& req,
 
 Result<void> Daemon::startLiveContent(std::unique_ptr<content::ContentSource> source, json info) {
   stopLiveContent();
+  // A new stream's first held drift check is due at once.
+  for (auto& [name, o] : drift_rt_.outputs) {
+    o.held_at.reset();
+    o.quick_holds = 0;
+    o.held_checks = 0;
+  }
   // A source with an fd (a FIFO) is read whenever bytes arrive, so that its
   // writer never waits for a timer; the others are read at their frame rate.
   const int fd = source->pollFd();

@@ -187,6 +187,10 @@ std::optional<std::pair<DriftCheckPlan, DriftKey>> Daemon::planDriftCheck(
                                        ? "fiducial frames are off (drift_fiducial_period_s = 0)"
                                        : "held frames are off (drift_stream_period_s = 0)"));
   }
+  if (streamed && !held && !d.fiducial_unavailable.empty()) {
+    return unavailable("streamed content: the frame changes between camera frames, and " +
+                       d.fiducial_unavailable);
+  }
   // The surface the output draws on: a plane, or a mesh (sceneTraits, as the frames).
   const bool curved = sceneTraits(out.name, false).surface == render::SurfaceKind::kNonPlanar;
   Result<blend::DisplayTile> tile = fail(ErrorCode::kNotFound, "a curved surface");
@@ -296,7 +300,6 @@ std::optional<std::pair<DriftCheckPlan, DriftKey>> Daemon::planDriftCheck(
     plan.hold_until =
         st->second.shown_at + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                   std::chrono::duration<double>(settle));
-    ++o.held_checks;
   }
   if (fiducial) {
     // The frames wait while the fiducial frame is up (refreshOutputs).
@@ -306,7 +309,13 @@ std::optional<std::pair<DriftCheckPlan, DriftKey>> Daemon::planDriftCheck(
     d.fiducial_showing = true;
   }
   plan.fence = device_manager_->readFence({cam->name});
-  DriftKey key{out.name, cam->name, plan.setup, plan.image, st->second.shown_at, rig_generation_};
+  DriftKey key{out.name,
+               cam->name,
+               plan.setup,
+               plan.image,
+               st->second.shown_at,
+               rig_generation_,
+               plan.hold_until.has_value()};
   return std::make_pair(std::move(plan), std::move(key));
 }
 
@@ -409,6 +418,7 @@ void Daemon::onDriftChecked(const DriftKey& key, tl::expected<DriftCheck, Calibr
     return;
   }
   ++o.checks;
+  if (key.held) ++o.held_checks;
   const rig::RigProjector* projector = rig_.projectorForOutput(key.output);
   const rig::RigCamera* camera = rig_.camera(key.camera);
   if (r->blur_fitted && !r->fitted_blur) v.blur_tried = {key.setup, key.image};

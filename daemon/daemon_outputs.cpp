@@ -323,11 +323,17 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done, bool supersede
           } else {
             for (auto& w : *waiting) w(shown);
           }
-          if (k.render_again) {
+          // A drift check the frame held back goes in first, even when the next frame
+          // is due at once (a stream that comes faster than it is drawn): the frame
+          // queues behind it on the worker.
+          const bool again = k.render_again;
+          if (drift_rt_.check_after_frame && !stopped) {
+            k.render_again = false;
+            checkDrift();
+          }
+          if (again) {
             k.render_again = false;
             refreshOutputs();
-          } else if (drift_rt_.check_after_frame) {
-            checkDrift();
           }
         };
       },

@@ -72,8 +72,9 @@ struct DriftCheckPlan {
   CalibrationDevice output_device;
   double settle_s = 0.1;
   // Set: the frame is a stream's, held on the outputs while the check runs (the worker
-  // that draws them runs the check): the capture waits until this time, the frame's
-  // latency to the camera, which the reference is made in.
+  // that draws them, one thread, runs the check): the capture waits until this time, the
+  // frame's latency to the camera, which the reference is made in. Only in a check of
+  // one output: runDriftChecks measures no other output in a held frame's capture.
   std::optional<std::chrono::steady_clock::time_point> hold_until;
 };
 

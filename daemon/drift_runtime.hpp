@@ -26,6 +26,7 @@ struct DriftKey {
   std::shared_ptr<const cv::Mat> image;
   std::chrono::steady_clock::time_point shown_at;
   uint64_t rig_generation = 0;
+  bool held = false;  // a stream's frame held for the check
 };
 
 struct DriftRuntime {
@@ -85,7 +86,8 @@ struct DriftRuntime {
     std::optional<Clock::time_point> fiducial_at;
     std::optional<double> fiducial_px;  // the last fiducial check's misregistration
     int quick_fiducials = 0;            // shown since the last one at the period
-    // Checks of a stream's frame held on the outputs (on-drift-silent), as above.
+    // Checks of a stream's frame held on the outputs (on-drift-silent) that counted, and
+    // the pace of those begun, as above (from the stream's start).
     uint64_t held_checks = 0;
     std::optional<Clock::time_point> held_at;
     int quick_holds = 0;

@@ -50,7 +50,7 @@ class FifoFrames {
         pollfd p{fd, POLLOUT, 0};
         if (::poll(&p, 1, 100) <= 0) continue;
         const ssize_t k = ::write(fd, f.data + done, n - done);
-        if (k < 0 && errno != EAGAIN) {
+        if (k < 0 && errno != EAGAIN && errno != EINTR) {
           stop_ = true;  // the daemon closed it
           break;
         }
@@ -93,9 +93,14 @@ std::string streamFrom(Connection& c, const TempDir& dir) {
   return fifo;
 }
 
+// Frames of the stream read, and frames drawn on the outputs.
 int contentFrames(Connection& c) {
   auto r = c.call({{"cmd", "content"}});
   return r ? (*r)["content"].value("frames", 0) : 0;
+}
+int framesDrawn(Connection& c) {
+  auto r = c.call({{"cmd", "status"}});
+  return r ? (*r)["outputs"].value("frames", 0) : 0;
 }
 
 // A stream of textured frames at 10 per second through the rig's keystone, checked every
@@ -110,9 +115,12 @@ void streamCourse(bool held) {
   ASSERT_NO_FATAL_FAILURE(showContent(r.c, texturedContent(dir)));
   const std::string before = rigText(dir);
   FifoFrames frames(streamFrom(r.c, dir), texturedFrames(), 10.0);
+  const int drawn_start = framesDrawn(r.c);
+  const double stream_start = r.sceneTime();
   const std::string what = held ? "a stream, silent" : "a stream";
   const json still = r.still(dir, before, what);
-  const int shown_still = contentFrames(r.c);
+  const int drawn_still = framesDrawn(r.c) - drawn_start;
+  const double streamed_s = r.sceneTime() - stream_start;
   EXPECT_TRUE(still.value("content_streamed", false)) << still.dump();
   EXPECT_FALSE(still.contains("unavailable")) << still.dump();
   if (held) {
@@ -121,15 +129,18 @@ void streamCourse(bool held) {
     EXPECT_FALSE(still.contains("fiducial")) << still.dump();  // silent: none shown
     EXPECT_FALSE(still.value("too_plain", true)) << still.dump();
   }
-  // The stream plays between the checks: at least a third of its 10 frames a second after
-  // the first 4 s (each check holds the frames back while the virtual camera renders its
-  // capture, up to a second on a loaded machine).
-  EXPECT_GE(shown_still, static_cast<int>(10.0 / 3.0 * (r.bump_t - 1.0 - at(4.0)))) << shown_still;
+  // The stream plays between the checks: at least a third of its 10 frames a second drawn
+  // (each check holds the frames back while the virtual camera renders its capture, up to
+  // a second on a loaded machine); not under the sanitizers, which draw slower than that.
+  std::printf("[ figures  ] stream frames drawn: %d in %.1f s before the bump (%d read)\n",
+              drawn_still, streamed_s, contentFrames(r.c));
+  if (kSlowdown == 1) {
+    EXPECT_GE(drawn_still, static_cast<int>(10.0 / 3.0 * streamed_s)) << streamed_s;
+  }
   r.corrected(dir, what);
-  const int shown_end = contentFrames(r.c);
-  std::printf("[ figures  ] stream frames shown: %d before the bump, %d in all\n", shown_still,
-              shown_end);
-  EXPECT_GT(shown_end, shown_still);
+  const int drawn_end = framesDrawn(r.c) - drawn_start;
+  std::printf("[ figures  ] stream frames drawn: %d in all\n", drawn_end);
+  EXPECT_GT(drawn_end, drawn_still);
 }
 
 // "on-drift": the checks are fiducial frames shown between the stream's frames, the bump
@@ -158,6 +169,7 @@ TEST(SimDrift, StreamedContentIsUnavailableWhenSilentWithoutHeldFrames) {
   ASSERT_NO_FATAL_FAILURE(showContent(c, texturedContent(dir)));
   const std::string before = rigText(dir);
   FifoFrames frames(streamFrom(c, dir), texturedFrames(), 10.0);
+  EXPECT_TRUE(eventually([&] { return contentFrames(c) >= 2; }, 10s * kSlowdown));
   json dr;
   EXPECT_TRUE(eventually(
       [&] {
@@ -169,7 +181,6 @@ TEST(SimDrift, StreamedContentIsUnavailableWhenSilentWithoutHeldFrames) {
       << dr.dump();
   EXPECT_TRUE(dr.value("content_streamed", false)) << dr.dump();
   EXPECT_FALSE(dr.contains("fiducial")) << dr.dump();
-  EXPECT_GE(contentFrames(c), 2);
   EXPECT_EQ(before, rigText(dir));
 }
 
