@@ -38,6 +38,17 @@ Vec3 blurKey(const rig::RigProjector& p, const rig::RigCamera& c) {
 // settle of 0.5 s, one correction); three more passes, room to spare.
 constexpr int kQuickFiducials = 12;
 
+// Whether an output's periodic check (a fiducial frame, a stream's held frame) is due:
+// `last` at least `period_s` ago or never (`at_period`), or sooner, at every check, while
+// drift a camera saw is confirmed or a correction of it checked: at most kQuickFiducials
+// (`quick` so far) between two at the period, none while the output is unresolved.
+bool periodicCheckDue(const DriftRuntime::Output& o,
+                      const std::optional<DriftRuntime::Clock::time_point>& last, int quick,
+                      double period_s, bool& at_period) {
+  at_period = !last || secondsSince(*last) >= period_s;
+  return at_period || (!o.unresolved && (o.drifted() || o.passes > 0) && quick < kQuickFiducials);
+}
+
 }  // namespace
 
 void Daemon::setupDriftCheck() {
@@ -323,19 +334,16 @@ bool Daemon::fiducialDue(DriftRuntime::Output& o, const DriftRuntime::View& view
                          const KeystoneRuntime::OutputState& shown, cv::Size framebuffer) {
   DriftRuntime& d = drift_rt_;
   // Only where the content this camera last looked at was too plain to register, or is
-  // a stream, never with "on-drift-silent"; at the period, and sooner (every camera's
-  // check) while drift a camera saw is confirmed or a correction of it checked: at most
-  // kQuickFiducials frames between two at the period, none while the output is
-  // unresolved.
+  // a stream, never with "on-drift-silent"; at its pace (every camera's check counts).
   if (!(streamPlaying() || view.foundPlain(shown.shown_setup, shown.shown_image)) ||
       !fiducialFramesOn()) {
     return false;
   }
-  const bool due =
-      !o.fiducial_at || secondsSince(*o.fiducial_at) >= config_.drift.fiducial_period_s;
-  const bool quick =
-      !o.unresolved && (o.drifted() || o.passes > 0) && o.quick_fiducials < kQuickFiducials;
-  if (!due && !quick) return false;
+  bool due = false;
+  if (!periodicCheckDue(o, o.fiducial_at, o.quick_fiducials, config_.drift.fiducial_period_s,
+                        due)) {
+    return false;
+  }
   const std::pair<int, int> size{framebuffer.width, framebuffer.height};
   if (!d.fiducial.count(size)) {
     auto made = makeFiducialFrame(framebuffer);
@@ -352,13 +360,10 @@ bool Daemon::fiducialDue(DriftRuntime::Output& o, const DriftRuntime::View& view
 }
 
 bool Daemon::holdDue(DriftRuntime::Output& o) {
-  // At the period, and sooner (every check) while drift is confirmed or a correction of
-  // it checked: at most kQuickFiducials between two at the period, none while the output
-  // is unresolved (as fiducial frames).
-  const bool due = !o.held_at || secondsSince(*o.held_at) >= config_.drift.stream_period_s;
-  const bool quick =
-      !o.unresolved && (o.drifted() || o.passes > 0) && o.quick_holds < kQuickFiducials;
-  if (!due && !quick) return false;
+  bool due = false;
+  if (!periodicCheckDue(o, o.held_at, o.quick_holds, config_.drift.stream_period_s, due)) {
+    return false;
+  }
   if (due) {
     o.held_at = DriftRuntime::Clock::now();
     o.quick_holds = 0;

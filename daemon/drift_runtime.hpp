@@ -31,7 +31,6 @@ struct DriftKey {
 
 struct DriftRuntime {
   using Clock = std::chrono::steady_clock;
-  // One camera's view of an output: its reference and last check.
   // One frame an output showed: its render setup and content, by identity.
   struct Frame {
     std::shared_ptr<const render::RenderSetup> setup;
@@ -41,6 +40,7 @@ struct DriftRuntime {
       return setup && setup == s && image == i;
     }
   };
+  // One camera's view of an output: its reference and last check.
   struct View {
     std::shared_ptr<const DriftReference> reference;
     std::optional<drift::Misregistration> last;
