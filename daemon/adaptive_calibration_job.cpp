@@ -24,10 +24,6 @@ namespace {
 
 using Outcome = tl::expected<CalibrationOutcome, CalibrationFailure>;
 
-tl::unexpected<CalibrationFailure> failed(const std::string& why) {
-  return tl::unexpected(CalibrationFailure{code::kFailed, why});
-}
-
 // The coarse pass's blocks in one camera tested for one homography, in its ideal pixels
 // (lens distortion bends a plane's image off one homography).
 Result<sl::PlanarityTest> coarseTest(const sl::PatternSet& coarse, const sl::Decoded& decoded,
@@ -71,7 +67,7 @@ Outcome fullScanAfter(const CalibrationPlan& plan, const CalibrationHooks& hooks
 Outcome runAdaptiveCalibration(const CalibrationPlan& plan, const CalibrationHooks& hooks) {
   const CalibrationFailure cancelled{code::kCancelled, "calibration cancelled"};
   if (!plan.coarse || !plan.tags || plan.cameras.empty() || (!plan.plane && !plan.adaptivePair())) {
-    return failed(
+    return calibrationFailed(
         "internal: the adaptive path is route (b′) with a camera and a plane, or two cameras");
   }
   const sl::PatternSet& coarse = *plan.coarse;
@@ -108,10 +104,12 @@ Outcome runAdaptiveCalibration(const CalibrationPlan& plan, const CalibrationHoo
   for (std::size_t c = 0; c < cameras; ++c) {
     const CalibrationCamera& cam = plan.cameras[c];
     auto decoded = sl::decode(coarse, captures[c]);
-    if (!decoded) return failed("camera '" + cam.device.name + "': " + decoded.error().message);
+    if (!decoded)
+      return calibrationFailed("camera '" + cam.device.name + "': " + decoded.error().message);
     auto test = coarseTest(coarse, *decoded, cam);
     if (!test) {
-      return failed("the coarse pass: camera '" + cam.device.name + "': " + test.error().message);
+      return calibrationFailed("the coarse pass: camera '" + cam.device.name +
+                               "': " + test.error().message);
     }
     const json fit = {{"blocks", test->camera.size()},
                       {"rms_px", test->rms_px},
@@ -132,7 +130,7 @@ Outcome runAdaptiveCalibration(const CalibrationPlan& plan, const CalibrationHoo
   out.coarse["planar"] = planar;
   if (cameras > 1) out.coarse["views"] = std::move(fits);
   if (!planar && !plan.adaptivePair()) {
-    return failed(
+    return calibrationFailed(
         why_not +
         ": route (b′) needs a plane; with two calibrated cameras and no plane the adaptive "
         "path scans it fully (route (a))");
@@ -157,7 +155,7 @@ Outcome runAdaptiveCalibration(const CalibrationPlan& plan, const CalibrationHoo
     out.coarse["then"] = "the full scan: " + plane.error().message;
     return fullScanAfter(plan, hooks, std::move(out), 0.95, done);
   }
-  if (!plane) return failed("the wall's plane: " + plane.error().message);
+  if (!plane) return calibrationFailed("the wall's plane: " + plane.error().message);
   auto solved = solveTagFrame(plan, *views, plane->fit.plane, out);
   if (!solved) return tl::unexpected(solved.error());
   if (plan.scene_plane) *plan.scene_plane = plane->fit.plane;

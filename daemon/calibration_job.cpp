@@ -18,6 +18,10 @@ namespace procam::daemon {
 
 namespace code = proto::code;
 
+tl::unexpected<CalibrationFailure> calibrationFailed(const std::string& why) {
+  return tl::unexpected(CalibrationFailure{code::kFailed, why});
+}
+
 CalibrationFailure deviceFailure(const char* family, const std::string& name, int rc,
                                  const char* what, const char* reason) {
   const std::string why = reason[0] ? reason : "no reason given";

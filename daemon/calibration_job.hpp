@@ -184,6 +184,8 @@ struct CalibrationOutcome {
   nlohmann::json coarse;     // the adaptive path's coarse pass: {frames, planar, ...}, else null
 };
 
+// A calibration that cannot go on for a reason of its own (code `failed`).
+tl::unexpected<CalibrationFailure> calibrationFailed(const std::string& why);
 // Shared with the latency probe (latency_probe.hpp).
 CalibrationFailure deviceFailure(const char* family, const std::string& name, int rc,
                                  const char* what, const char* reason);

@@ -14,14 +14,6 @@ namespace procam::daemon {
 
 namespace code = proto::code;
 
-namespace {
-
-tl::unexpected<CalibrationFailure> failed(const std::string& why) {
-  return tl::unexpected(CalibrationFailure{code::kFailed, why});
-}
-
-}  // namespace
-
 tl::expected<CalibrationOutcome, CalibrationFailure> runTagCalibration(
     const CalibrationPlan& plan, const CalibrationHooks& hooks) {
   CalibrationOutcome out;
@@ -35,7 +27,7 @@ tl::expected<TagViews, CalibrationFailure> captureTagFrame(const CalibrationPlan
                                                            int settle_frames, double start) {
   const CalibrationFailure cancelled{code::kCancelled, "calibration cancelled"};
   if (!plan.tags || plan.cameras.empty()) {
-    return failed("internal: the tag frame needs the frame and a camera");
+    return calibrationFailed("internal: the tag frame needs the frame and a camera");
   }
   if (hooks.cancelled()) return tl::unexpected(cancelled);
   auto shown = showAndSettle(plan, plan.tags->rgb, "show the tag frame", settle_frames, hooks);
@@ -62,16 +54,16 @@ tl::expected<TagViews, CalibrationFailure> captureTagFrame(const CalibrationPlan
     const CalibrationCamera& cam = plan.cameras[c];
     const cv::Mat& seen = captures[c];
     if (seen.cols != cam.model.width || seen.rows != cam.model.height) {
-      return failed("captures of camera '" + cam.device.name + "' are " +
-                    std::to_string(seen.cols) + "x" + std::to_string(seen.rows) +
-                    " but its calibration is " + std::to_string(cam.model.width) + "x" +
-                    std::to_string(cam.model.height));
+      return calibrationFailed("captures of camera '" + cam.device.name + "' are " +
+                               std::to_string(seen.cols) + "x" + std::to_string(seen.rows) +
+                               " but its calibration is " + std::to_string(cam.model.width) + "x" +
+                               std::to_string(cam.model.height));
     }
     auto found = findFiducials(*plan.tags, seen);
-    if (!found) return failed("camera '" + cam.device.name + "': " + found.error());
+    if (!found) return calibrationFailed("camera '" + cam.device.name + "': " + found.error());
     if (found->empty()) {
-      return failed("camera '" + cam.device.name + "' found no tag of output '" + plan.output.name +
-                    "': it does not see the projected tags");
+      return calibrationFailed("camera '" + cam.device.name + "' found no tag of output '" +
+                               plan.output.name + "': it does not see the projected tags");
     }
     views.push_back(std::move(*found));
   }
@@ -82,7 +74,7 @@ tl::expected<void, CalibrationFailure> solveTagFrame(const CalibrationPlan& plan
                                                      const TagViews& views,
                                                      const geom::Plane& plane,
                                                      CalibrationOutcome& out) {
-  if (views.empty()) return failed("internal: no camera's tag corners");
+  if (views.empty()) return calibrationFailed("internal: no camera's tag corners");
   const CalibrationCamera& cam = plan.cameras.front();
   for (const auto& corners : views) out.decoded.push_back(static_cast<int>(corners.size()));
   Points2 projector, camera;
@@ -91,10 +83,10 @@ tl::expected<void, CalibrationFailure> solveTagFrame(const CalibrationPlan& plan
     camera.push_back(c.camera);
   }
   auto nodes = calib::collineationOfPoints(projector, camera, cam.model, cam.device.name);
-  if (!nodes) return failed(nodes.error().message);
+  if (!nodes) return calibrationFailed(nodes.error().message);
   auto planar = calib::solvePlaneFromNodes(*nodes, cam.model, cam.device.name, plane,
                                            plan.set.options.width, plan.set.options.height);
-  if (!planar) return failed(planar.error().message);
+  if (!planar) return calibrationFailed(planar.error().message);
   out.planar = std::move(*planar);
   return {};
 }
@@ -124,7 +116,7 @@ tl::expected<CalibrationOutcome, CalibrationFailure> tagFrameOutcome(const Calib
                                                                      const CalibrationHooks& hooks,
                                                                      CalibrationOutcome out,
                                                                      double start) {
-  if (!plan.plane) return failed("internal: the tag frame is route (b′) with a plane");
+  if (!plan.plane) return calibrationFailed("internal: the tag frame is route (b′) with a plane");
   auto views = captureTagFrame(plan, hooks, out.settle_frames, start);
   if (!views) return tl::unexpected(views.error());
   hooks.progress({0.95, "solving", plan.captures()});

@@ -16,4 +16,7 @@ inline constexpr double radToDeg(double radians) {
   return radians * (180.0 / std::numbers::pi);
 }
 
+// One degree in radians: `30 * kDeg` reads as thirty degrees.
+inline constexpr double kDeg = degToRad(1);
+
 }  // namespace procam

@@ -129,13 +129,6 @@ Mat3 denormalize(const Normalized& n, const Mat3& Hn) {
   return n.td.inverseMatrix() * Hn * n.ts.matrix();
 }
 
-Mat3 canonical(Mat3 H) {
-  if (!H.allFinite() || !(H.cwiseAbs().maxCoeff() > 0)) return H;  // caller checks finiteness
-  H = detail::unitFrobenius(H);
-  if (H(2, 2) < 0) H = -H;
-  return H;
-}
-
 // RMS transfer error in dst pixels; nullopt when a point maps to infinity.
 std::optional<double> transferRms(const Mat3& H, std::span<const Vec2> src,
                                   std::span<const Vec2> dst) {
@@ -206,7 +199,7 @@ struct TransferError {
 
 Result<HomographyFit> finish(const Normalized& n, const Mat3& Hn, double condition, int iterations,
                              std::span<const Vec2> src, std::span<const Vec2> dst) {
-  const Mat3 H = canonical(denormalize(n, Hn));
+  const Mat3 H = detail::canonicalCollineation<Mat3>(denormalize(n, Hn));
   if (!H.allFinite()) {
     return fail(ErrorCode::kIllConditioned, "homography: result not representable");
   }
@@ -283,7 +276,7 @@ Result<Mat3> homographyFrom4(const std::array<Vec2, 4>& src, const std::array<Ve
     return fail(ErrorCode::kDegenerate, "homography: three of the four points are collinear");
   }
   const Mat3 Hn = *Md * Ms->inverse();
-  const Mat3 H = canonical(td->inverseMatrix() * Hn * ts->matrix());
+  const Mat3 H = detail::canonicalCollineation<Mat3>(td->inverseMatrix() * Hn * ts->matrix());
   if (!H.allFinite()) {
     return fail(ErrorCode::kIllConditioned, "homography: result not representable");
   }

@@ -91,4 +91,14 @@ Matrix unitFrobenius(const Matrix& M) {
   return scaled / scaled.norm();
 }
 
+// The representative of a collineation's class with unit Frobenius norm and H(2,2) >= 0,
+// so that results compare entry by entry; a non-finite or zero H is returned as it is
+// (the caller checks finiteness).
+template <class Matrix>
+Matrix canonicalCollineation(const Matrix& H) {
+  if (!H.allFinite() || !(H.cwiseAbs().maxCoeff() > 0)) return H;
+  const Matrix out = unitFrobenius(H);
+  return out(2, 2) < 0 ? Matrix(-out) : out;
+}
+
 }  // namespace procam::geom::detail

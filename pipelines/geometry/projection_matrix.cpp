@@ -15,7 +15,7 @@ namespace {
 
 using Vec12 = Eigen::Matrix<double, 12, 1>;
 
-struct Normalized {
+struct NormalizedCorrespondences {
   detail::Similarity<3> tw;
   detail::Similarity<2> tp;
   std::vector<Vec3> X;
@@ -34,8 +34,8 @@ Vec12 toVector(const Mat34& P) {
   return p;
 }
 
-Result<Normalized> prepare(std::span<const Vec3> world, std::span<const Vec2> pixels,
-                           const ProjectionOptions& options) {
+Result<NormalizedCorrespondences> prepare(std::span<const Vec3> world, std::span<const Vec2> pixels,
+                                          const ProjectionOptions& options) {
   if (world.size() != pixels.size()) {
     return fail(ErrorCode::kInvalidInput, "projection matrix: point lists differ in length");
   }
@@ -48,7 +48,7 @@ Result<Normalized> prepare(std::span<const Vec3> world, std::span<const Vec2> pi
   auto tw = detail::hartley<3>(world);
   auto tp = detail::hartley<2>(pixels);
   if (!tw || !tp) return fail(ErrorCode::kDegenerate, "projection matrix: all points coincide");
-  Normalized n{*tw, *tp, {}, {}};
+  NormalizedCorrespondences n{*tw, *tp, {}, {}};
   for (const Vec3& X : world) n.X.push_back(tw->apply(X));
   for (const Vec2& x : pixels) n.x.push_back(tp->apply(x));
 
@@ -87,13 +87,13 @@ Result<Normalized> prepare(std::span<const Vec3> world, std::span<const Vec2> pi
   return n;
 }
 
-struct Dlt {
+struct CameraDlt {
   Mat34 Pn;
   double condition;
 };
 
 // Null vector of the 2n x 12 DLT system (HZ §7.1); condition is σ1/σ11.
-Dlt solveDlt(const Normalized& n) {
+CameraDlt solveCameraDlt(const NormalizedCorrespondences& n) {
   Eigen::MatrixXd A(2 * Eigen::Index(n.X.size()), 12);
   for (std::size_t i = 0; i < n.X.size(); ++i) {
     const Vec4 X = n.X[i].homogeneous();
@@ -103,7 +103,7 @@ Dlt solveDlt(const Normalized& n) {
     A.row(r + 1) << X.transpose(), Eigen::RowVector4d::Zero(), -u * X.transpose();
   }
   const detail::NullVector nv = detail::smallestRightSingularVector(A);
-  Dlt out;
+  CameraDlt out;
   out.Pn = fromVector(Vec12(nv.v));
   out.condition = nv.singular(10) > 0 ? nv.singular(0) / nv.singular(10)
                                       : std::numeric_limits<double>::infinity();
@@ -113,11 +113,11 @@ Dlt solveDlt(const Normalized& n) {
 // Reprojection error in the normalised image frame (a uniform scaling of the pixel
 // error). P = P0 + B·δ with B spanning the tangent space of ||P|| = const: 11 parameters.
 struct ReprojectionError {
-  const Normalized& n;
+  const NormalizedCorrespondences& n;
   Vec12 p0;
   Eigen::Matrix<double, 12, 11> B;  // fixed size: the per-point products stay inlined
 
-  ReprojectionError(const Normalized& norm, const Mat34& P0) : n(norm) {
+  ReprojectionError(const NormalizedCorrespondences& norm, const Mat34& P0) : n(norm) {
     p0 = toVector(P0).normalized();
     B = detail::orthogonalComplement(p0);
   }
@@ -156,7 +156,8 @@ struct ReprojectionError {
   }
 };
 
-std::pair<Mat34, int> refine(const Normalized& n, const Mat34& Pn0, int max_iterations) {
+std::pair<Mat34, int> refine(const NormalizedCorrespondences& n, const Mat34& Pn0,
+                             int max_iterations) {
   const ReprojectionError error(n, Pn0);
   detail::LeastSquaresProblem problem;
   problem.parameters = 11;
@@ -180,7 +181,7 @@ Result<ProjectionFit> fitProjectionMatrix(std::span<const Vec3> world, std::span
                                           const ProjectionOptions& options) {
   auto n = prepare(world, pixels, options);
   if (!n) return tl::unexpected(n.error());
-  const Dlt dlt = solveDlt(*n);
+  const CameraDlt dlt = solveCameraDlt(*n);
   if (!(dlt.condition <= options.max_condition)) {
     return fail(ErrorCode::kIllConditioned, "projection matrix: DLT condition number " +
                                                 detail::shortNumber(dlt.condition) +

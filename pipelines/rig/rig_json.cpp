@@ -3,16 +3,6 @@
 #include "rig/rig_model.hpp"
 
 namespace procam::rig {
-namespace {
-
-nlohmann::json matrixJson(const Mat3& m) {
-  nlohmann::json a = nlohmann::json::array();
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) a.push_back(m(r, c));
-  return a;
-}
-
-}  // namespace
 
 // The rig model's parsing of one camera (rig_model.hpp), so that cameras.json and
 // rig.json accept exactly the same camera entries.

@@ -43,13 +43,6 @@ Result<Vec3> vector3(const json& j, const char* key, const std::string& where) {
   return Vec3((*v)[0], (*v)[1], (*v)[2]);
 }
 
-json matrixJson(const Mat3& m) {
-  json a = json::array();
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) a.push_back(m(r, c));
-  return a;
-}
-
 json vecJson(const Vec3& v) {
   return {v.x(), v.y(), v.z()};
 }
@@ -119,6 +112,13 @@ json provenanceJson(const Provenance& p) {
 }
 
 }  // namespace
+
+json matrixJson(const Mat3& m) {
+  json a = json::array();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) a.push_back(m(r, c));
+  return a;
+}
 
 Result<RigCamera> cameraFromJson(const json& c, const std::string& where, size_t index) {
   if (!c.is_object()) return fail(ErrorCode::kParse, where + ": not an object");

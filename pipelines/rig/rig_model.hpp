@@ -143,6 +143,8 @@ Result<RigCamera> cameraFromJson(const nlohmann::json& entry, const std::string&
                                  size_t index);
 // Version 2; numbers with full double precision.
 nlohmann::json rigToJson(const RigModel& rig);
+// A 3 x 3 matrix as rig.json writes it: nine numbers, row by row.
+nlohmann::json matrixJson(const Mat3& m);
 
 // `update` merged into `base`: its cameras and projectors replace those of the
 // same name and are added otherwise; its surface parts (plane, per-projector

@@ -10,7 +10,7 @@ src=$1 out=$2 build=${3:-}
 CXX=${FUZZ_CXX:-clang++}
 command -v "$CXX" >/dev/null || { echo "no $CXX: fuzzers not built"; exit 77; }
 mkdir -p "$out"
-flags=(-std=c++20 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined
+flags=(-std=c++20 -O1 -gline-tables-only -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined
        -I"$src/daemon" -I"$src/pipelines" -I"$src/plugins/include" -I"$src/drivers"
        -I/usr/include/eigen3 -I/usr/include/opencv4
        -DTOML_HEADER_ONLY=0 -DTOML_SHARED_LIB=1)

@@ -21,6 +21,7 @@
 #include "curved_display_checks.hpp"
 #include "cylinder_mesh.hpp"
 #include "daemon_harness.hpp"
+#include "json_matrix.hpp"
 #include "mpcdi_readback.hpp"
 #include "render/dome_master.hpp"
 #include "render_command.hpp"
@@ -33,19 +34,19 @@
 namespace procam::itest {
 namespace {
 
-constexpr int kW = 4800, kH = 900;  // a panorama
+constexpr int kPanoramaW = 4800, kPanoramaH = 900;  // a panorama
 
-struct Rig {
+struct CylinderRig {
   sim::Scene scene;
   sim::SceneState state;
   std::string file;
   std::string eye;  // --viewer
 };
 
-Rig trueCylinder(const TempDir& dir) {
+CylinderRig trueCylinder(const TempDir& dir) {
   auto scene = sim::resolveScene("cylinder3");
   EXPECT_TRUE(scene);
-  Rig r{*scene, scene->at(0), "", ""};
+  CylinderRig r{*scene, scene->at(0), "", ""};
   auto rig = sim::truthRig(r.scene, 0.0);
   EXPECT_TRUE(rig);
   addTruePhotometry(r.scene, r.state, *rig);
@@ -60,17 +61,11 @@ Rig trueCylinder(const TempDir& dir) {
   return r;
 }
 
-Mat34 rowMajor34(const json& j) {
-  Mat34 m;
-  for (int i = 0; i < 12; ++i) m(i / 4, i % 4) = j[i].get<double>();
-  return m;
-}
-
 // Every 7th pixel of every projector's 16-bit frame in `frames`, with the TRUE wall
 // point the TRUE projector lights there: expected(point) gives the content pixel it
 // should show (nullopt: none), added to `error`.
 template <typename Expected>
-void rampAgainstTheTrueWall(const Rig& rig, const TempDir& dir, Expected expected,
+void rampAgainstTheTrueWall(const CylinderRig& rig, const TempDir& dir, Expected expected,
                             RampError& error) {
   for (const auto& p : rig.state.projectors) {
     const cv::Mat frame =
@@ -92,8 +87,8 @@ void rampAgainstTheTrueWall(const Rig& rig, const TempDir& dir, Expected expecte
 
 TEST(RenderCliCurved, FramebuffersShowTheViewerEveryContentPixelWhereTheTrueRigPutsIt) {
   TempDir dir;
-  const Rig rig = trueCylinder(dir);
-  const cv::Mat ramp = contentRamp(kW, kH);
+  const CylinderRig rig = trueCylinder(dir);
+  const cv::Mat ramp = contentRamp(kPanoramaW, kPanoramaH);
   ASSERT_TRUE(cv::imwrite(dir.file("ramp.png"), ramp));
   auto args = render_cli::parseRenderArgs({"--rig", rig.file, "--content", dir.file("ramp.png"),
                                            "--out", dir.file("frames"), "--viewer", rig.eye,
@@ -105,14 +100,15 @@ TEST(RenderCliCurved, FramebuffersShowTheViewerEveryContentPixelWhereTheTrueRigP
   EXPECT_EQ((*doc)["display"]["surface"], "mesh");
   EXPECT_EQ((*doc)["display"]["viewer"]["source"], "given");
   const Mat34 V = rowMajor34((*doc)["display"]["viewer_matrix"]);
-  RampError error{kW, kH};
+  RampError error{kPanoramaW, kPanoramaH};
   for (const json& share : (*doc)["projectors"]) EXPECT_EQ(share["path"], "lookup-warp");
   rampAgainstTheTrueWall(
       rig, dir,
       [&](const Vec3& X, const cv::Vec3w&) -> std::optional<Vec2> {
         const Vec2 c = (V * X.homogeneous()).hnormalized();
         // Inside the content, one pixel in from its edge (the edge half pixel is clamped).
-        if (c.x() < 1 || c.y() < 1 || c.x() > kW - 2 || c.y() > kH - 2) return std::nullopt;
+        if (c.x() < 1 || c.y() < 1 || c.x() > kPanoramaW - 2 || c.y() > kPanoramaH - 2)
+          return std::nullopt;
         return c;
       },
       error);
@@ -133,7 +129,7 @@ TEST(RenderCliCurved, FramebuffersShowTheViewerEveryContentPixelWhereTheTrueRigP
 // eye to the TRUE wall point the TRUE projector lights (render/dome_master.hpp).
 TEST(RenderCliCurved, ADomeMasterShowsEachDirectionWhereItsFisheyePutsIt) {
   TempDir dir;
-  const Rig rig = trueCylinder(dir);
+  const CylinderRig rig = trueCylinder(dir);
   constexpr int kSide = 2048;
   ASSERT_TRUE(cv::imwrite(dir.file("ramp.png"), contentRamp(kSide, kSide)));
   auto args =
@@ -185,8 +181,9 @@ TEST(RenderCliCurved, ADomeMasterShowsEachDirectionWhereItsFisheyePutsIt) {
 
 TEST(RenderCliCurved, BlendedFramesLightTheCurvedWallEvenlyForTheViewer) {
   TempDir dir;
-  const Rig rig = trueCylinder(dir);
-  ASSERT_TRUE(cv::imwrite(dir.file("white.png"), cv::Mat(kH, kW, CV_8UC3, cv::Scalar::all(255))));
+  const CylinderRig rig = trueCylinder(dir);
+  ASSERT_TRUE(cv::imwrite(dir.file("white.png"),
+                          cv::Mat(kPanoramaH, kPanoramaW, CV_8UC3, cv::Scalar::all(255))));
   auto doc = render_cli::runRender(
       *render_cli::parseRenderArgs({"--rig", rig.file, "--content", dir.file("white.png"), "--out",
                                     dir.file("frames"), "--viewer", rig.eye}));
@@ -209,7 +206,8 @@ TEST(RenderCliCurved, BlendedFramesLightTheCurvedWallEvenlyForTheViewer) {
     auto hit = rig.scene.world().intersect(*ray);
     if (!hit) return false;
     const Vec2 q = (V * hit->hit.point.homogeneous()).hnormalized();
-    return q.x() > 0.03 * kW && q.x() < 0.97 * kW && q.y() > 0.03 * kH && q.y() < 0.97 * kH;
+    return q.x() > 0.03 * kPanoramaW && q.x() < 0.97 * kPanoramaW && q.y() > 0.03 * kPanoramaH &&
+           q.y() < 0.97 * kPanoramaH;
   };
   const ViewerLight light = viewerLight(view, inside);
   EXPECT_FALSE(light.unlit) << "an unlit point inside the display at viewer pixel "
@@ -224,7 +222,7 @@ TEST(RenderCliCurved, BlendedFramesLightTheCurvedWallEvenlyForTheViewer) {
 
 TEST(RenderCliCurved, MpcdiPackageRebuildsTheSameFramebuffers) {
   TempDir dir;
-  const Rig rig = trueCylinder(dir);
+  const CylinderRig rig = trueCylinder(dir);
   cv::Mat content(300, 1600, CV_8UC3);
   for (int y = 0; y < content.rows; ++y) {
     for (int x = 0; x < content.cols; ++x) {
@@ -250,7 +248,7 @@ TEST(RenderCliCurved, MpcdiPackageRebuildsTheSameFramebuffers) {
 
 TEST(RenderCliCurved, WhatACurvedRigCannotDoIsRefusedWithAReason) {
   TempDir dir;
-  const Rig rig = trueCylinder(dir);
+  const CylinderRig rig = trueCylinder(dir);
   ASSERT_TRUE(cv::imwrite(dir.file("white.png"), cv::Mat(90, 480, CV_8UC3, cv::Scalar::all(255))));
   auto refused = [&](std::vector<std::string> extra, const std::string& says) {
     std::vector<std::string> a = {"--rig", rig.file,           "--content", dir.file("white.png"),

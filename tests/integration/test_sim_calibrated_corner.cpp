@@ -14,6 +14,7 @@
 #include "content/mesh_content.hpp"
 #include "content/mesh_placement.hpp"
 #include "daemon_harness.hpp"
+#include "json_matrix.hpp"
 #include "mesh_ray_cast.hpp"
 #include "sim/truth_rig.hpp"
 #include "sim_calibrate_run.hpp"
@@ -53,12 +54,6 @@ std::optional<json> shownByLookupWarp(Connection& c) {
     return std::nullopt;
   }
   return shown;
-}
-
-Mat34 rowMajor34(const json& j) {
-  Mat34 m;
-  for (int i = 0; i < 12; ++i) m(i / 4, i % 4) = j[i].get<double>();
-  return m;
 }
 
 // `label(surface point)` for every pixel of the scene's TRUE projector whose ray meets a

@@ -22,6 +22,7 @@
 #include "cylinder_mesh.hpp"
 #include "cylinder_scene.hpp"
 #include "daemon_harness.hpp"
+#include "json_matrix.hpp"
 #include "render/cpu_renderer.hpp"
 #include "sim/renderer.hpp"
 #include "sim/truth_rig.hpp"
@@ -30,8 +31,8 @@
 namespace procam::itest {
 namespace {
 
-const std::vector<std::string> kOutputs = {"proj_l", "proj_c", "proj_r"};
-constexpr int kW = 2400, kH = 450;  // a panorama
+const std::vector<std::string> kCylinderOutputs = {"proj_l", "proj_c", "proj_r"};
+constexpr int kPanoramaW = 2400, kPanoramaH = 450;  // a panorama
 const Vec3 kSweetSpot(0.0, -0.6, 1.6);
 
 // cylinder3 with lenses, its viewer walking x = -0.3 ... 0.3 m in 4 s and back, and a head
@@ -60,12 +61,6 @@ name = "head"
 noise_sigma_m = 0.001
 rate_hz = 60.0
 )";
-}
-
-Mat34 rowMajor34(const json& j) {
-  Mat34 m;
-  for (int i = 0; i < 12; ++i) m(i / 4, i % 4) = j[i].get<double>();
-  return m;
 }
 
 // The eye of a world -> content pixel pinhole: its null vector.
@@ -108,7 +103,7 @@ TEST(SimCurvedTracked, EveryOutputDrawsTheSweetSpotDisplayForTheTrackedEye) {
   Connection c(d.socketPath());
 
   const std::string png = contentFile(dir, "white.png");
-  ASSERT_TRUE(cv::imwrite(png, cv::Mat(kH, kW, CV_8UC3, cv::Scalar::all(255))));
+  ASSERT_TRUE(cv::imwrite(png, cv::Mat(kPanoramaH, kPanoramaW, CV_8UC3, cv::Scalar::all(255))));
   auto load = c.call({{"cmd", "content"}, {"action", "load"}, {"path", png}}, kSlowdown * 30s);
   ASSERT_TRUE(load);
   ASSERT_EQ((*load)["class"], "CONTENT") << load->dump();
@@ -147,22 +142,22 @@ TEST(SimCurvedTracked, EveryOutputDrawsTheSweetSpotDisplayForTheTrackedEye) {
   std::vector<blend::SurfaceProjector> projectors;
   std::vector<std::optional<blend::ProjectorResponse>> responses;
   for (std::size_t t = 0; t < 3; ++t) {
-    const rig::RigProjector* p = rig->projectorForOutput(kOutputs[t]);
+    const rig::RigProjector* p = rig->projectorForOutput(kCylinderOutputs[t]);
     // The rig's lenses: each output draws the pinhole through its lens's warp.
     auto warp = render::projectorPostRenderWarp(p->model(), nullptr);  // one shared wall
-    ASSERT_TRUE(warp && *warp) << kOutputs[t];
+    ASSERT_TRUE(warp && *warp) << kCylinderOutputs[t];
     EXPECT_EQ((*warp)->source, render::PostRenderWarp::Source::kLens);
     EXPECT_EQ(display["tiles"][t]["post_warp"], blend::postWarpJson(**warp)) << display.dump();
     projectors.push_back({&*wall, p->model().projectionMatrix(), cv::Size(p->width, p->height),
                           std::shared_ptr<const render::WarpGrid>(*warp, &(*warp)->grid)});
     responses.push_back(blend::projectorResponse(*p));
   }
-  auto blend = blend::makeCurvedBlend(projectors, responses, kSweetSpot, {kW, kH});
+  auto blend = blend::makeCurvedBlend(projectors, responses, kSweetSpot, {kPanoramaW, kPanoramaH});
   ASSERT_TRUE(blend) << blend.error().message;
 
   // Each output drew that display for a tracked eye on the walk.
   std::map<std::string, Mat34> V;
-  for (const std::string& name : kOutputs) {
+  for (const std::string& name : kCylinderOutputs) {
     V[name] = rowMajor34(shown[name]["viewer_matrix"]);
     const Vec3 eye = eyeOf(V[name]);
     std::printf("[ figures  ] %s drew for the eye at (%.3f, %.3f, %.3f)\n", name.c_str(), eye.x(),
@@ -170,14 +165,14 @@ TEST(SimCurvedTracked, EveryOutputDrawsTheSweetSpotDisplayForTheTrackedEye) {
     EXPECT_NEAR(eye.y(), -0.6, 0.01) << name;  // the tracker's noise is 1 mm
     EXPECT_NEAR(eye.z(), 1.6, 0.01) << name;
     EXPECT_LE(std::abs(eye.x()), 0.31) << name;
-    const Mat34 expected =
-        render::contentViewMatrix(blend->display.rotation, eye, blend->display.rect, {kW, kH});
+    const Mat34 expected = render::contentViewMatrix(blend->display.rotation, eye,
+                                                     blend->display.rect, {kPanoramaW, kPanoramaH});
     EXPECT_LT((V[name] - expected).norm(), 1e-6 * expected.norm()) << name;
   }
 
   // Geometry for one eye (the first output's), every output's two-pass drawing rebuilt as
   // lookups: the outputs agree where they overlap, and lines stay straight.
-  const Mat34& V0 = V[kOutputs[0]];
+  const Mat34& V0 = V[kCylinderOutputs[0]];
   std::vector<render::WarpGrid> lookup;
   for (std::size_t m = 0; m < 3; ++m) {
     auto g = render::lookupGridForViewer(*wall, projectors[m].projector, projectors[m].size, V0, 8,
@@ -186,12 +181,12 @@ TEST(SimCurvedTracked, EveryOutputDrawsTheSweetSpotDisplayForTheTrackedEye) {
     lookup.push_back(std::move(*g));
   }
   TrueRig true_rig{&*scene, {}};
-  for (const std::string& name : kOutputs) {
+  for (const std::string& name : kCylinderOutputs) {
     for (const auto& p : at0.projectors) {
       if (p.spec.name == name) true_rig.projectors.push_back(p.model);
     }
   }
-  const SeamFigures seams = seamsOnTheTrueSurface(lookup, true_rig, {kW, kH});
+  const SeamFigures seams = seamsOnTheTrueSurface(lookup, true_rig, {kPanoramaW, kPanoramaH});
   ASSERT_GT(seams.pairs, 1000);
   std::printf(
       "[ figures  ] seams for the tracked eye: %d content points lit twice, RMS %.3f px, "
@@ -206,11 +201,11 @@ TEST(SimCurvedTracked, EveryOutputDrawsTheSweetSpotDisplayForTheTrackedEye) {
     ASSERT_TRUE(g) << g.error().message;
     pinhole.push_back(std::move(*g));
   }
-  const SeamFigures open = seamsOnTheTrueSurface(pinhole, true_rig, {kW, kH});
+  const SeamFigures open = seamsOnTheTrueSurface(pinhole, true_rig, {kPanoramaW, kPanoramaH});
   std::printf("[ figures  ] without the lenses' warps: seams RMS %.3f px, max %.3f px\n", open.rms,
               open.worst);
   EXPECT_GT(open.worst, 1.0);
-  const double bent = bentOnTheTrueSurface(lookup, true_rig, V0, {kW, kH});
+  const double bent = bentOnTheTrueSurface(lookup, true_rig, V0, {kPanoramaW, kPanoramaH});
   std::printf(
       "[ figures  ] content lines seen from the tracked eye: %.3f content px from "
       "straight\n",
@@ -219,11 +214,11 @@ TEST(SimCurvedTracked, EveryOutputDrawsTheSweetSpotDisplayForTheTrackedEye) {
 
   // The frames: white through each output's two-pass path and blend for the eye it drew
   // for, rebuilt from the rig: the daemon's statistics agree.
-  const cv::Mat white(kH, kW, CV_8UC4, cv::Scalar::all(255));
+  const cv::Mat white(kPanoramaH, kPanoramaW, CV_8UC4, cv::Scalar::all(255));
   auto frameFor = [&](std::size_t t, const Mat34& viewer) -> cv::Mat {
     render::RenderSetup setup;
     setup.output_size = projectors[t].size;
-    setup.content_size = cv::Size(kW, kH);
+    setup.content_size = cv::Size(kPanoramaW, kPanoramaH);
     setup.path = render::RenderPath::kTwoPassMesh;
     setup.surface = drawn;
     setup.projector = projectors[t].projector;
@@ -239,17 +234,17 @@ TEST(SimCurvedTracked, EveryOutputDrawsTheSweetSpotDisplayForTheTrackedEye) {
     return bgr;
   };
   for (std::size_t t = 0; t < 3; ++t) {
-    const cv::Mat bgr = frameFor(t, V[kOutputs[t]]);
+    const cv::Mat bgr = frameFor(t, V[kCylinderOutputs[t]]);
     cv::Mat grey;
     cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
     const double lit = cv::countNonZero(grey) / double(grey.total());
     const double mean = cv::mean(bgr)[0];
-    const json& o = shown[kOutputs[t]];
+    const json& o = shown[kCylinderOutputs[t]];
     std::printf("[ figures  ] %s: lit %.5f (daemon %.5f), mean %.3f (daemon %.3f)\n",
-                kOutputs[t].c_str(), lit, o["lit_fraction"].get<double>(), mean,
+                kCylinderOutputs[t].c_str(), lit, o["lit_fraction"].get<double>(), mean,
                 o["mean_rgb"][0].get<double>());
-    EXPECT_NEAR(lit, o["lit_fraction"].get<double>(), 1e-3) << kOutputs[t];
-    EXPECT_NEAR(mean, o["mean_rgb"][0].get<double>(), 0.1) << kOutputs[t];
+    EXPECT_NEAR(lit, o["lit_fraction"].get<double>(), 1e-3) << kCylinderOutputs[t];
+    EXPECT_NEAR(mean, o["mean_rgb"][0].get<double>(), 0.1) << kCylinderOutputs[t];
   }
 
   // White for one eye, lit by the TRUE projectors and seen by the viewer standing there
@@ -270,13 +265,14 @@ TEST(SimCurvedTracked, EveryOutputDrawsTheSweetSpotDisplayForTheTrackedEye) {
   ASSERT_LT(nearest, 0.005) << "the eye drawn for is not on the walk";
   const sim::SceneState state = scene->at(when);
   sim::Framebuffers frames;
-  for (std::size_t t = 0; t < 3; ++t) frames[kOutputs[t]] = frameFor(t, V0);
+  for (std::size_t t = 0; t < 3; ++t) frames[kCylinderOutputs[t]] = frameFor(t, V0);
   auto lit = sim::Renderer::create(*scene, state, frames);
   ASSERT_TRUE(lit) << lit.error().message;
   const cv::Mat view = lit->renderViewer(4);
   auto inContent = [&](const Mat34& viewer, const Vec3& X) {
     const Vec2 q = (viewer * X.homogeneous()).hnormalized();
-    return q.x() > 0.03 * kW && q.x() < 0.97 * kW && q.y() > 0.03 * kH && q.y() < 0.97 * kH;
+    return q.x() > 0.03 * kPanoramaW && q.x() < 0.97 * kPanoramaW && q.y() > 0.03 * kPanoramaH &&
+           q.y() < 0.97 * kPanoramaH;
   };
   std::vector<std::optional<Vec3>> seen(static_cast<std::size_t>(view.rows) * view.cols);
   long in_display = 0, in_both = 0;

@@ -25,6 +25,7 @@
 #include "curved_display_checks.hpp"
 #include "cylinder_scene.hpp"
 #include "daemon_harness.hpp"
+#include "json_matrix.hpp"
 #include "render/viewer_view.hpp"
 #include "rig/rig_model.hpp"
 #include "sim/renderer.hpp"
@@ -36,12 +37,6 @@ namespace {
 
 const char* const kOutputs[] = {"proj_l", "proj_c", "proj_r"};
 constexpr int kW = 4800, kH = 900;  // a panorama
-
-Mat34 rowMajor34(const json& j) {
-  Mat34 m;
-  for (int i = 0; i < 12; ++i) m(i / 4, i % 4) = j[i].get<double>();
-  return m;
-}
 
 TEST(SimCurvedWall, ThreeProjectorsCalibratedIntoOneDisplayForTheSweetSpot) {
   TempDir dir;

@@ -26,7 +26,7 @@
 namespace procam::itest {
 namespace {
 
-const std::vector<std::string> kOutputs = {"proj_a", "proj_b", "proj_c"};
+const std::vector<std::string> kDomeOutputs = {"proj_a", "proj_b", "proj_c"};
 constexpr int kSide = 1024;      // the dome master: 1024 x 1024
 const Vec3 kEye(0.0, 0.0, 0.0);  // the dome's centre
 
@@ -117,7 +117,7 @@ TEST(SimDome, ThreeProjectorsCalibratedIntoOneDomeMaster) {
   const json& display = loaded.display;
   std::map<std::string, json>& shown = loaded.shown;
   EXPECT_EQ(display["projection"], "dome") << display.dump();
-  EXPECT_EQ(display["outputs"], json(kOutputs)) << display.dump();
+  EXPECT_EQ(display["outputs"], json(kDomeOutputs)) << display.dump();
   EXPECT_EQ(display["dome"]["fov_deg"], 180.0);
   EXPECT_EQ(display["blend"]["response"], "measured");
   // The master is made for the static eye, whatever ir_head reports; its content is
@@ -129,7 +129,7 @@ TEST(SimDome, ThreeProjectorsCalibratedIntoOneDomeMaster) {
 
   // The same display from the rig model the daemon wrote: what every output draws.
   Calibrated cal;
-  ASSERT_NO_FATAL_FAILURE(readCalibrated(dir.file("state"), kOutputs, cal));
+  ASSERT_NO_FATAL_FAILURE(readCalibrated(dir.file("state"), kDomeOutputs, cal));
   auto master = render::domeMaster(kEye, Vec3(0, 1, 0), 180, {kSide, kSide});
   ASSERT_TRUE(master) << master.error().message;
   auto blend = blend::makeDomeBlend(cal.projectors, cal.responses, *master);
@@ -143,7 +143,7 @@ TEST(SimDome, ThreeProjectorsCalibratedIntoOneDomeMaster) {
   EXPECT_GT(blend->display.coverage, 0.25);
 
   TrueRig true_rig{&*scene, {}};
-  for (const auto& name : kOutputs) true_rig.projectors.push_back(truth[name]);
+  for (const auto& name : kDomeOutputs) true_rig.projectors.push_back(truth[name]);
 
   // Seams: where one projector puts a content point on the TRUE dome, the other shows
   // the same content point within 0.3 px RMS, 1 px at most (its pixels).
@@ -167,8 +167,8 @@ TEST(SimDome, ThreeProjectorsCalibratedIntoOneDomeMaster) {
   // the projectors draw, 3 % of the circle's diameter in from where they stop.
   sim::Framebuffers frames;
   for (std::size_t t = 0; t < 3; ++t) {
-    frames[kOutputs[t]] = whiteThroughLookup(lookup[t], *blend, t, {1280, 800}, {kSide, kSide},
-                                             shown[kOutputs[t]], kOutputs[t]);
+    frames[kDomeOutputs[t]] = whiteThroughLookup(lookup[t], *blend, t, {1280, 800}, {kSide, kSide},
+                                                 shown[kDomeOutputs[t]], kDomeOutputs[t]);
   }
   auto lit = sim::Renderer::create(*scene, state, frames);
   ASSERT_TRUE(lit) << lit.error().message;

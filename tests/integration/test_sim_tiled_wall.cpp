@@ -153,8 +153,8 @@ TEST(SimTiledWall, FourProjectorsCalibratedIntoOneSeamlessDisplay) {
              bl = wallPoint({-0.5, kH - 0.5}), br = wallPoint({kW - 0.5, kH - 0.5});
   ASSERT_TRUE(tl && tr && bl && br) << "a corner of the display is not lit";
   const Vec3 top = *tr - *tl, left = *tl - *bl;
-  const double tilt_deg = std::atan2(top.z(), top.x()) * kDeg;
-  const double lean_deg = std::atan2(left.x(), left.z()) * kDeg;
+  const double tilt_deg = std::atan2(top.z(), top.x()) * kDegPerRad;
+  const double lean_deg = std::atan2(left.x(), left.z()) * kDegPerRad;
   const double aspect = top.norm() / left.norm() / (double(kW) / kH) - 1;
   const double area =
       0.5 * ((*tr - *tl).cross(*bl - *tl).norm() + (*tr - *br).cross(*bl - *br).norm());

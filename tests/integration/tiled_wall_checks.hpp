@@ -25,7 +25,7 @@
 
 namespace procam::itest {
 
-inline constexpr double kDeg = 180.0 / std::numbers::pi;
+inline constexpr double kDegPerRad = 180.0 / std::numbers::pi;
 inline const char* const kOutputs[] = {"proj_tl", "proj_tr", "proj_bl", "proj_br"};
 inline const json kWallPlane = {0.0, 1.0, 0.0, -3.0};  // y = 3, as measured by the installer
 

@@ -15,7 +15,7 @@ using namespace procam::calib;
 
 namespace {
 
-constexpr double kDeg = 180.0 / std::numbers::pi;
+constexpr double kDegPerRad = 180.0 / std::numbers::pi;
 
 struct Seen {
   BoardView view;
@@ -57,7 +57,7 @@ TEST(BoardPlane, PlaneOfABoardSeenByADistortedCamera) {
     ASSERT_GE(s.view.image.size(), 48u) << "pose " << i;
     auto p = boardPlane(cam, s.view);
     ASSERT_TRUE(p) << p.error().message;
-    const double normal_deg = std::acos(std::min(1.0, p->plane.n.dot(s.truth.n))) * kDeg;
+    const double normal_deg = std::acos(std::min(1.0, p->plane.n.dot(s.truth.n))) * kDegPerRad;
     const Vec3 c = cam.pose.center();
     const double dist = std::abs(s.truth.signedDistance(c));
     const double dist_rel = std::abs(std::abs(p->plane.signedDistance(c)) - dist) / dist;

@@ -36,11 +36,12 @@ Wall threeInARow() {
   return w;
 }
 
-const geom::Plane kWall{Vec3(0, -1, 0), 3.0};  // y = 3, the synthetic wall
+const geom::Plane kSyntheticWall{Vec3(0, -1, 0), 3.0};  // y = 3, the synthetic wall
 
 TEST(WallViewsNodes, EveryProjectorOnTheWallWithItsFigures) {
   const Wall w = threeInARow();
-  auto r = calib::solveWallViews(w.sizes, w.views.size(), w.nodes, w.views[0], "left", kWall);
+  auto r =
+      calib::solveWallViews(w.sizes, w.views.size(), w.nodes, w.views[0], "left", kSyntheticWall);
   ASSERT_TRUE(r) << r.error().message;
   ASSERT_EQ(r->projectors.size(), 3u);
   for (std::size_t p = 0; p < 3; ++p) {
@@ -65,7 +66,7 @@ TEST(WallViewsNodes, UnsolvableWallsAreNamed) {
   auto sizes = w.sizes;
   sizes.emplace_back(1280, 800);
   named.projector_names.push_back("output 'd'");
-  auto unseen = calib::solveWallViews(sizes, 2, w.nodes, w.views[0], "left", kWall, named);
+  auto unseen = calib::solveWallViews(sizes, 2, w.nodes, w.views[0], "left", kSyntheticWall, named);
   ASSERT_FALSE(unseen);
   EXPECT_EQ(unseen.error().code, ErrorCode::kDegenerate);
   EXPECT_NE(unseen.error().message.find("output 'd'"), std::string::npos) << unseen.error().message;
@@ -86,7 +87,8 @@ TEST(WallViewsNodes, UnsolvableWallsAreNamed) {
     }
     corner.push_back(std::move(n));
   }
-  auto extrapolated = calib::solveWallViews(w.sizes, 2, corner, w.views[0], "left", kWall, named);
+  auto extrapolated =
+      calib::solveWallViews(w.sizes, 2, corner, w.views[0], "left", kSyntheticWall, named);
   ASSERT_FALSE(extrapolated);
   EXPECT_EQ(extrapolated.error().code, ErrorCode::kDegenerate);
   EXPECT_NE(extrapolated.error().message.find("output 'c'"), std::string::npos)
@@ -97,12 +99,14 @@ TEST(WallViewsNodes, UnsolvableWallsAreNamed) {
           .error()
           .code,
       ErrorCode::kInvalidInput);
-  EXPECT_EQ(calib::solveWallViews(w.sizes, 1, w.nodes, w.views[0], "left", kWall).error().code,
-            ErrorCode::kInvalidInput);
+  EXPECT_EQ(
+      calib::solveWallViews(w.sizes, 1, w.nodes, w.views[0], "left", kSyntheticWall).error().code,
+      ErrorCode::kInvalidInput);
   auto uneven = w.nodes;
   uneven[0].nodes.camera.pop_back();
-  EXPECT_EQ(calib::solveWallViews(w.sizes, 2, uneven, w.views[0], "left", kWall).error().code,
-            ErrorCode::kInvalidInput);
+  EXPECT_EQ(
+      calib::solveWallViews(w.sizes, 2, uneven, w.views[0], "left", kSyntheticWall).error().code,
+      ErrorCode::kInvalidInput);
   // The plane behind the reference camera: it does not see the lit wall there.
   EXPECT_EQ(calib::solveWallViews(w.sizes, 2, w.nodes, w.views[0], "left",
                                   geom::Plane{Vec3(0, -1, 0), -5.0})

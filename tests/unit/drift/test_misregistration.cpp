@@ -26,8 +26,8 @@
 namespace procam::drift {
 namespace {
 
-// The device turned about its own centre by yaw/pitch/roll in its own frame.
-geom::Pose turned(const geom::Pose& pose, double yaw_deg, double pitch_deg) {
+// The device turnedBy about its own centre by yaw/pitch/roll in its own frame.
+geom::Pose turnedBy(const geom::Pose& pose, double yaw_deg, double pitch_deg) {
   geom::YawPitchRoll a;
   a.yaw = degToRad(yaw_deg);
   a.pitch = degToRad(pitch_deg);
@@ -38,14 +38,14 @@ geom::Pose turned(const geom::Pose& pose, double yaw_deg, double pitch_deg) {
   return p;
 }
 
-struct Rig {
+struct PlanarRig {
   sim::Scene scene;
   rig::RigModel model;
   geom::PlaneHomography tile;
   geom::CameraModel camera;
 };
 
-Rig restingRig() {
+PlanarRig restingPlanarRig() {
   auto scene = sim::resolveScene("wall_oblique");
   EXPECT_TRUE(scene) << scene.error().message;
   auto model = sim::truthRig(*scene, 0.0);
@@ -55,15 +55,16 @@ Rig restingRig() {
   return {*scene, *model, tile->projector_to_plane, model->cameras.at(0).model};
 }
 
-struct View {
+struct PlanarView {
   cv::Mat shown;   // work grid, CV_32F
   cv::Mat camera;  // CV_32F
   cv::Mat map;
   WorkGrid grid;
 };
 
-View viewOf(const Rig& rig, const cv::Mat& framebuffer, const geom::Pose& projector_pose,
-            const std::optional<geom::Pose>& camera_pose = std::nullopt) {
+PlanarView planarViewOf(const PlanarRig& rig, const cv::Mat& framebuffer,
+                        const geom::Pose& projector_pose,
+                        const std::optional<geom::Pose>& camera_pose = std::nullopt) {
   sim::SceneState state = rig.scene.at(0);
   state.projectors.at(0).model.pose = projector_pose;
   if (camera_pose) state.cameras.at(0).model.pose = *camera_pose;
@@ -71,7 +72,7 @@ View viewOf(const Rig& rig, const cv::Mat& framebuffer, const geom::Pose& projec
   EXPECT_TRUE(renderer) << renderer.error().message;
   auto image = renderer->renderCamera("cam");
   EXPECT_TRUE(image) << image.error().message;
-  View v;
+  PlanarView v;
   v.grid = {framebuffer.size(), 2};
   image->convertTo(v.camera, CV_32F);
   // The frame's light, through the projector's true response.
@@ -86,7 +87,7 @@ View viewOf(const Rig& rig, const cv::Mat& framebuffer, const geom::Pose& projec
 
 // Framebuffer pixel `p` of the projector at `pose` lands on the wall where the rig model
 // (at rest) puts this framebuffer point.
-Vec2 whereTheRigSees(const Rig& rig, const geom::Pose& pose, const Vec2& p) {
+Vec2 whereTheRigSees(const PlanarRig& rig, const geom::Pose& pose, const Vec2& p) {
   geom::CameraModel m = rig.scene.at(0).projectors.at(0).model;
   m.pose = pose;
   auto ray = m.backproject(p);
@@ -96,9 +97,9 @@ Vec2 whereTheRigSees(const Rig& rig, const geom::Pose& pose, const Vec2& p) {
 }
 
 TEST(DriftCheck, AProjectorAtRestShowsNoMisregistration) {
-  const Rig rig = restingRig();
+  const PlanarRig rig = restingPlanarRig();
   const geom::Pose rest = rig.scene.at(0).projectors.at(0).model.pose;
-  const View v = viewOf(rig, texturedContent({1920, 1080}, 3, {96, 32, 12}), rest);
+  const PlanarView v = planarViewOf(rig, texturedContent({1920, 1080}, 3, {96, 32, 12}), rest);
   auto m = measureMisregistration(v.shown, v.camera, v.map, v.grid);
   ASSERT_TRUE(m) << m.error().message;
   std::printf(
@@ -114,10 +115,10 @@ TEST(DriftCheck, AProjectorAtRestShowsNoMisregistration) {
 }
 
 TEST(DriftCheck, PlainContentIsTooPlainToTell) {
-  const Rig rig = restingRig();
+  const PlanarRig rig = restingPlanarRig();
   const geom::Pose rest = rig.scene.at(0).projectors.at(0).model.pose;
   for (int level : {0, 128}) {
-    const View v = viewOf(rig, cv::Mat(1080, 1920, CV_8U, cv::Scalar(level)), rest);
+    const PlanarView v = planarViewOf(rig, cv::Mat(1080, 1920, CV_8U, cv::Scalar(level)), rest);
     auto m = measureMisregistration(v.shown, v.camera, v.map, v.grid);
     ASSERT_TRUE(m) << m.error().message;
     EXPECT_TRUE(m->too_plain) << level;
@@ -149,16 +150,16 @@ cv::Mat crossedBands() {
 // too plain to tell; counted as texture (no isotropy test) they are, and the same bands
 // crossed by others make corners that count.
 TEST(DriftCheck, EdgesAloneAreTooPlainToTell) {
-  const Rig rig = restingRig();
+  const PlanarRig rig = restingPlanarRig();
   const geom::Pose rest = rig.scene.at(0).projectors.at(0).model.pose;
-  const View v = viewOf(rig, slantedBands(), rest);
+  const PlanarView v = planarViewOf(rig, slantedBands(), rest);
   auto m = measureMisregistration(v.shown, v.camera, v.map, v.grid);
   ASSERT_TRUE(m) << m.error().message;
   MisregistrationOptions any_edge;
   any_edge.min_isotropy = 0;
   auto counted = measureMisregistration(v.shown, v.camera, v.map, v.grid, any_edge);
   ASSERT_TRUE(counted) << counted.error().message;
-  const View x = viewOf(rig, crossedBands(), rest);
+  const PlanarView x = planarViewOf(rig, crossedBands(), rest);
   auto corners = measureMisregistration(x.shown, x.camera, x.map, x.grid);
   ASSERT_TRUE(corners) << corners.error().message;
   std::printf(
@@ -176,7 +177,7 @@ TEST(DriftCheck, EdgesAloneAreTooPlainToTell) {
 // The blur the virtual camera sees the frame with, in work pixels at the grid's centre:
 // the projector's pixel footprint, the camera's lens, its pixel (a box: variance 1/12)
 // and the bilinear resampling onto the grid (a tent: 1/6).
-double theoreticalBlur(const Rig& rig, const View& v) {
+double theoreticalBlur(const PlanarRig& rig, const PlanarView& v) {
   const cv::Point c(v.map.cols / 2, v.map.rows / 2);
   const cv::Vec2f m0 = v.map.at<cv::Vec2f>(c), mx = v.map.at<cv::Vec2f>(c + cv::Point(1, 0)),
                   my = v.map.at<cv::Vec2f>(c + cv::Point(0, 1));
@@ -189,13 +190,13 @@ double theoreticalBlur(const Rig& rig, const View& v) {
 }
 
 TEST(DriftCheck, TheReferenceIsBlurredAsTheCameraSeesTheFrame) {
-  const Rig rig = restingRig();
+  const PlanarRig rig = restingPlanarRig();
   const geom::Pose rest = rig.scene.at(0).projectors.at(0).model.pose;
   for (const auto& [name, content] :
        {std::pair{"crossed bands", crossedBands()},
         std::pair{"textured", texturedContent({1920, 1080}, 3, {96, 32, 12})}}) {
     SCOPED_TRACE(name);
-    const View v = viewOf(rig, content, rest);
+    const PlanarView v = planarViewOf(rig, content, rest);
     auto sharp = measureMisregistration(v.shown, v.camera, v.map, v.grid);
     auto fitted = fitReferenceBlur(v.shown, v.camera, v.map, v.grid);
     ASSERT_TRUE(sharp) << sharp.error().message;
@@ -220,7 +221,7 @@ TEST(DriftCheck, TheReferenceIsBlurredAsTheCameraSeesTheFrame) {
     EXPECT_LE(standardError(m), standardError(*sharp));
   }
   // Nothing to register: no blur is found, and the frame is too plain.
-  const View plain = viewOf(rig, cv::Mat(1080, 1920, CV_8U, cv::Scalar(128)), rest);
+  const PlanarView plain = planarViewOf(rig, cv::Mat(1080, 1920, CV_8U, cv::Scalar(128)), rest);
   auto none = fitReferenceBlur(plain.shown, plain.camera, plain.map, plain.grid);
   ASSERT_TRUE(none);
   EXPECT_FALSE(none->sigma_px);
@@ -242,13 +243,13 @@ TEST(DriftCheck, TheReferenceIsBlurredAsTheCameraSeesTheFrame) {
 }
 
 TEST(DriftCheck, ABumpedProjectorIsMeasuredAndItsPoseCorrectedFromContent) {
-  const Rig rig = restingRig();
+  const PlanarRig rig = restingPlanarRig();
   const geom::Pose rest = rig.scene.at(0).projectors.at(0).model.pose;
   const cv::Mat content = texturedContent({1920, 1080}, 5, {96, 32, 12});
   for (auto [yaw, pitch] : {std::pair{0.5, 0.0}, std::pair{0.0, -2.0}, std::pair{1.2, 0.8}}) {
     SCOPED_TRACE(testing::Message() << "yaw " << yaw << " pitch " << pitch);
-    const geom::Pose bumped = turned(rest, yaw, pitch);
-    const View v = viewOf(rig, content, bumped);
+    const geom::Pose bumped = turnedBy(rest, yaw, pitch);
+    const PlanarView v = planarViewOf(rig, content, bumped);
     auto m = measureMisregistration(v.shown, v.camera, v.map, v.grid);
     ASSERT_TRUE(m) << m.error().message;
     // Each registered tile against where the bumped projector truly puts its content.
@@ -315,14 +316,14 @@ TEST(DriftCheck, ABumpedProjectorIsMeasuredAndItsPoseCorrectedFromContent) {
 }
 
 TEST(DriftCheck, ABumpedCameraIsReregisteredFromTheContent) {
-  const Rig rig = restingRig();
+  const PlanarRig rig = restingPlanarRig();
   const geom::Pose rest = rig.scene.at(0).projectors.at(0).model.pose;
   const cv::Mat content = texturedContent({1920, 1080}, 7, {96, 32, 12});
   for (auto [yaw, pitch] : {std::pair{0.3, 0.0}, std::pair{-0.2, 0.4}}) {
     SCOPED_TRACE(testing::Message() << "camera yaw " << yaw << " pitch " << pitch);
     geom::CameraModel truth = rig.camera;
-    truth.pose = turned(rig.camera.pose, yaw, pitch);
-    const View v = viewOf(rig, content, rest, truth.pose);
+    truth.pose = turnedBy(rig.camera.pose, yaw, pitch);
+    const PlanarView v = planarViewOf(rig, content, rest, truth.pose);
     auto m = measureMisregistration(v.shown, v.camera, v.map, v.grid);
     ASSERT_TRUE(m) << m.error().message;
     auto c = correctCamera(rig.model.cameras.at(0), rig.tile, *m, v.map, v.grid);

@@ -4,13 +4,12 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 
+#include "core/units.hpp"
 #include "keystone/orientation.hpp"
 #include "keystone_command.hpp"
 
 namespace procam::keystone_cli {
 namespace {
-
-constexpr double kDeg = std::numbers::pi / 180;
 
 std::vector<std::string> base() {
   return {"--size", "1920x1080", "--intrinsics", "1600,1600,959.5,539.5", "--json"};

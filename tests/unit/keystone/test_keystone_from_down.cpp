@@ -9,8 +9,6 @@
 namespace procam::keystone {
 namespace {
 
-const double kDeg = degToRad(1);
-
 TEST(SolveFromDown, EqualsTheKeystoneSolveAtThatTilt) {
   ProjectorModel p;
   p.K = geom::Intrinsics{1400, 1400, 639.5, 359.5, 0};

@@ -4,13 +4,12 @@
 #include <numbers>
 #include <random>
 
+#include "core/units.hpp"
 #include "keystone/keystone_solver.hpp"
 #include "keystone/orientation.hpp"
 
 namespace procam::keystone {
 namespace {
-
-constexpr double kDeg = std::numbers::pi / 180;
 
 KeystoneProblem problem(const Angles& a) {
   KeystoneProblem p;

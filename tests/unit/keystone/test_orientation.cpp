@@ -4,12 +4,11 @@
 #include <numbers>
 #include <random>
 
+#include "core/units.hpp"
 #include "keystone/orientation.hpp"
 
 namespace procam::keystone {
 namespace {
-
-constexpr double kDeg = std::numbers::pi / 180;
 
 Vec3 opticalAxisInWall(const Mat3& R) {
   return R.transpose() * Vec3::UnitZ();

@@ -10,6 +10,7 @@
 #include <numbers>
 #include <random>
 
+#include "core/units.hpp"
 #include "geometry/plane_homography.hpp"
 #include "keystone/orientation.hpp"
 #include "keystone/rig_keystone.hpp"
@@ -17,7 +18,6 @@
 namespace procam::keystone {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180;
 const geom::Intrinsics kK = {1600, 1600, 959.5, 539.5, 0};
 const geom::Plane kWall = {Vec3(0, 1, 0), -2.5};  // y = 2.5, the wall frame's wall
 

@@ -12,8 +12,6 @@
 namespace procam::keystone {
 namespace {
 
-const double kDeg = degToRad(1);
-
 TEST(SixPositionCollector, SixHoldsRecoverOffsetAndGain) {
   AccelCalibration truth;
   truth.offset = Vec3(0.03, -0.02, 0.05);

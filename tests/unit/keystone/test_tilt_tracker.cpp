@@ -14,8 +14,6 @@
 namespace procam::keystone {
 namespace {
 
-const double kDeg = degToRad(1);
-
 // The handheld scene's MPU-6050 mount: chip x right, y forward, z up.
 Mat3 handheldMount() {
   Mat3 M;

@@ -8,6 +8,7 @@
 
 #include "sim/renderer.hpp"
 #include "sim_test_util.hpp"
+#include "unit/sim/rotated_grid.hpp"
 
 namespace procam::sim {
 namespace {
@@ -27,8 +28,7 @@ cv::Mat patches() {
   return fb;
 }
 
-// The documented 2 x 2 rotated-grid sample positions (renderer.hpp).
-const Vec2 kSampleOffsets[4] = {{-0.375, -0.125}, {0.125, -0.375}, {-0.125, 0.375}, {0.375, 0.125}};
+using testing::kSampleOffsets;
 
 // Exact radiance of one camera pixel (mean over its 2 x 2 samples),
 // or -1 when a sample's framebuffer neighbourhood is not one flat patch.

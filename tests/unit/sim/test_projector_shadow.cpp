@@ -10,12 +10,12 @@
 
 #include "sim/renderer.hpp"
 #include "sim/scene_library.hpp"
+#include "unit/sim/rotated_grid.hpp"
 
 namespace procam::sim {
 namespace {
 
-// The documented 2 x 2 rotated-grid sample positions (renderer.hpp).
-const Vec2 kSampleOffsets[4] = {{-0.375, -0.125}, {0.125, -0.375}, {-0.125, 0.375}, {0.375, 0.125}};
+using testing::kSampleOffsets;
 
 // Axis-aligned box [lo, hi]: does the segment p + s (q - p), s in (0, 1), enter it?
 bool segmentHitsBox(const Vec3& p, const Vec3& q, const Vec3& lo, const Vec3& hi) {

@@ -11,6 +11,10 @@
 
 namespace procam::testing {
 
+// The decoder tests' projector and camera sizes: a 400 x 300 projector seen obliquely.
+inline constexpr int kProjW = 400, kProjH = 300;
+inline const cv::Size kCamera(320, 240);
+
 struct ViewModel {
   cv::Mat map_x, map_y;          // CV_32F: projector coordinate seen by each camera pixel
   double projector_gamma = 2.2;  // projector response: radiance = (value/255)^gamma

@@ -6,12 +6,13 @@
 
 using namespace procam;
 using namespace procam::sl;
+using procam::testing::kCamera;
+using procam::testing::kProjH;
+using procam::testing::kProjW;
 using procam::testing::ViewModel;
 
 namespace {
 
-constexpr int kProjW = 400, kProjH = 300;
-const cv::Size kCamera(320, 240);
 const cv::Matx33d kH(1.15, 0.08, 12, -0.05, 1.1, 15, 2e-4, 1e-4, 1);
 
 CaptureFn captureWith(const ViewModel& m, int* calls) {

@@ -6,12 +6,12 @@
 
 using namespace procam;
 using namespace procam::sl;
+using procam::testing::kCamera;
+using procam::testing::kProjH;
+using procam::testing::kProjW;
 using procam::testing::ViewModel;
 
 namespace {
-
-constexpr int kProjW = 400, kProjH = 300;
-const cv::Size kCamera(320, 240);
 
 ViewModel obliqueView() {
   ViewModel m;

@@ -18,8 +18,8 @@ using synthetic::capCamera;
 using synthetic::headAt;
 using synthetic::kCapLeds;
 
-constexpr double kRate = 60;  // Hz
-constexpr double kFrame = 1 / kRate;
+constexpr double kFrameRate = 60;  // Hz
+constexpr double kFramePeriod = 1 / kFrameRate;
 
 Points2 observe(const geom::CameraModel& cam, const synthetic::HeadPose& h, double sigma,
                 std::mt19937_64& rng) {
@@ -49,7 +49,7 @@ TrackRun track(FilterKind kind) {
   TrackRun r;
   double sq = 0, angle_sq = 0;
   for (int k = 0; k < 300; ++k) {
-    const double t = k * kFrame;
+    const double t = k * kFramePeriod;
     const synthetic::HeadPose h = headAt(t);
     auto p = tracker->update(observe(capCamera(), h, 0.1, rng), t);
     EXPECT_TRUE(p) << p.error().message;
@@ -81,13 +81,13 @@ TEST(LedTracker, KalmanMeetsTwoMillimetresAndOneFrameOfLag) {
   const TrackRun r = track(FilterKind::kKalman);
   EXPECT_LE(r.raw_rms, 2e-3);
   EXPECT_LT(r.angle_rms, 0.25 * M_PI / 180);
-  EXPECT_LE(std::abs(r.filtered_lag - r.raw_lag), kFrame);
+  EXPECT_LE(std::abs(r.filtered_lag - r.raw_lag), kFramePeriod);
 }
 
 TEST(LedTracker, OneEuroMeetsTwoMillimetresAndOneFrameOfLag) {
   const TrackRun r = track(FilterKind::kOneEuro);
   EXPECT_LE(r.raw_rms, 2e-3);
-  EXPECT_LE(std::abs(r.filtered_lag - r.raw_lag), kFrame);
+  EXPECT_LE(std::abs(r.filtered_lag - r.raw_lag), kFramePeriod);
 }
 
 TEST(LedTracker, RegistrationMapsPoseAndOrientationToTheWorld) {
@@ -121,12 +121,13 @@ TEST(LedTracker, UnseenLedsFailTheFrameAndTrackingResumes) {
   std::mt19937_64 rng(3);
   ASSERT_TRUE(tracker->update(observe(capCamera(), headAt(0), 0.1, rng), 0));
   const Points2 two = {Vec2(600, 500), Vec2(700, 520)};
-  EXPECT_EQ(tracker->update(two, kFrame).error().code, ErrorCode::kTooFewPoints);
+  EXPECT_EQ(tracker->update(two, kFramePeriod).error().code, ErrorCode::kTooFewPoints);
   const Points2 junk = {Vec2(100, 100), Vec2(900, 120), Vec2(500, 800), Vec2(130, 640)};
-  EXPECT_EQ(tracker->update(junk, 2 * kFrame).error().code, ErrorCode::kNotFound);
-  auto back = tracker->update(observe(capCamera(), headAt(3 * kFrame), 0.1, rng), 3 * kFrame);
+  EXPECT_EQ(tracker->update(junk, 2 * kFramePeriod).error().code, ErrorCode::kNotFound);
+  auto back =
+      tracker->update(observe(capCamera(), headAt(3 * kFramePeriod), 0.1, rng), 3 * kFramePeriod);
   ASSERT_TRUE(back) << back.error().message;
-  EXPECT_LT((back->raw - headAt(3 * kFrame).t).norm(), 5e-3);
+  EXPECT_LT((back->raw - headAt(3 * kFramePeriod).t).norm(), 5e-3);
   // Time must increase; reset() forgets it.
   EXPECT_EQ(tracker->update(observe(capCamera(), headAt(0), 0.1, rng), 0).error().code,
             ErrorCode::kInvalidInput);
