@@ -94,7 +94,11 @@ Result<std::vector<TagCorrespondence>> detectTagGrid(const TagGrid& grid, const 
   std::unique_ptr<apriltag_detector_t, DetectorDeleter> detector(apriltag_detector_create());
   apriltag_detector_add_family(detector.get(), family.get());
   detector->quad_decimate = o.decimate;
-  detector->nthreads = std::max(1, o.threads);
+  // One thread: libapriltag's worker pool up to 3.3 (Debian 12's) can run a task from a
+  // task list that is being reallocated, and its worker then jumps to a freed address
+  // (AprilRobotics/apriltag pull request 339, "Fix spurious wake-ups ... in workerpool").
+  // Seen here as a segfault in 1 of about 40 detections on a loaded 2-core machine.
+  detector->nthreads = 1;
   detector->refine_edges = 1;
   // libapriltag reads the buffer but its API takes a non-const pointer.
   cv::Mat contiguous = image.isContinuous() ? image : image.clone();

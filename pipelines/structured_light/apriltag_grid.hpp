@@ -48,7 +48,6 @@ struct TagCorrespondence {
 struct TagDetectOptions {
   float decimate = 1.0f;     // libapriltag quad_decimate (1 = full resolution)
   double min_margin = 30.0;  // decision margin below which a detection is dropped
-  int threads = 2;
 };
 
 // Tags of the grid found in an 8-bit grey image; ids outside the grid are ignored.
