@@ -37,7 +37,9 @@ tl::expected<CameraCalibrationArgs, std::string> parseCameraCalibrationArgs(cons
   static const char* kKnown[] = {"cmd",       "id",         "action",   "camera",
                                  "board",     "views",      "coverage", "rms_px",
                                  "timeout_s", "interval_s", "min_shift"};
-  for (const auto& [key, value] : request.items()) {
+  for (const auto& item : request.items()) {
+    // Not a structured binding: clang before 16 cannot capture one in the lambda.
+    const std::string& key = item.key();
     if (std::none_of(std::begin(kKnown), std::end(kKnown), [&](const char* k) { return key == k; }))
       return tl::unexpected("unknown argument \"" + key + "\" for calibrate-camera");
   }
