@@ -199,7 +199,7 @@ struct TransferError {
 
 Result<HomographyFit> finish(const Normalized& n, const Mat3& Hn, double condition, int iterations,
                              std::span<const Vec2> src, std::span<const Vec2> dst) {
-  const Mat3 H = detail::canonicalCollineation<Mat3>(denormalize(n, Hn));
+  const Mat3 H = detail::canonicalCollineation(denormalize(n, Hn));
   if (!H.allFinite()) {
     return fail(ErrorCode::kIllConditioned, "homography: result not representable");
   }
@@ -276,7 +276,7 @@ Result<Mat3> homographyFrom4(const std::array<Vec2, 4>& src, const std::array<Ve
     return fail(ErrorCode::kDegenerate, "homography: three of the four points are collinear");
   }
   const Mat3 Hn = *Md * Ms->inverse();
-  const Mat3 H = detail::canonicalCollineation<Mat3>(td->inverseMatrix() * Hn * ts->matrix());
+  const Mat3 H = detail::canonicalCollineation(td->inverseMatrix() * Hn * ts->matrix());
   if (!H.allFinite()) {
     return fail(ErrorCode::kIllConditioned, "homography: result not representable");
   }

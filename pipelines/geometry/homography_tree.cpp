@@ -135,7 +135,7 @@ struct Refinement {
   static Mat3 updated(const Mat3& H, const Eigen::VectorXd& step, std::size_t offset) {
     Mat3 D = Mat3::Zero();
     for (int k = 0; k < kFree; ++k) D(row(k), col(k)) = step(Eigen::Index(offset) + k);
-    return detail::canonicalCollineation<Mat3>(H * (Mat3::Identity() + D));
+    return detail::canonicalCollineation(H * (Mat3::Identity() + D));
   }
 
   void run(int max_iterations) {
@@ -250,11 +250,11 @@ Result<HomographyTree> solveHomographyTree(std::span<const ViewProjectorMatches>
     frontier.pop();
     const std::size_t pn = views + l.projector;
     if (depth[l.view] >= 0 && depth[pn] < 0) {
-      P[l.projector] = detail::canonicalCollineation<Mat3>(G[l.view] * l.H);
+      P[l.projector] = detail::canonicalCollineation(G[l.view] * l.H);
       depth[pn] = depth[l.view] + 1;
       reach(pn);
     } else if (depth[pn] >= 0 && depth[l.view] < 0) {
-      G[l.view] = detail::canonicalCollineation<Mat3>(P[l.projector] * l.H.inverse());
+      G[l.view] = detail::canonicalCollineation(P[l.projector] * l.H.inverse());
       depth[l.view] = depth[pn];
       reach(l.view);
     }
@@ -307,11 +307,11 @@ Result<HomographyTree> solveHomographyTree(std::span<const ViewProjectorMatches>
     const Mat3 TrefInv = tv[options.reference_view].inverseMatrix();
     std::vector<Mat3> Pn(projectors);
     for (std::size_t p = 0; p < projectors; ++p)
-      Pn[p] = detail::canonicalCollineation<Mat3>(Tref * P[p] * tp[p].inverseMatrix());
+      Pn[p] = detail::canonicalCollineation(Tref * P[p] * tp[p].inverseMatrix());
     for (std::size_t v = 0; v < views; ++v) {
       if (v == options.reference_view || depth[v] < 0) continue;
       view_param[v] = int(Qn.size());
-      Qn.push_back(detail::canonicalCollineation<Mat3>(tv[v].matrix() * G[v].inverse() * TrefInv));
+      Qn.push_back(detail::canonicalCollineation(tv[v].matrix() * G[v].inverse() * TrefInv));
     }
     std::vector<Block> blocks;
     for (const Link& l : links) {
@@ -344,11 +344,11 @@ Result<HomographyTree> solveHomographyTree(std::span<const ViewProjectorMatches>
     out.iterations = lm.iterations;
     out.converged = lm.converged;
     for (std::size_t p = 0; p < projectors; ++p)
-      P[p] = detail::canonicalCollineation<Mat3>(TrefInv * Pn[p] * tp[p].matrix());
+      P[p] = detail::canonicalCollineation(TrefInv * Pn[p] * tp[p].matrix());
     for (std::size_t v = 0; v < views; ++v) {
       if (view_param[v] >= 0)
-        G[v] = detail::canonicalCollineation<Mat3>(TrefInv * Qn[view_param[v]].inverse() *
-                                                   tv[v].matrix());
+        G[v] =
+            detail::canonicalCollineation(TrefInv * Qn[view_param[v]].inverse() * tv[v].matrix());
     }
     residuals(links, P, G, out.rms_px, out.max_px);
   }

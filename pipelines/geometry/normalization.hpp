@@ -94,11 +94,10 @@ Matrix unitFrobenius(const Matrix& M) {
 // The representative of a collineation's class with unit Frobenius norm and H(2,2) >= 0,
 // so that results compare entry by entry; a non-finite or zero H is returned as it is
 // (the caller checks finiteness).
-template <class Matrix>
-Matrix canonicalCollineation(const Matrix& H) {
+inline Mat3 canonicalCollineation(const Mat3& H) {
   if (!H.allFinite() || !(H.cwiseAbs().maxCoeff() > 0)) return H;
-  const Matrix out = unitFrobenius(H);
-  return out(2, 2) < 0 ? Matrix(-out) : out;
+  const Mat3 out = unitFrobenius(H);
+  return out(2, 2) < 0 ? Mat3(-out) : out;
 }
 
 }  // namespace procam::geom::detail
