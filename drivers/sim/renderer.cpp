@@ -7,6 +7,7 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "sim/background_rows.hpp"
 #include "sim/camera_response.hpp"
 
 namespace procam::sim {
@@ -42,6 +43,10 @@ std::vector<Vec2> sampleOffsets(int supersamples) {
 void forEachRow(int rows, int threads, const std::function<void(int)>& body) {
   if (threads == 1) {
     for (int y = 0; y < rows; ++y) body(y);
+    return;
+  }
+  if (backgroundRendering()) {
+    forEachRowInBackground(rows, body);
     return;
   }
   cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {

@@ -27,7 +27,7 @@ using Framebuffers = std::map<std::string, cv::Mat, std::less<>>;
 struct RenderOptions {
   bool noise = true;
   std::uint64_t seed = 1;
-  int threads = 0;  // 1: the calling thread only; otherwise OpenCV's pool (all cores)
+  int threads = 0;  // 1: the calling thread only; otherwise all cores (forEachRow)
 };
 
 // What one camera pixel (its centre ray) sees.
@@ -138,7 +138,8 @@ std::optional<geom::Ray> pixelRay(const geom::CameraModel& view, double x, doubl
 std::vector<Vec2> sampleOffsets(int supersamples);
 
 // Runs body(row) for rows [0, rows): in the calling thread if threads == 1, else
-// on OpenCV's thread pool.
+// on OpenCV's thread pool, or on background threads when background rendering is on
+// (background_rows.hpp).
 void forEachRow(int rows, int threads, const std::function<void(int)>& body);
 
 }  // namespace procam::sim

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "render/cpu_renderer.hpp"
+#include "sim/background_rows.hpp"
 #include "sim/sensors.hpp"
 #include "sim_tilt.hpp"
 #include "sim_unplug.hpp"
@@ -383,6 +384,9 @@ int create(const procam_device_desc* d, const procam_config*, procam_device* out
     if constexpr (Family == PROCAM_FAMILY_CAMERA) {
       known = cameraSpec(dev.get()) != nullptr;
       out->ops.camera = &kCameraOps;
+      // A virtual camera's frames are rendered on the daemon's cores, where a real
+      // one's take none of them: below the daemon's own threads (background_rows.hpp).
+      setBackgroundRendering(true);
     } else if constexpr (Family == PROCAM_FAMILY_TILT) {
       for (const auto& t : s.tiltSensors()) known = known || t.name == name;
       // Through the tilt drivers' wrapper: the same sample gate and counts as hardware.
