@@ -87,8 +87,6 @@ struct KeystoneRuntime {
   std::optional<KeystoneEstimate> estimate;
   std::string estimate_yaw;  // where its yaw came from (cameraYawSource)
   double estimate_lead = 0;  // s: predicted ahead of its sample, to when it is shown
-  bool solving = false;
-  bool solve_again = false;
   uint64_t solves = 0;
 
   // Outputs.
