@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <mutex>
 #include <set>
 #include <stdexcept>
@@ -51,9 +52,12 @@ TEST(BackgroundRows, EveryRowOnceOnNicedThreads) {
 
 TEST(BackgroundRows, AFailureStopsTheRowsAndIsRethrown) {
   std::atomic<int> done{0};
+  // Each other row takes 10 us: all of them would take half a second on two cores,
+  // a failure stops them within the time an exception takes to be caught.
   EXPECT_THROW(forEachRowInBackground(100000,
                                       [&](int y) {
                                         if (y == 10) throw std::runtime_error("row 10");
+                                        std::this_thread::sleep_for(std::chrono::microseconds(10));
                                         done.fetch_add(1);
                                       }),
                std::runtime_error);
