@@ -164,8 +164,9 @@ class Daemon {
   void stopTiltPolling();
   void onTiltSample(const TiltReading& reading);
   // The gyroscope's reading with a tilt sample: the bias while still, the orientation
-  // carried while moving (daemon_camera_yaw.cpp).
-  void onGyroRate(const procam_rate_sample& rate, const Vec3& specific_force, bool was_still);
+  // carried while moving (daemon_camera_yaw.cpp). True when it carried a turn: the
+  // reading is to be solved.
+  bool onGyroRate(const procam_rate_sample& rate, const Vec3& specific_force, bool was_still);
   void accelCalibrationStep(ClientId client, const proto::Request& req, const std::string& action);
   void requestSolve();
   std::optional<Mat3> currentWarp(cv::Size content_size) const;

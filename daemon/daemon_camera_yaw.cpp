@@ -210,14 +210,14 @@ void Daemon::measureCameraYaw() {
       });
 }
 
-void Daemon::onGyroRate(const procam_rate_sample& sample, const Vec3& specific_force,
+bool Daemon::onGyroRate(const procam_rate_sample& sample, const Vec3& specific_force,
                         bool was_still) {
   KeystoneRuntime& k = keystone_rt_;
-  if (!k.tracker || !settings_.auto_keystone) return;
+  if (!k.tracker || !settings_.auto_keystone) return false;
   const Mat3& M = k.tracker->mount().sensor_from_projector;  // row i: sensor axis i
   const Vec3 w = M.transpose() * Vec3(sample.angular_velocity[0], sample.angular_velocity[1],
                                       sample.angular_velocity[2]);
-  if (sample.timestamp_ns <= k.gyro_last_ns) return;  // not newer: read twice
+  if (sample.timestamp_ns <= k.gyro_last_ns) return false;  // not newer: read twice
   if (k.gyro && k.gyro->running() && k.gyro_last_ns > 0 &&
       sample.timestamp_ns - k.gyro_last_ns > kGyroGapNs) {
     ++k.gyro_gaps;
@@ -232,7 +232,7 @@ void Daemon::onGyroRate(const procam_rate_sample& sample, const Vec3& specific_f
   if (was_still && !still) k.gyro_bias.endHold();
   if (!k.gyro) {
     auto g = keystone::GyroOrientation::create();
-    if (!g) return;
+    if (!g) return false;
     k.gyro = std::move(*g);
   }
   const Vec3 rate = w - k.gyro_bias.value();
@@ -246,7 +246,7 @@ void Daemon::onGyroRate(const procam_rate_sample& sample, const Vec3& specific_f
     if (k.gyro->running() && camera_pending) {
       const Vec3 f = k.tracker->mount().calibration.apply(specific_force / kStandardGravity);
       k.gyro->update(rate, keystone::downFromSpecificForce(M.transpose(), f), sample.timestamp_ns);
-      return;
+      return false;
     }
     if (k.gyro->running()) {
       // A turn ended: its yaw is a better guess than the last hold's, unless the camera
@@ -263,10 +263,10 @@ void Daemon::onGyroRate(const procam_rate_sample& sample, const Vec3& specific_f
       k.gyro_anchor_ns = sample.timestamp_ns;
       k.gyro_anchor_rate = rate;
     }
-    return;
+    return false;
   }
   if (!k.gyro->running()) {
-    if (!k.gyro_anchor) return;
+    if (!k.gyro_anchor) return false;
     k.gyro->start(*k.gyro_anchor, k.gyro_anchor_ns, k.gyro_anchor_rate);
   }
   if (still) {
@@ -283,12 +283,12 @@ void Daemon::onGyroRate(const procam_rate_sample& sample, const Vec3& specific_f
     // The readings stalled mid-turn: go on from this reading's gravity and the yaw
     // carried so far (the pull to gravity then smooths the accelerometer's noise).
     auto tilt = keystone::tiltFromDown(down);
-    if (!tilt) return;
+    if (!tilt) return false;
     tilt->yaw = keystone::anglesFromRotation(before).yaw;
     k.gyro->start(keystone::rotationFromAngles(*tilt), sample.timestamp_ns, rate);
   }
   k.down_time = static_cast<double>(sample.timestamp_ns) * 1e-9;
-  requestSolve();  // every reading while it turns
+  return true;  // every reading while it turns is solved
 }
 
 std::optional<Mat3> Daemon::keystoneOrientation(const Vec3& down) const {

@@ -201,29 +201,16 @@ void Daemon::onTiltSample(const TiltReading& reading) {
   }
   // A hold that ended takes its wall normal along; the gyroscope then gives this
   // sample's turn, so that a solve made for this sample's time uses it; a new hold
-  // starts the camera's look after that solve. One solve per reading, made once all of
-  // it is taken in (a turn the gyroscope carries asks for one too).
-  {
-    struct Taken {
-      bool& in_progress;
-      ~Taken() { in_progress = false; }
-    };
-    k.reading_in_progress = true;
-    const Taken taken{k.reading_in_progress};
-    k.solve_requested = down.has_value();
-    endTiltHold(was_still);
-    if (reading.rate) onGyroRate(*reading.rate, f, was_still);
-  }
-  if (k.solve_requested) requestSolve();
+  // starts the camera's look after that solve. One solve per reading: for a new gravity
+  // or a turn the gyroscope carried.
+  endTiltHold(was_still);
+  const bool turned = reading.rate && onGyroRate(*reading.rate, f, was_still);
+  if (down || turned) requestSolve();
   startTiltHold();
 }
 
 void Daemon::requestSolve() {
   KeystoneRuntime& k = keystone_rt_;
-  if (k.reading_in_progress) {
-    k.solve_requested = true;  // made when the reading is in (onTiltSample)
-    return;
-  }
   if (!settings_.auto_keystone || !k.down || !k.projector) return;
   const cv::Size content = currentSourceSize();
   if (content.width < 1 || content.height < 1) return;

@@ -88,9 +88,6 @@ struct KeystoneRuntime {
   std::string estimate_yaw;  // where its yaw came from (cameraYawSource)
   double estimate_lead = 0;  // s: predicted ahead of its sample, to when it is shown
   uint64_t solves = 0;
-  // While a tilt reading is taken in, solves asked for wait for its end: one per reading.
-  bool reading_in_progress = false;
-  bool solve_requested = false;
 
   // Outputs.
   struct OutputState {
