@@ -30,10 +30,15 @@ Result<PackedMap> packMap(const WarpMap& map, cv::Size source_size, int source_s
   const int w = source_size.width, h = source_size.height;
   // One axis: top-left texel index and quantised weight of the next texel. The outer half
   // pixel of the footprint clamps to the edge texel (see bilinear.hpp).
+  // v lies in the footprint, [-0.5, size - 0.5): the integer floor without a libm call,
+  // and v - floor(v) in [0, 1) times a power of two plus a half is exact in double (v came
+  // from a float), so truncation rounds half up as lround does; a handheld projector's
+  // keystone packs a new map every frame.
   auto axis = [](double v, int size, int& i0, uint8_t& f) {
-    const double fl = std::floor(v);
-    int i = static_cast<int>(fl);
-    int q = static_cast<int>(std::lround((v - fl) * kSubpixelOne));
+    int i = static_cast<int>(v);
+    if (static_cast<double>(i) > v) --i;
+    const double fl = static_cast<double>(i);
+    int q = static_cast<int>((v - fl) * kSubpixelOne + 0.5);
     if (q == kSubpixelOne) {
       ++i;
       q = 0;

@@ -61,13 +61,14 @@ Result<WarpMap> homographyMap(const Mat3& H, cv::Size output_size) {
       const Vec3 dx = Hinv.col(0);
       for (int x = 0; x < output_size.width; ++x) {
         const Vec3 p = base + x * dx;
-        if (p.z() <= 1e-12 * p.head<2>().norm() || p.z() <= 0) {
+        if (!(p.z() > 0)) {
           row[x] = outside();
           continue;
         }
         const double sx = p.x() / p.z(), sy = p.y() / p.z();
-        // Anything beyond +-1e6 px is outside every image; keep floats finite.
-        if (std::abs(sx) > 1e6 || std::abs(sy) > 1e6) {
+        // Anything beyond +-1e6 px is outside every image; keep floats finite. This also
+        // takes the points near the horizon (z <= 1e-12 |(x, y)| puts them beyond 1e11 px).
+        if (!(std::abs(sx) <= 1e6 && std::abs(sy) <= 1e6)) {
           row[x] = outside();
         } else {
           row[x] = cv::Vec2f(float(sx), float(sy));
