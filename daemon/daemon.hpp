@@ -169,6 +169,11 @@ class Daemon {
   bool onGyroRate(const procam_rate_sample& rate, const Vec3& specific_force, bool was_still);
   void accelCalibrationStep(ClientId client, const proto::Request& req, const std::string& action);
   void requestSolve();
+  // keystone_frames.cpp: the automatic keystone's solution a frame being planned carries
+  // (while a turn is carried, predicted to the time the frame is asked to go on the
+  // wall); nullopt when none is shown. Reported once the frame is on the wall.
+  std::optional<KeystoneRuntime::FrameSolution> planKeystoneFrame();
+  void keystoneFrameShown(const KeystoneRuntime::FrameSolution& solution, const OutputDrawn& drawn);
   std::optional<Mat3> currentWarp(cv::Size content_size) const;
   // daemon_camera_yaw.cpp: the yaw from the camera mounted on the projector.
   void probeCameraYaw();

@@ -6,9 +6,11 @@
 #include <numbers>
 #include <sstream>
 
+#include "core/monotonic_clock.hpp"
 #include "core/units.hpp"
 #include "daemon.hpp"
 #include "geometry/homography.hpp"
+#include "json_matrix.hpp"
 #include "log.hpp"
 #include "output_draw.hpp"
 #include "request_args.hpp"
@@ -20,21 +22,10 @@ namespace code = proto::code;
 
 namespace {
 
-// The longest lead a turn is predicted over (keystone_latency.hpp): three 60 Hz frames.
-// The prediction's error grows with the cube of the lead (a hand's jerk), 0.14 degrees
-// at 50 ms for a fast turn; a frame shown later than this is late whatever is predicted.
-constexpr double kMaxLead = 0.05;
-
 json quadJson(const std::array<Vec2, 4>& q) {
   json a = json::array();
   for (const auto& p : q) a.push_back({p.x(), p.y()});
   return a;
-}
-
-json matJson(const Mat3& H) {
-  json rows = json::array();
-  for (int r = 0; r < 3; ++r) rows.push_back({H(r, 0), H(r, 1), H(r, 2)});
-  return rows;
 }
 
 // The content's corner pixel centres, top-left first, clockwise on screen.
@@ -192,6 +183,7 @@ void Daemon::onTiltSample(const TiltReading& reading) {
   if (!k.tracker) return;
   k.reading_arrival = std::chrono::steady_clock::now();
   const procam_tilt_sample& sample = reading.sample;
+  k.sensor_clock.add(monotonicNs(k.reading_arrival), sample.timestamp_ns);
   const Vec3 f(sample.specific_force[0], sample.specific_force[1], sample.specific_force[2]);
   const bool was_still = k.tracker->still();
   const auto down = k.tracker->add(f, sample.timestamp_ns);
@@ -216,11 +208,11 @@ void Daemon::requestSolve() {
   if (content.width < 1 || content.height < 1) return;
   // While the gyroscope carries a turn, the solution is for the moment its frame reaches
   // the wall: the orientation predicted over the measured reading-to-shown latency (at
-  // most kMaxLead: a hand's turn changes within a longer one).
+  // most kMaxPredictionLead: a hand's turn changes within a longer one).
   std::optional<Mat3> R = keystoneOrientation(*k.down);
   double lead = 0;
   if (R && k.gyro && k.gyro->running() && !k.yaw.normal) {
-    lead = std::min(k.latency.median(), kMaxLead);
+    lead = std::min(k.latency.median(), kMaxPredictionLead);
     R = k.gyro->predicted(lead);
   }
   // Solved here, on the loop: a solve takes microseconds (bench_keystone; 0.1 ms at most
@@ -297,7 +289,14 @@ json Daemon::keystoneJson() const {
             {"output_size", nullptr},
             {"content_size", nullptr}};
   if (!k.unavailable.empty()) j["auto_unavailable"] = k.unavailable;
-  if (settings_.auto_keystone) j["latency"] = k.latency.toJson();
+  if (settings_.auto_keystone) {
+    j["latency"] = k.latency.toJson();
+    // Frames of a turn presented at a time chosen as they were planned (keystone_frames.cpp).
+    j["pacing"] = {{"frames", k.paced_frames},
+                   {"late", k.paced_late},
+                   {"budget_ms", 1e3 * k.draw_budget.budget()},
+                   {"vblank_period_ms", 1e-6 * static_cast<double>(k.vblank_period_ns)}};
+  }
   if (rig.contains("unavailable")) {
     j["rig_unavailable"] = rig["unavailable"];
   } else if (rig_active) {
@@ -360,7 +359,7 @@ json Daemon::keystoneJson() const {
   if (content.width > 0 && content.height > 0) {
     j["content_size"] = {content.width, content.height};
     if (auto H = currentWarp(content)) {
-      j["homography"] = matJson(*H);
+      j["homography"] = matrixRows(*H);
       if (auto_active || rig_active) {
         std::array<Vec2, 4> c = contentCorners(content);
         for (auto& p : c) p = (*H * p.homogeneous()).hnormalized();

@@ -218,6 +218,9 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done, bool supersede
     for (auto& w : waiters) w(false);
     return;
   }
+  // The automatic keystone's solution this frame carries: for a turn, predicted to the
+  // time the frame is asked to go on the wall (keystone_frames.cpp).
+  const auto solution = planKeystoneFrame();
   const OutputDrawPolicy policy{std::chrono::steady_clock::now(), !waiters.empty(),
                                 live_content_ && !live_content_->ended};
   std::vector<OutputDraw> jobs;
@@ -257,16 +260,21 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done, bool supersede
     }
     k.unshown_arrival.reset();
   }
+  if (solution) {
+    for (auto& job : jobs) {
+      if (job.homography) job.present_at_ns = solution->present_at_ns;
+    }
+  }
   k.rendering = true;
   k.frame_stop = std::make_shared<std::atomic<bool>>(false);
   for (auto& job : jobs) job.stop = k.frame_stop;
   // Shared with the failure handler: the waiters are answered either way.
   auto waiting = std::make_shared<decltype(waiters)>(std::move(waiters));
   compute_worker_->submit(
-      [this, jobs = std::move(jobs), waiting, arrival] {
+      [this, jobs = std::move(jobs), waiting, arrival, solution] {
         auto results = std::make_shared<std::vector<OutputDrawn>>();
         for (const auto& job : jobs) results->push_back(drawOutput(job));
-        return [this, results, waiting, arrival] {
+        return [this, results, waiting, arrival, solution] {
           KeystoneRuntime& k = keystone_rt_;
           k.rendering = false;
           k.frame_stop.reset();
@@ -308,6 +316,15 @@ void Daemon::refreshOutputs(std::function<void(bool shown)> done, bool supersede
             }
           }
           if (drawn) ++k.frames;  // frames drawn, not statistics read again
+          if (solution) {
+            // One report per frame: the first output that showed the keystone's solution.
+            for (const OutputDrawn& r : *results) {
+              if (r.ok && r.homography && r.shown_ns) {
+                keystoneFrameShown(*solution, r);
+                break;
+              }
+            }
+          }
           if (latency) {
             k.latency.add(*latency);
           } else if (stopped && arrival && !k.unshown_arrival) {

@@ -34,6 +34,13 @@ inline nlohmann::json rowMajor(const Mat34& m) {
   return v;
 }
 
+// [[a, b, c], [d, e, f], [g, h, i]]: a 3x3 matrix as rows (keystone homographies).
+inline nlohmann::json matrixRows(const Mat3& m) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (int r = 0; r < 3; ++r) rows.push_back({m(r, 0), m(r, 1), m(r, 2)});
+  return rows;
+}
+
 inline nlohmann::json rowMajor(const Mat3& m) {
   nlohmann::json v = nlohmann::json::array();
   for (int i = 0; i < 9; ++i) v.push_back(m(i / 3, i % 3));

@@ -18,6 +18,7 @@
 #include "blend/tiled_blend.hpp"
 #include "content_mesh.hpp"
 #include "driver.hpp"
+#include "frame_pacing.hpp"
 #include "keystone/dot_grid.hpp"
 #include "keystone/gyro_orientation.hpp"
 #include "keystone_latency.hpp"
@@ -80,6 +81,24 @@ struct KeystoneRuntime {
   std::chrono::steady_clock::time_point grid_ended{};  // the camera yaw's dot grid, last
   KeystoneLatency latency;
   Vec3 gyro_rate = Vec3::Zero();  // the last reading, projector frame, rad/s
+
+  // While the gyroscope carries a turn, each frame goes on the wall at a time chosen as
+  // it is planned, with the orientation predicted to then (frame_pacing.hpp), on an
+  // output that presents when asked (output operations version 4).
+  SensorClock sensor_clock;
+  DrawBudget draw_budget;
+  uint64_t last_vblank_ns = 0, vblank_period_ns = 0;  // the keystone output's, if it has one
+  uint64_t paced_frames = 0, paced_late = 0;          // late: shown after the time asked for
+  uint64_t last_present_at_ns = 0;                    // the latest time asked for
+  // The keystone solution a frame in flight carries (what `keystone_shown` reports).
+  struct FrameSolution {
+    uint64_t solve = 0;
+    uint64_t planned_ns = 0;  // CLOCK_MONOTONIC
+    Mat3 H = Mat3::Identity();
+    int content_width = 0, content_height = 0;
+    uint64_t present_at_ns = 0;            // 0: shown when drawn
+    std::optional<double> predicted_time;  // s, sensor clock: what it was solved for
+  };
 
   // The last published gravity and the solution made from it.
   std::optional<Vec3> down;

@@ -4,6 +4,7 @@
 #include <exception>
 #include <opencv2/imgproc.hpp>
 
+#include "core/monotonic_clock.hpp"
 #include "support/render_abi.hpp"
 
 namespace procam::daemon {
@@ -18,12 +19,22 @@ int stopRequested(void* flag) {
   return static_cast<const std::atomic<bool>*>(flag)->load(std::memory_order_relaxed) ? 1 : 0;
 }
 
-// A new frame on the output, drawn from a tilt solution not shown before: how long
+// A new frame on the output: when it was drawn and shown (as the output says, for one
+// that presents when asked) and, drawn from a tilt solution not shown before, how long
 // after its reading arrived.
-void stampLatency(const OutputDraw& j, OutputDrawn& r) {
-  if (!r.ok || !r.drawn || !j.reading_arrival) return;
-  r.latency_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - *j.reading_arrival).count();
+void stampShown(const OutputDraw& j, OutputDrawn& r,
+                const std::optional<plugins::PresentTiming>& timing = std::nullopt) {
+  if (!r.ok || !r.drawn) return;
+  const auto now = std::chrono::steady_clock::now();
+  r.ready_ns = timing ? timing->ready_ns : monotonicNs(now);
+  r.shown_ns = timing ? timing->shown_ns : monotonicNs(now);
+  if (timing) r.vblank_period_ns = timing->period_ns;
+  if (j.reading_arrival) {
+    // To when it goes on the wall, which an output that queues frames says.
+    const int64_t since =
+        static_cast<int64_t>(*r.shown_ns) - static_cast<int64_t>(monotonicNs(*j.reading_arrival));
+    r.latency_s = static_cast<double>(since) * 1e-9;
+  }
 }
 
 // Outputs with operations version 1 show RGB8 frames drawn here.
@@ -62,7 +73,7 @@ void drawFallback(const OutputDraw& j, OutputDrawn& r) {
   }
   r.ok = true;
   r.drawn = *drawn;
-  stampLatency(j, r);  // shown: the statistics below are not the wall's wait
+  stampShown(j, r);  // shown: the statistics below are not the wall's wait
   if (j.want_stats) {
     if (auto st = render::frameStats(cpu.frame())) r.stats = *st;
   }
@@ -107,6 +118,8 @@ OutputDrawn drawOutput(const OutputDraw& j) {
       r.configured = true;
     }
     const plugins::ContentView content(j.image.get(), j.mesh.get(), j.version);
+    const bool presents_at = plugins::outputPresentsAt(raw);
+    if (presents_at) (void)raw.ops.output->present_at(raw.self, j.present_at_ns);
     int drawn = 0;
     procam_frame_stats stats{};
     procam_frame_stats* want = j.want_stats ? &stats : nullptr;
@@ -132,7 +145,7 @@ OutputDrawn drawOutput(const OutputDraw& j) {
       r.stats = render::FrameStats{stats.lit_fraction,
                                    {stats.mean_rgb[0], stats.mean_rgb[1], stats.mean_rgb[2]}};
     }
-    stampLatency(j, r);
+    stampShown(j, r, presents_at ? plugins::outputTiming(raw) : std::nullopt);
   } catch (const std::exception& e) {
     r.ok = false;
     r.error = e.what();

@@ -41,6 +41,10 @@ struct OutputDraw {
   // Set when the homography is a tilt solution not shown before: its reading's arrival,
   // from which the draw measures when the frame is shown (keystone_latency.hpp).
   std::optional<std::chrono::steady_clock::time_point> reading_arrival;
+  // For an output that presents when asked (output operations version 4): the earliest
+  // time the frame goes on screen (CLOCK_MONOTONIC ns; 0: when drawn). Asked every
+  // frame, so that no earlier request lingers.
+  uint64_t present_at_ns = 0;
 };
 
 struct OutputDrawn {
@@ -59,6 +63,12 @@ struct OutputDrawn {
   std::string error;
   std::optional<render::FrameStats> stats;
   std::optional<double> latency_s;  // reading_arrival to shown, when a new frame was shown
+  // A new frame: when it went on screen (CLOCK_MONOTONIC ns): as the output says for one
+  // that presents when asked (at a vblank when vblank_period_ns > 0), else when its
+  // render returned.
+  std::optional<uint64_t> shown_ns;
+  uint64_t ready_ns = 0;  // its drawing ended (CLOCK_MONOTONIC)
+  uint64_t vblank_period_ns = 0;
   // What the output shows when ok: the job's setup and content (the drift check draws it
   // again to know what a camera should see).
   std::shared_ptr<const render::RenderSetup> setup;

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <functional>
 #include <opencv2/core.hpp>
+#include <optional>
 
 #include "core/error.hpp"
 #include "render/render_setup.hpp"
@@ -30,6 +31,17 @@ class ProjectorOutput {
   virtual Result<void> readFrame(cv::Mat& rgba) = 0;
   // The next show() draws even when nothing changed (something else was shown meanwhile).
   virtual void redraw() = 0;
+  // Outputs that present at their display's vblank (a page flip; show() returns once the
+  // frame is on screen). presentAt: the next show() presents at the first vblank at or
+  // after not_before_ns (CLOCK_MONOTONIC; 0: the first after its drawing ends).
+  // vblankTiming: the last frame's drawing end and vblank (CLOCK_MONOTONIC ns) and the
+  // refresh period; nullopt for outputs that show a frame when its drawing ends (the
+  // plugin holds their frames itself) and before the first vblank.
+  struct Timing {
+    uint64_t ready_ns = 0, shown_ns = 0, period_ns = 0;
+  };
+  virtual void presentAt(uint64_t /*not_before_ns*/) {}
+  virtual std::optional<Timing> vblankTiming() const { return std::nullopt; }
 };
 
 }  // namespace procam::output

@@ -37,6 +37,9 @@ struct ProjectorSpec {
   double gamma = 2.2;          // framebuffer value v in [0,1] emits v^gamma
   double blur_sigma_px = 0.0;  // Gaussian pixel footprint, framebuffer pixels
   double brightness = 1.0;     // irradiance of a full-white pixel at 1 m, normal incidence
+  // Its mock output presents a rendered frame at the next vblank of a 60 Hz display
+  // and says when (a page flip); off: at once, when its drawing ends.
+  bool vsync = false;
 };
 
 struct CameraSpec {

@@ -164,6 +164,7 @@ class Reader {
     s.gamma = f.numberIn("gamma", 2.2, 0.1, 10);
     s.blur_sigma_px = f.numberIn("blur_sigma_px", 0, 0, 50);
     s.brightness = f.numberIn("brightness", 1, 0, 1e9);
+    s.vsync = f.boolean("vsync", false);
     f.finish();
     return s;
   }

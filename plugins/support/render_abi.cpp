@@ -285,4 +285,21 @@ bool outputStops(const procam_device& d) {
   return outputRenders(d) && d.ops.output->version >= 3 && d.ops.output->render_stoppable;
 }
 
+bool outputPresentsAt(const procam_device& d) {
+  return outputRenders(d) && d.ops.output->version >= 4 && d.ops.output->present_at &&
+         d.ops.output->get_timing;
+}
+
+std::optional<PresentTiming> outputTiming(const procam_device& d) {
+  if (!outputPresentsAt(d)) return std::nullopt;
+  PresentTiming t;
+  if (d.ops.output->get_timing(d.self, &t.ready_ns, &t.shown_ns, &t.period_ns) != PROCAM_OK) {
+    return std::nullopt;
+  }
+  const bool period_ok =
+      t.period_ns == 0 || (t.period_ns >= 1'000'000 && t.period_ns <= 1'000'000'000);
+  if (t.ready_ns == 0 || t.shown_ns < t.ready_ns || !period_ok) return std::nullopt;
+  return t;
+}
+
 }  // namespace procam::plugins

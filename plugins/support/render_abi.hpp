@@ -73,4 +73,16 @@ bool outputRenders(const procam_device& device);
 // True when the output's render can be stopped midway (output operations version 3).
 bool outputStops(const procam_device& device);
 
+// An output that holds a frame until a time the daemon asks for and says when its
+// frames were drawn and shown (output operations version 4).
+bool outputPresentsAt(const procam_device& device);
+struct PresentTiming {
+  uint64_t ready_ns = 0;   // the last frame's drawing ended (CLOCK_MONOTONIC)
+  uint64_t shown_ns = 0;   // it went on screen
+  uint64_t period_ns = 0;  // the display's refresh period when it presents at vblank, else 0
+};
+// nullopt for an output without the operation, one that does not answer, or times of
+// 0, a shown time before the ready time or a period outside 1 ms .. 1 s.
+std::optional<PresentTiming> outputTiming(const procam_device& device);
+
 }  // namespace procam::plugins

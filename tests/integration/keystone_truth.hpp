@@ -79,13 +79,11 @@ inline Measured measureAgainstTruth(const geom::Intrinsics& K, const Mat3& R, in
   return m;
 }
 
-// A keystone event of the daemon on a handheld scene (projector "proj" before the wall
-// y = 2.5 facing -y, which makes the world frame the wall frame of
-// keystone/orientation.hpp, so the pose's rotation, yaw included, is R) against the
-// truth when its frame is on the wall: the tilt sample's time plus the lead the daemon
-// predicted the turn over (0 unless the gyroscope carries a turn).
-inline Measured handheldEventAgainstTruth(const sim::Scene& scene, const nlohmann::json& event) {
-  const double t = event["estimate"]["display_time"].get<double>();
+// An event with a keystone `homography` and `content_size` on a handheld scene (projector
+// "proj" before the wall y = 2.5 facing -y: the world frame is the wall frame) against
+// the truth at time t.
+inline Measured handheldAgainstTruthAt(const sim::Scene& scene, const nlohmann::json& event,
+                                       double t) {
   const sim::SceneState state = scene.at(t);
   const sim::ProjectorState* proj = state.projector("proj");
   EXPECT_TRUE(proj);
@@ -93,6 +91,21 @@ inline Measured handheldEventAgainstTruth(const sim::Scene& scene, const nlohman
   return measureAgainstTruth(proj->spec.K, proj->model.pose.R, proj->spec.width, proj->spec.height,
                              matrixOf(event["homography"]), event["content_size"][0].get<int>(),
                              event["content_size"][1].get<int>());
+}
+
+// A keystone event of the daemon on a handheld scene (projector "proj" before the wall
+// y = 2.5 facing -y, which makes the world frame the wall frame of
+// keystone/orientation.hpp, so the pose's rotation, yaw included, is R) against the
+// truth at the time it was solved for: the tilt sample's time plus the lead the daemon
+// predicted the turn over (0 unless the gyroscope carries a turn).
+inline Measured handheldEventAgainstTruth(const sim::Scene& scene, const nlohmann::json& event) {
+  return handheldAgainstTruthAt(scene, event, event["estimate"]["display_time"].get<double>());
+}
+
+// A `keystone_shown` event (a frame on the output, its homography and the time it went
+// on the wall, on the tilt sensor's clock) against the truth at that time.
+inline Measured handheldShownAgainstTruth(const sim::Scene& scene, const nlohmann::json& shown) {
+  return handheldAgainstTruthAt(scene, shown, shown["display_time"].get<double>());
 }
 
 }  // namespace procam::itest

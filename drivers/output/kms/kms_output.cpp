@@ -4,7 +4,13 @@
 #include <xf86drm.h>
 
 #include <cerrno>
+#include <chrono>
+#include <cmath>
 #include <cstring>
+#include <thread>
+#include <utility>
+
+#include "core/monotonic_clock.hpp"
 
 namespace procam::output::kms {
 namespace {
@@ -194,6 +200,37 @@ void KmsOutput::onFlip(int, unsigned int sequence, unsigned int sec, unsigned in
   auto* out = static_cast<KmsOutput*>(self);
   out->flip_pending_ = false;
   out->stats_.flip(sequence, sec + usec * 1e-6);
+  out->last_flip_ns_ = uint64_t{sec} * 1'000'000'000u + uint64_t{usec} * 1000u;
+}
+
+uint64_t KmsOutput::periodNs() const {
+  const double hz = refreshHz(mode_.clock, mode_.htotal, mode_.vtotal,
+                              (mode_.flags & DRM_MODE_FLAG_INTERLACE) != 0,
+                              (mode_.flags & DRM_MODE_FLAG_DBLSCAN) != 0);
+  return hz > 0 ? static_cast<uint64_t>(std::llround(1e9 / hz)) : 0;
+}
+
+std::optional<ProjectorOutput::Timing> KmsOutput::vblankTiming() const {
+  const uint64_t period = periodNs();
+  if (last_flip_ns_ == 0 || ready_ns_ == 0 || period == 0) return std::nullopt;
+  return Timing{ready_ns_, last_flip_ns_, period};
+}
+
+// Asked for a later vblank than the next: wait until the period before it, so that the
+// flip committed then lands on it.
+void KmsOutput::waitForVblankAsked() {
+  const uint64_t period = periodNs();
+  const uint64_t asked = std::exchange(not_before_ns_, 0);
+  if (asked == 0 || last_flip_ns_ == 0 || period == 0) return;
+  const uint64_t now = monotonicNowNs();
+  const uint64_t from = std::max(asked, now);
+  const uint64_t k = (from - std::min(from, last_flip_ns_) + period - 1) / period;
+  const uint64_t target = last_flip_ns_ + k * period;
+  // Half a millisecond into the period before the target vblank.
+  const uint64_t commit_at = target - period + 500'000;
+  if (commit_at > now) {
+    std::this_thread::sleep_for(std::chrono::nanoseconds(commit_at - now));
+  }
 }
 
 Result<void> KmsOutput::waitForFlip() {
@@ -219,6 +256,8 @@ Result<void> KmsOutput::present() {
     gbm_surface_release_buffer(surface_, bo);
     return tl::unexpected(fb.error());
   }
+  ready_ns_ = monotonicNowNs();
+  if (mode_set_) waitForVblankAsked();
   if (auto ok = commit(*fb, !mode_set_); !ok) {
     gbm_surface_release_buffer(surface_, bo);
     return ok;

@@ -36,6 +36,10 @@ class KmsOutput final : public ProjectorOutput {
   Result<bool> show(const render::Content& content) override;
   Result<void> readFrame(cv::Mat& rgba) override;
   void redraw() override;
+  // Flips are timed by the page-flip events (CLOCK_MONOTONIC, the kernel's default for
+  // them): a frame is committed in the period before the vblank asked for.
+  void presentAt(uint64_t not_before_ns) override { not_before_ns_ = not_before_ns; }
+  std::optional<Timing> vblankTiming() const override;
 
   const FrameStats& stats() const { return stats_; }
   const std::string& connectorName() const { return connector_name_; }
@@ -47,6 +51,8 @@ class KmsOutput final : public ProjectorOutput {
   Result<uint32_t> framebufferFor(gbm_bo* bo);
   Result<void> commit(uint32_t fb, bool modeset);
   Result<void> waitForFlip();
+  void waitForVblankAsked();
+  uint64_t periodNs() const;  // of the mode; 0 when its totals are zero
   static void onFlip(int fd, unsigned int sequence, unsigned int sec, unsigned int usec,
                      unsigned int crtc, void* self);
 
@@ -68,6 +74,9 @@ class KmsOutput final : public ProjectorOutput {
   bool mode_set_ = false, flip_pending_ = false;
   int flip_timeout_ms_ = 1000;
   FrameStats stats_;
+  uint64_t last_flip_ns_ = 0;   // the vblank of the latest page flip
+  uint64_t ready_ns_ = 0;       // the latest frame's drawing ended
+  uint64_t not_before_ns_ = 0;  // the next flip's earliest vblank (0: the next)
 };
 
 }  // namespace procam::output::kms

@@ -1,17 +1,22 @@
 // The projector outputs behind the driver plugin ABI (plugins/include/procamd/
 // procam_plugin.h): "headless" (EGL surfaceless, frames kept on the GPU) and, when built,
-// "kms" (DRM/KMS scan-out). Both render by themselves (output operations version 3): the
+// "kms" (DRM/KMS scan-out). Both render by themselves (output operations version 4): the
 // daemon's render setup is drawn by the GLES renderer, content is uploaded only when its
-// version changes. A frame handed over with `show` is shown 1:1 (identity homography).
+// version changes; "kms" presents at vblank and says when. A frame handed over with
+// `show` is shown 1:1 (identity homography).
 #include <procamd/procam_plugin.h>
 
+#include <chrono>
 #include <climits>
 #include <cstring>
 #include <memory>
 #include <opencv2/imgproc.hpp>
 #include <optional>
 #include <string>
+#include <thread>
+#include <utility>
 
+#include "core/monotonic_clock.hpp"
 #include "headless/headless_output.hpp"
 #include "support/driver_support.hpp"
 #include "support/render_abi.hpp"
@@ -34,7 +39,32 @@ struct Device {
   bool showing = true;                       // configured for 1:1 frames
   std::optional<render::RenderSetup> setup;  // the daemon's, once configured
   plugins::MeshCache mesh;
+  // The next rendered frame goes on screen no earlier than this (CLOCK_MONOTONIC ns, 0:
+  // at once); when the last one was ready and shown. An output that presents at vblank
+  // times its own frames (ProjectorOutput::vblankTiming); the others are held here.
+  uint64_t not_before_ns = 0;
+  uint64_t ready_ns = 0, shown_ns = 0;
 };
+
+// A rendered frame, drawn: an output that shows it when its drawing ends is held until
+// the time asked for. Returns once the frame is on screen.
+Result<bool> showAt(Device& d, const render::Content& content) {
+  const uint64_t not_before = std::exchange(d.not_before_ns, 0);
+  d.out->presentAt(not_before);
+  auto drawn = d.out->show(content);
+  if (!drawn || !*drawn) return drawn;
+  if (auto t = d.out->vblankTiming()) {
+    d.ready_ns = t->ready_ns;
+    d.shown_ns = t->shown_ns;
+    return drawn;
+  }
+  d.ready_ns = monotonicNowNs();
+  if (not_before > d.ready_ns) {
+    std::this_thread::sleep_for(std::chrono::nanoseconds(not_before - d.ready_ns));
+  }
+  d.shown_ns = std::max(d.ready_ns, not_before);
+  return drawn;
+}
 
 int getMode(void* self, uint32_t* w, uint32_t* h, double* hz) {
   auto* d = static_cast<Device*>(self);
@@ -125,7 +155,7 @@ int renderStoppable(void* self, const procam_content* content, int (*stop)(void*
     auto c = plugins::contentFromAbi(*content, *d->setup, header, d->mesh);
     if (!c) return plugins::report(err, err_len, c.error());
     if (stop) c->stop = [stop, stop_ctx] { return stop(stop_ctx) != 0; };
-    auto drawn = d->out->show(*c);
+    auto drawn = showAt(*d, *c);
     if (!drawn) return plugins::report(err, err_len, drawn.error());
     if (out_drawn) *out_drawn = *drawn ? 1 : 0;
     if (stats) {
@@ -153,8 +183,23 @@ int render(void* self, const procam_content* content, int* out_drawn, procam_fra
   return renderStoppable(self, content, nullptr, nullptr, out_drawn, stats, err, err_len);
 }
 
-const procam_output_ops kOps = {PROCAM_OUTPUT_OPS_VERSION, &getMode, &show, &configure, &render,
-                                &renderStoppable};
+int presentAt(void* self, uint64_t not_before_ns) {
+  static_cast<Device*>(self)->not_before_ns = not_before_ns;
+  return PROCAM_OK;
+}
+
+int getTiming(void* self, uint64_t* ready_ns, uint64_t* shown_ns, uint64_t* period_ns) {
+  auto* d = static_cast<Device*>(self);
+  const auto t = d->out->vblankTiming();
+  if (ready_ns) *ready_ns = d->ready_ns;
+  if (shown_ns) *shown_ns = d->shown_ns;
+  if (period_ns) *period_ns = t ? t->period_ns : 0;
+  return PROCAM_OK;
+}
+
+const procam_output_ops kOps = {
+    PROCAM_OUTPUT_OPS_VERSION, &getMode,   &show,     &configure, &render,
+    &renderStoppable,          &presentAt, &getTiming};
 
 int finish(std::unique_ptr<Device> d, procam_device* out, char* err, size_t err_len) {
   if (auto ok = configureOneToOne(*d); !ok) return plugins::report(err, err_len, ok.error());

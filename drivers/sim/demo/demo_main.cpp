@@ -216,9 +216,11 @@ static int run(int argc, char** argv) {
 
   section("keystone updates while the projector moves (procamctl --json watch)");
   std::printf(
-      "The shown image judged with the projector's TRUE orientation (yaw, pitch and roll)\n"
-      "when it is on the wall (the tilt sample's time plus the latency the daemon predicts a\n"
-      "turn over): corner px in the framebuffer, aspect and area against the largest upright\n"
+      "Each frame shown judged with the projector's TRUE orientation (yaw, pitch and roll)\n"
+      "at the time it went on the wall (procamd's `keystone_shown`: the output's present\n"
+      "time; while the projector turns, procamd asks the output to present each frame at a\n"
+      "time it chose and predicts the turn to it): corner px in the framebuffer, aspect and\n"
+      "area against the largest upright\n"
       "rectangle. Gravity gives pitch and roll; the camera on the projector gives the yaw at\n"
       "each still hold ([Raskar02] §6.2.2), the gyroscope carries it while the projector\n"
       "turns.\n\n");
@@ -229,31 +231,50 @@ static int run(int argc, char** argv) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   int updates = 0, hidden = 0;
   double last_printed = -1;
-  std::vector<double> moving_px;  // corner errors while the projector moves
+  std::vector<double> moving_px;   // corner errors while the projector moves
+  std::vector<double> on_time_px;  // of those, frames shown at the time procamd asked for
   double worst_moving = -1, worst_moving_t = 0;
   std::string worst_moving_by;
   // The last update of each still hold whose yaw the camera measured in that hold,
   // keyed by the measurement's count.
   std::map<long, std::pair<double, Errors>> holds;
+  // Each solution as published (`keystone`), by its update count: whether the sensor
+  // was still, the estimate and where its yaw came from.
+  std::map<long, json> published;
+  int late = 0, paced = 0;
+  std::vector<double> predicted_off_ms;  // shown - predicted display time, paced frames
   while (std::chrono::steady_clock::now() < end) {
     auto line = watch->readLine(std::chrono::milliseconds(200));
     if (!line) continue;
     const json e = json::parse(*line, nullptr, false);
-    if (e.is_discarded() || e.value("event", "") != "keystone" || e.value("mode", "") != "auto") {
+    if (e.is_discarded()) continue;
+    const std::string event = e.value("event", "");
+    if (event == "keystone" && e.value("mode", "") == "auto" && e.contains("estimate")) {
+      published[e["estimate"].value("updates", 0L)] = e;
+      while (published.size() > 256) published.erase(published.begin());
       continue;
     }
+    if (event != "keystone_shown" || !e["display_time"].is_number()) continue;
+    const auto info = published.find(e.value("updates", 0L));
+    if (info == published.end()) continue;
+    const json& k = info->second;
     ++updates;
-    // When the frame is on the wall: the daemon predicts a turn to then.
-    const double t = e["estimate"]["display_time"].get<double>();
+    // Judged when the frame went on the wall, as procamd saw its output present it.
+    const double t = e["display_time"].get<double>();
+    if (e["predicted_display_time"].is_number()) {
+      ++paced;
+      if (e.value("late", false)) ++late;
+      predicted_off_ms.push_back(1e3 * (t - e["predicted_display_time"].get<double>()));
+    }
     const int cw = e["content_size"][0].get<int>(), ch = e["content_size"][1].get<int>();
     const Mat3 H = matrixOf(e["homography"]);
     // The handheld wall is the world plane y = const facing -y: wall frame = world frame.
     const Mat3 R_true = scene.at(t).projector(pspec.name)->model.pose.R;
     const keystone::Angles truth = keystone::anglesFromRotation(R_true);
     const Errors full = errorsAt(pspec, R_true, H, cw, ch);
-    const bool still = e["tilt"].value("still", false);
-    const json& yaw = e["tilt"]["yaw"];
-    const std::string source = e["estimate"].value("yaw_source", "");
+    const bool still = k["tilt"].value("still", false);
+    const json& yaw = k["tilt"]["yaw"];
+    const std::string source = k["estimate"].value("yaw_source", "");
     const bool this_hold = source == "camera, this still hold";
     const char* yaw_by = this_hold                         ? "camera"
                          : source.starts_with("gyroscope") ? "gyro"
@@ -271,6 +292,7 @@ static int run(int argc, char** argv) {
         worst_moving_by = yaw_by;
       }
       moving_px.push_back(full.corner_px);
+      if (!e.value("late", false)) on_time_px.push_back(full.corner_px);
     }
     if (still && this_hold) holds[yaw.value("measurements", 0L)] = {t, full};
     // While moving the daemon updates on every sample: print ten a second.
@@ -281,8 +303,8 @@ static int run(int argc, char** argv) {
     last_printed = t;
     std::printf("%7.2f %6s | %6.1f %6.1f %6.1f | %6.2f %6.2f %6.2f %-7s | %8.3f %8.4f %7.4f\n", t,
                 still ? "yes" : "no", radToDeg(truth.pitch), radToDeg(truth.roll),
-                radToDeg(truth.yaw), e["estimate"]["pitch_deg"].get<double>(),
-                e["estimate"]["roll_deg"].get<double>(), e["estimate"].value("yaw_deg", 0.0),
+                radToDeg(truth.yaw), k["estimate"]["pitch_deg"].get<double>(),
+                k["estimate"]["roll_deg"].get<double>(), k["estimate"].value("yaw_deg", 0.0),
                 yaw_by, full.corner_px, full.aspect_pct, full.area_pct);
     std::fflush(stdout);
   }
@@ -305,13 +327,26 @@ static int run(int argc, char** argv) {
   }
   if (!moving_px.empty()) {
     std::sort(moving_px.begin(), moving_px.end());
+    std::sort(on_time_px.begin(), on_time_px.end());
+    const auto at = [](const std::vector<double>& v, double q) {
+      return v.empty() ? 0.0 : v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))];
+    };
     std::printf(
-        "While the projector moves (%zu updates): corner error median %.2f px, max %.2f px (at\n"
-        "  t = %.2f s, yaw by %s; the orientation is carried by the gyroscope where the tilt\n"
-        "  sensor has one; otherwise the tilt low-pass lags the motion and the yaw is the last\n"
-        "  hold's until the next).\n",
-        moving_px.size(), moving_px[moving_px.size() / 2], moving_px.back(), worst_moving_t,
-        worst_moving_by.c_str());
+        "While the projector moves (%zu frames): corner error median %.2f px, 95 %% %.2f px,\n"
+        "  max %.2f px (at t = %.2f s, yaw by %s); the %zu frames shown at the time procamd\n"
+        "  asked for: median %.2f px, max %.2f px. The gyroscope carries the orientation where\n"
+        "  the tilt sensor has one; otherwise the tilt low-pass lags the motion and the yaw is\n"
+        "  the last hold's until the next.\n",
+        moving_px.size(), at(moving_px, 0.5), at(moving_px, 0.95), moving_px.back(), worst_moving_t,
+        worst_moving_by.c_str(), on_time_px.size(), at(on_time_px, 0.5),
+        on_time_px.empty() ? 0.0 : on_time_px.back());
+  }
+  if (!predicted_off_ms.empty()) {
+    std::sort(predicted_off_ms.begin(), predicted_off_ms.end());
+    std::printf(
+        "Frames presented at a time procamd chose (%d): %d late by more than 0.5 ms (drawn\n"
+        "  over their budget); shown minus asked-for time median %.3f ms, max %.3f ms.\n",
+        paced, late, predicted_off_ms[predicted_off_ms.size() / 2], predicted_off_ms.back());
   }
 
   section("procamctl keystone");

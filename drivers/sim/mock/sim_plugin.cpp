@@ -1,6 +1,7 @@
 #include "sim_plugin.hpp"
 
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <exception>
@@ -90,6 +91,10 @@ struct Device {
   uint64_t frames = 0;          // camera frames captured: each has its own noise
   std::unique_ptr<OutputRender> output;
   CameraRadiance cache;
+  // Outputs: the next rendered frame goes on the wall no earlier than this (CLOCK_MONOTONIC
+  // ns, 0: at once); when the last one was ready and shown.
+  uint64_t present_not_before = 0;
+  uint64_t ready_ns = 0, shown_ns = 0;
 };
 
 // PROCAM_OK while the device is plugged in (sim_unplug.hpp).
@@ -145,13 +150,48 @@ const ProjectorSpec* projectorSpec(const Device* dev) {
   return nullptr;
 }
 
+// Every virtual projector is a 60 Hz display; one with `vsync` presents a rendered
+// frame at a vblank, world time k / kRefreshHz (SCENE-FORMAT.md).
+constexpr double kRefreshHz = 60.0;
+
 int outputMode(void* self, uint32_t* w, uint32_t* h, double* hz) {
   const ProjectorSpec* p = projectorSpec(static_cast<Device*>(self));
   if (!p || presence(p->name, nullptr, 0) != PROCAM_OK) return PROCAM_ENODEV;
   *w = static_cast<uint32_t>(p->width);
   *h = static_cast<uint32_t>(p->height);
-  *hz = 60.0;
+  *hz = kRefreshHz;
   return PROCAM_OK;
+}
+
+int outputPresentAt(void* self, uint64_t not_before_ns) {
+  static_cast<Device*>(self)->present_not_before = not_before_ns;
+  return PROCAM_OK;
+}
+
+int outputTiming(void* self, uint64_t* ready_ns, uint64_t* shown_ns, uint64_t* period_ns) {
+  auto* dev = static_cast<Device*>(self);
+  const ProjectorSpec* p = projectorSpec(dev);
+  if (!p) return PROCAM_ENODEV;
+  if (ready_ns) *ready_ns = dev->ready_ns;
+  if (shown_ns) *shown_ns = dev->shown_ns;
+  if (period_ns) *period_ns = p->vsync ? static_cast<uint64_t>(std::llround(1e9 / kRefreshHz)) : 0;
+  return PROCAM_OK;
+}
+
+// A rendered frame, drawn: it goes on the wall no earlier than the time asked for and,
+// with `vsync`, at the first vblank from then (a page flip). Queued: render returns
+// once it is drawn, and the next frame may be drawn while this one waits.
+void presentFrame(Device& dev, const ProjectorSpec& p, cv::Mat bgr) {
+  SimWorld& world = *dev.world;
+  const double ready = world.now();
+  double shown = ready;
+  if (dev.present_not_before) shown = std::max(shown, world.worldTime(dev.present_not_before));
+  if (p.vsync) shown = std::ceil(shown * kRefreshHz) / kRefreshHz;
+  dev.present_not_before = 0;  // for the next frame only
+  // After a frame queued before it, if that one goes on later.
+  shown = world.show(dev.name, std::move(bgr), shown);
+  dev.ready_ns = world.monotonicNs(ready);
+  dev.shown_ns = std::max(dev.ready_ns, world.monotonicNs(shown));
 }
 
 int outputShow(void* self, const procam_image* frame, char* err, size_t len) {
@@ -234,7 +274,9 @@ int outputRenderStoppable(void* self, const procam_content* content, int (*stop)
       // The simulated projector lights the world with a BGR frame.
       cv::Mat bgr;
       cv::cvtColor(o->renderer.frame(), bgr, cv::COLOR_RGBA2BGR);
-      dev->world->show(dev->name, std::move(bgr));
+      const ProjectorSpec* p = projectorSpec(dev);
+      if (!p) return report(err, len, "projector gone", PROCAM_ENODEV);
+      presentFrame(*dev, *p, std::move(bgr));
       o->showing = false;
       if (drawn) *drawn = 1;
     }
@@ -255,8 +297,8 @@ int outputRender(void* self, const procam_content* content, int* drawn, procam_f
 }
 
 const procam_output_ops kOutputOps = {
-    PROCAM_OUTPUT_OPS_VERSION, outputMode,   outputShow,
-    outputConfigure,           outputRender, outputRenderStoppable};
+    PROCAM_OUTPUT_OPS_VERSION, outputMode,      outputShow,  outputConfigure, outputRender,
+    outputRenderStoppable,     outputPresentAt, outputTiming};
 
 // --- camera ---
 const CameraSpec* cameraSpec(const Device* dev) {

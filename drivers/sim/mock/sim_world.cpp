@@ -42,31 +42,43 @@ uint64_t SimWorld::monotonicNs(double world_time) const {
       std::chrono::duration_cast<std::chrono::nanoseconds>(at.time_since_epoch()).count());
 }
 
-void SimWorld::show(const std::string& projector, cv::Mat framebuffer) {
+double SimWorld::worldTime(uint64_t monotonic_ns) const {
+  const auto at = std::chrono::steady_clock::time_point(
+      std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+          std::chrono::nanoseconds(monotonic_ns)));
+  return std::chrono::duration<double>(at - epoch_).count();
+}
+
+double SimWorld::show(const std::string& projector, cv::Mat framebuffer, std::optional<double> at) {
   const double t = now();
   std::lock_guard lock(mutex_);
   History& h = history_[projector];
-  h.frames.push_back({t, std::move(framebuffer)});
+  double on = std::max(t, at.value_or(t));
+  if (!h.frames.empty()) on = std::max(on, h.frames.back().time);
+  h.frames.push_back({on, std::move(framebuffer)});
   ++shows_;
   // Keep the frame that was on at t - keep_s_ (the one before the first younger
-  // than that), and no more than kMaxKeptFrames.
+  // than that) and those to come, and no more than kMaxKeptFrames.
   while (h.frames.size() > 1 &&
          (h.frames[1].time <= t - keep_s_ || h.frames.size() > kMaxKeptFrames)) {
     h.frames.pop_front();
     h.trimmed = true;
   }
+  return on;
 }
 
 std::uint64_t SimWorld::showCount() const {
+  const double t = now();
   std::lock_guard lock(mutex_);
-  return shows_;
+  std::uint64_t to_come = 0;  // frames asked to go on later
+  for (const auto& [name, h] : history_) {
+    for (auto it = h.frames.rbegin(); it != h.frames.rend() && it->time > t; ++it) ++to_come;
+  }
+  return shows_ - to_come;
 }
 
 Framebuffers SimWorld::shown() const {
-  std::lock_guard lock(mutex_);
-  Framebuffers out;
-  for (const auto& [name, h] : history_) out[name] = h.frames.back().frame;
-  return out;
+  return shownAt(now());
 }
 
 Framebuffers SimWorld::shownAt(double t) const {

@@ -10,6 +10,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 
 #include "core/error.hpp"
@@ -30,12 +31,16 @@ class SimWorld {
   double now() const;
   // A world time on CLOCK_MONOTONIC (ns), the camera frames' clock.
   uint64_t monotonicNs(double world_time) const;
+  // The world time of a CLOCK_MONOTONIC time (ns).
+  double worldTime(uint64_t monotonic_ns) const;
 
-  // Shows `framebuffer` on `projector` from now on.
-  void show(const std::string& projector, cv::Mat framebuffer);
-  // What the projectors show now, and how many frames have been shown so far (it
-  // changes with every show: a camera's view of a still scene is the same between two
-  // equal counts).
+  // Shows `framebuffer` on `projector` from world time `at` on (now when not given or
+  // past; never before a frame shown before it). Returns the time it goes on.
+  double show(const std::string& projector, cv::Mat framebuffer,
+              std::optional<double> at = std::nullopt);
+  // What the projectors show now, and how many frames have gone on so far (it changes
+  // with every frame that goes on: a camera's view of a still scene is the same between
+  // two equal counts).
   Framebuffers shown() const;
   std::uint64_t showCount() const;
   // What they showed at world time `t` (a projector that had shown nothing yet is

@@ -40,7 +40,7 @@ extern "C" {
 #define PROCAM_CAMERA_OPS_VERSION 2u
 #define PROCAM_TILT_OPS_VERSION 3u
 #define PROCAM_TRACKER_OPS_VERSION 1u
-#define PROCAM_OUTPUT_OPS_VERSION 3u
+#define PROCAM_OUTPUT_OPS_VERSION 4u
 
 #define PROCAM_PLUGIN_ABI_SYMBOL "procam_plugin_abi_version"
 #define PROCAM_PLUGIN_ENTRY_SYMBOL "procam_plugin_entry"
@@ -289,6 +289,20 @@ typedef struct procam_output_ops {
   int (*render_stoppable)(void* self, const procam_content* content, int (*stop)(void* stop_ctx),
                           void* stop_ctx, int* out_drawn, procam_frame_stats* stats, char* err,
                           size_t err_len);
+  /* Version 4, both optional (may be NULL). `present_at`: the next frame `render`
+   * draws goes on screen no earlier than `not_before_ns` (CLOCK_MONOTONIC; 0: as soon
+   * as it is drawn, the default); an output that presents at its display's vblank
+   * presents at the first vblank at or after it. `render` returns once the frame is
+   * drawn: either once it is on screen or with it queued to go on at the time
+   * `get_timing` gives, so that the next frame can be drawn meanwhile. The daemon
+   * predicts a moving projector's pose to that instant. */
+  int (*present_at)(void* self, uint64_t not_before_ns);
+  /* About the last frame `render` drew: when its drawing ended (`out_ready_ns`) and
+   * when it goes on screen (`out_shown_ns`), CLOCK_MONOTONIC, 0 before the first; the
+   * display's refresh period for an output that presents at vblank (`out_period_ns`),
+   * else 0. */
+  int (*get_timing)(void* self, uint64_t* out_ready_ns, uint64_t* out_shown_ns,
+                    uint64_t* out_period_ns);
 } procam_output_ops;
 
 /* A created device. `poll_fd` returns a file descriptor the daemon may watch

@@ -276,6 +276,133 @@ TEST(SimDrivers, WorldGivesTheFramesShownAtATime) {
   EXPECT_EQ(valueAt(world.now()), 200);
 }
 
+TEST(SimDrivers, WorldQueuesAFrameToGoOnLater) {
+  auto scene = sim::Scene::parse(handheldHeldStill(), "handheld still", {});
+  ASSERT_TRUE(scene) << scene.error().message;
+  sim::mock::SimWorld world(std::move(*scene));
+  auto frame = [](int v) { return cv::Mat(2, 2, CV_8UC1, cv::Scalar(v)); };
+  auto valueNow = [&] {
+    auto shown = world.shown();
+    return shown.count("proj") ? int(shown.at("proj").at<uint8_t>(0, 0)) : -1;
+  };
+  world.show("proj", frame(1));
+  const std::uint64_t shows = world.showCount();
+  const double at = world.now() + 0.08;
+  world.show("proj", frame(2), at);
+  // Asked for before the queued one: goes on after it, not before.
+  world.show("proj", frame(3), at - 0.05);
+  EXPECT_EQ(valueNow(), 1);
+  EXPECT_EQ(world.showCount(), shows);  // nothing new on the wall yet
+  EXPECT_EQ(int(world.shownAt(at - 1e-6).at("proj").at<uint8_t>(0, 0)), 1);
+  EXPECT_EQ(int(world.shownAt(at).at("proj").at<uint8_t>(0, 0)), 3);
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  EXPECT_EQ(valueNow(), 3);
+  EXPECT_EQ(world.showCount(), shows + 2);
+}
+
+// A scene file of the held-still handheld projector, `vsync` as given; removed with the
+// object. The world registry keys worlds by scene: one file per test.
+struct SceneFile {
+  std::filesystem::path path;
+  SceneFile(const std::string& tag, bool vsync) {
+    path = std::filesystem::temp_directory_path() /
+           ("procam_" + tag + "_" + std::to_string(::getpid()) + ".toml");
+    std::ofstream out(path);
+    out << replaced(handheldHeldStill(), "[[projectors]]\n",
+                    std::string("[[projectors]]\nvsync = ") + (vsync ? "true" : "false") + "\n");
+  }
+  ~SceneFile() { std::filesystem::remove(path); }
+};
+
+uint64_t monotonicNow() {
+  return static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                   std::chrono::steady_clock::now().time_since_epoch())
+                                   .count());
+}
+
+// Renders a white frame on the output (identity homography) to go on no earlier than
+// `not_before_ns`; returns when render returned (CLOCK_MONOTONIC ns).
+uint64_t renderAt(Device& out, uint64_t not_before_ns, uint64_t version) {
+  uint32_t w = 0, h = 0;
+  double hz = 0;
+  EXPECT_EQ(out.raw().ops.output->get_mode(out.raw().self, &w, &h, &hz), PROCAM_OK);
+  procam_render_setup setup{};
+  setup.output_width = setup.content_width = w;
+  setup.output_height = setup.content_height = h;
+  setup.path = PROCAM_RENDER_HOMOGRAPHY;
+  setup.homography[0] = setup.homography[4] = setup.homography[8] = 1;
+  char err[256] = {};
+  EXPECT_EQ(out.raw().ops.output->configure(out.raw().self, &setup, err, sizeof err), PROCAM_OK)
+      << err;
+  std::vector<uint8_t> px(static_cast<size_t>(w) * h * 4, 255);
+  procam_image image{w, h, w * 4, PROCAM_PIXEL_RGBA8, px.data(), 0};
+  procam_content content{};
+  content.image = &image;
+  content.version = version;
+  EXPECT_EQ(out.raw().ops.output->present_at(out.raw().self, not_before_ns), PROCAM_OK);
+  int drawn = 0;
+  EXPECT_EQ(
+      out.raw().ops.output->render(out.raw().self, &content, &drawn, nullptr, err, sizeof err),
+      PROCAM_OK)
+      << err;
+  EXPECT_EQ(drawn, 1);
+  return monotonicNow();
+}
+
+TEST(SimDrivers, OutputPresentsAFrameAtTheTimeAskedFor) {
+  const SceneFile file("present_at", false);
+  auto r = simRegistry();
+  Device out = open(r, simDevice(PROCAM_FAMILY_OUTPUT, "proj", file.path.string()));
+  ASSERT_GE(out.raw().ops.output->version, 4u);
+  ASSERT_NE(out.raw().ops.output->present_at, nullptr);
+  ASSERT_NE(out.raw().ops.output->get_timing, nullptr);
+  uint64_t ready = 0, shown = 0, period = 1;
+  // Not asked: on the wall when drawn.
+  renderAt(out, 0, 1);
+  ASSERT_EQ(out.raw().ops.output->get_timing(out.raw().self, &ready, &shown, &period), PROCAM_OK);
+  EXPECT_EQ(period, 0u);
+  EXPECT_GT(ready, 0u);
+  EXPECT_GE(shown, ready);  // as it is handed to the world, microseconds later
+  EXPECT_LT(shown - ready, 1'000'000u);
+  // Asked for 250 ms ahead (a 1280x720 frame draws in milliseconds): queued, render
+  // returns before it goes on, on the wall at the time asked for.
+  const uint64_t asked = monotonicNow() + 250'000'000;
+  const uint64_t returned = renderAt(out, asked, 2);
+  ASSERT_EQ(out.raw().ops.output->get_timing(out.raw().self, &ready, &shown, &period), PROCAM_OK);
+  EXPECT_LT(ready, asked);
+  EXPECT_NEAR(static_cast<double>(shown), static_cast<double>(std::max(asked, ready)),
+              2.0);  // ns rounding through the world's clock
+  EXPECT_LT(returned, shown);
+  // A time already past: when drawn. The request was for that frame only.
+  renderAt(out, 1, 3);
+  ASSERT_EQ(out.raw().ops.output->get_timing(out.raw().self, &ready, &shown, &period), PROCAM_OK);
+  EXPECT_GE(shown + 2, asked);  // after the frame queued before it (ns rounding)
+}
+
+TEST(SimDrivers, OutputWithVsyncPresentsAtItsVblanks) {
+  const SceneFile file("vsync", true);
+  auto r = simRegistry();
+  Device out = open(r, simDevice(PROCAM_FAMILY_OUTPUT, "proj", file.path.string()));
+  uint64_t ready = 0, first = 0, period = 0;
+  renderAt(out, 0, 1);
+  ASSERT_EQ(out.raw().ops.output->get_timing(out.raw().self, &ready, &first, &period), PROCAM_OK);
+  EXPECT_NEAR(static_cast<double>(period), 1e9 / 60, 1.0);
+  EXPECT_GE(first, ready);
+  EXPECT_LT(first - ready, period + 2);
+  // Asked for 240 ms after the first vblank (14.4 periods): the first vblank at or after
+  // that, on the same 60 Hz grid, when drawn by then (a frame draws in milliseconds).
+  uint64_t shown = 0;
+  const uint64_t asked = first + 240'000'000;
+  renderAt(out, asked, 2);
+  ASSERT_EQ(out.raw().ops.output->get_timing(out.raw().self, &ready, &shown, &period), PROCAM_OK);
+  const double periods = static_cast<double>(shown - first) / static_cast<double>(period);
+  EXPECT_NEAR(periods, std::round(periods), 1e-6);  // on the grid, up to ns rounding
+  if (ready < asked) {
+    EXPECT_NEAR(periods, 15.0, 1e-6);
+  }
+  EXPECT_GE(shown + 2, std::max(ready, asked));  // ns rounding
+}
+
 TEST(SimDrivers, CameraSeesTheOutputAfterItsLatency) {
   // A scene file of this test: the world registry keys worlds by scene.
   const auto file = std::filesystem::temp_directory_path() /
