@@ -1,8 +1,9 @@
 // procam-demo: the daemon on the virtual rig. Starts `procamd --sim SCENE` in a
 // temporary runtime and state directory, drives it with procamctl (status,
-// devices, keystone), follows the keystone updates with `procamctl watch` while
-// the simulated projector moves along the scene's trajectory, and prints for
-// every update its error against the rig's ground truth; then stops the daemon.
+// devices, keystone), follows the frames shown with `procamctl watch` while the
+// simulated projector moves along the scene's trajectory, and prints for every frame
+// its error against the rig's ground truth at the time it went on the wall; then stops
+// the daemon.
 #include <unistd.h>
 
 #include <Eigen/Geometry>
@@ -214,7 +215,7 @@ static int run(int argc, char** argv) {
   section("procamctl pattern white");
   std::fputs(ctl({"pattern", "white"}).out.c_str(), stdout);
 
-  section("keystone updates while the projector moves (procamctl --json watch)");
+  section("frames shown while the projector moves (procamctl --json watch)");
   std::printf(
       "Each frame shown judged with the projector's TRUE orientation (yaw, pitch and roll)\n"
       "at the time it went on the wall (procamd's `keystone_shown`: the output's present\n"
@@ -309,7 +310,7 @@ static int run(int argc, char** argv) {
     std::fflush(stdout);
   }
   watch->stop();
-  std::printf("\n%d keystone update(s) in %.1f s (%d not printed).\n", updates, seconds, hidden);
+  std::printf("\n%d frame(s) shown in %.1f s (%d not printed).\n", updates, seconds, hidden);
   if (!holds.empty()) {
     Errors worst;
     for (const auto& [n, hold] : holds) {
