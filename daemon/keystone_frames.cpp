@@ -30,10 +30,12 @@ std::optional<KeystoneRuntime::FrameSolution> Daemon::planKeystoneFrame() {
   const bool turning = k.gyro && k.gyro->running() && !k.yaw.normal && k.down && k.projector;
   DeviceEntry* out = turning ? devices_.firstUsable(PROCAM_FAMILY_OUTPUT) : nullptr;
   if (out && plugins::outputPresentsAt(out->device.raw())) {
-    // After the frame before it, which an output may still hold.
+    // After the frame before it (as asked for, or as shown when that was later), which an
+    // output may still hold: on a vblank output, at the vblank after its.
+    const uint64_t before = std::max(k.last_present_at_ns, k.last_vblank_ns);
     const uint64_t target = std::max(
         presentTarget(f.planned_ns, k.draw_budget.budget(), k.vblank_period_ns, k.last_vblank_ns),
-        k.last_present_at_ns + 1);
+        before + std::max<uint64_t>(1, k.vblank_period_ns));
     const auto at = k.sensor_clock.sensorSeconds(target);
     const double lead = at ? *at - static_cast<double>(k.gyro_last_ns) * 1e-9 : -1;
     const cv::Size content = currentSourceSize();

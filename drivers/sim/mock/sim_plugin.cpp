@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "render/cpu_renderer.hpp"
@@ -179,19 +180,36 @@ int outputTiming(void* self, uint64_t* ready_ns, uint64_t* shown_ns, uint64_t* p
 }
 
 // A rendered frame, drawn: it goes on the wall no earlier than the time asked for and,
-// with `vsync`, at the first vblank from then (a page flip). Queued: render returns
-// once it is drawn, and the next frame may be drawn while this one waits.
+// with `vsync`, at the first vblank from then (a page flip: render returns once it is
+// on). Without: queued, render returns once it is drawn, and the next frame may be
+// drawn while this one waits.
 void presentFrame(Device& dev, const ProjectorSpec& p, cv::Mat bgr) {
   SimWorld& world = *dev.world;
   const double ready = world.now();
   double shown = ready;
+  if (p.vsync && dev.shown_ns > world.monotonicNs(ready)) {
+    // One flip pending at a time, as on a display: wait until the frame before is on,
+    // and take the vblank after its.
+    std::this_thread::sleep_until(
+        std::chrono::steady_clock::time_point(std::chrono::nanoseconds(dev.shown_ns)));
+    shown = world.worldTime(dev.shown_ns) + 1 / kRefreshHz;
+  }
   if (dev.present_not_before) shown = std::max(shown, world.worldTime(dev.present_not_before));
-  if (p.vsync) shown = std::ceil(shown * kRefreshHz) / kRefreshHz;
+  // The first vblank at or after then. A time up to a thousandth of a period after a
+  // vblank counts as that vblank: a client steps the period in whole nanoseconds (the
+  // ABI's), 0.33 ns off per 60 Hz period, which adds up over a few seconds of periods.
+  if (p.vsync) shown = std::ceil(shown * kRefreshHz - 1e-3) / kRefreshHz;
   dev.present_not_before = 0;  // for the next frame only
   // After a frame queued before it, if that one goes on later.
   shown = world.show(dev.name, std::move(bgr), shown);
   dev.ready_ns = world.monotonicNs(ready);
   dev.shown_ns = std::max(dev.ready_ns, world.monotonicNs(shown));
+  if (p.vsync) {
+    // A page flip returns once the frame is on, as KMS does: the next frame is drawn
+    // for the vblank after it, not queued behind it.
+    std::this_thread::sleep_until(
+        std::chrono::steady_clock::time_point(std::chrono::nanoseconds(dev.shown_ns)));
+  }
 }
 
 int outputShow(void* self, const procam_image* frame, char* err, size_t len) {
