@@ -169,6 +169,9 @@ class Daemon {
   bool onGyroRate(const procam_rate_sample& rate, const Vec3& specific_force, bool was_still);
   void accelCalibrationStep(ClientId client, const proto::Request& req, const std::string& action);
   void requestSolve();
+  // The keystone for the last gravity (k.down, its time as the sample's) in orientation
+  // R, or from gravity alone when none; nullopt (logged) when it cannot be solved.
+  std::optional<KeystoneEstimate> solveKeystone(const std::optional<Mat3>& R, cv::Size content);
   // keystone_frames.cpp: the automatic keystone's solution a frame being planned carries
   // (while a turn is carried, predicted to the time the frame is asked to go on the
   // wall); nullopt when none is shown. Reported once the frame is on the wall.

@@ -218,6 +218,20 @@ void Daemon::requestSolve() {
   // Solved here, on the loop: a solve takes microseconds (bench_keystone; 0.1 ms at most
   // in the daemon on two cores), where queued on the compute worker it waited for the
   // frame being drawn, 12 ms of a turning reading's 22 ms to the wall.
+  auto e = solveKeystone(R, content);
+  if (!e) return;
+  k.estimate = *e;
+  k.estimate_yaw = cameraYawSource();
+  k.unshown_arrival = k.reading_arrival;
+  k.estimate_lead = lead;
+  ++k.solves;
+  broadcast("keystone", keystoneJson());
+  refreshOutputs();
+}
+
+std::optional<KeystoneEstimate> Daemon::solveKeystone(const std::optional<Mat3>& R,
+                                                      cv::Size content) {
+  const KeystoneRuntime& k = keystone_rt_;
   Result<KeystoneEstimate> e = [&]() -> Result<KeystoneEstimate> {
     try {
       return R ? keystone::solveFromOrientation(*k.projector, *R, *k.down, content.width,
@@ -230,16 +244,10 @@ void Daemon::requestSolve() {
   }();
   if (!e) {
     logDebug("keystone solve: " + e.error().message);
-    return;
+    return std::nullopt;
   }
   e->sample_time = k.down_time;
-  k.estimate = *e;
-  k.estimate_yaw = cameraYawSource();
-  k.unshown_arrival = k.reading_arrival;
-  k.estimate_lead = lead;
-  ++k.solves;
-  broadcast("keystone", keystoneJson());
-  refreshOutputs();
+  return *e;
 }
 
 cv::Size Daemon::currentSourceSize() const {

@@ -8,7 +8,6 @@
 #include "core/monotonic_clock.hpp"
 #include "daemon.hpp"
 #include "json_matrix.hpp"
-#include "log.hpp"
 #include "support/render_abi.hpp"
 
 namespace procam::daemon {
@@ -40,20 +39,11 @@ std::optional<KeystoneRuntime::FrameSolution> Daemon::planKeystoneFrame() {
     const double lead = at ? *at - static_cast<double>(k.gyro_last_ns) * 1e-9 : -1;
     const cv::Size content = currentSourceSize();
     if (at && lead >= 0 && lead <= kMaxPredictionLead && content.width > 0 && content.height > 0) {
-      try {
-        auto e = keystone::solveFromOrientation(*k.projector, k.gyro->predicted(lead), *k.down,
-                                                content.width, content.height);
-        if (e) {
-          e->sample_time = k.down_time;
-          k.estimate = *e;
-          k.estimate_lead = *at - k.down_time;
-          f.present_at_ns = k.last_present_at_ns = target;
-          f.predicted_time = *at;
-        } else {
-          logDebug("keystone frame: " + e.error().message);
-        }
-      } catch (const std::exception& ex) {
-        warn(std::string("keystone solve failed: ") + ex.what());
+      if (auto e = solveKeystone(k.gyro->predicted(lead), content)) {
+        k.estimate = *e;
+        k.estimate_lead = *at - k.down_time;
+        f.present_at_ns = k.last_present_at_ns = target;
+        f.predicted_time = *at;
       }
     }
   }

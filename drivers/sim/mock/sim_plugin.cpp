@@ -187,13 +187,10 @@ void presentFrame(Device& dev, const ProjectorSpec& p, cv::Mat bgr) {
   SimWorld& world = *dev.world;
   const double ready = world.now();
   double shown = ready;
-  if (p.vsync && dev.shown_ns > world.monotonicNs(ready)) {
-    // One flip pending at a time, as on a display: wait until the frame before is on,
-    // and take the vblank after its.
-    std::this_thread::sleep_until(
-        std::chrono::steady_clock::time_point(std::chrono::nanoseconds(dev.shown_ns)));
-    shown = world.worldTime(dev.shown_ns) + 1 / kRefreshHz;
-  }
+  // One frame per vblank: the one after the frame before's (which is on by now: render
+  // returned once it was).
+  if (p.vsync && dev.shown_ns)
+    shown = std::max(shown, world.worldTime(dev.shown_ns) + 1 / kRefreshHz);
   if (dev.present_not_before) shown = std::max(shown, world.worldTime(dev.present_not_before));
   // The first vblank at or after then. A time up to a thousandth of a period after a
   // vblank counts as that vblank: a client steps the period in whole nanoseconds (the

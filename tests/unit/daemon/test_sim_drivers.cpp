@@ -12,6 +12,7 @@
 #include <numeric>
 #include <thread>
 
+#include "core/monotonic_clock.hpp"
 #include "loader.hpp"
 #include "registry.hpp"
 #include "sim/embedded_scenes.hpp"
@@ -314,12 +315,6 @@ struct SceneFile {
   ~SceneFile() { std::filesystem::remove(path); }
 };
 
-uint64_t monotonicNow() {
-  return static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                   std::chrono::steady_clock::now().time_since_epoch())
-                                   .count());
-}
-
 // Renders a white frame on the output (identity homography) to go on no earlier than
 // `not_before_ns`; returns when render returned (CLOCK_MONOTONIC ns).
 uint64_t renderAt(Device& out, uint64_t not_before_ns, uint64_t version) {
@@ -346,7 +341,7 @@ uint64_t renderAt(Device& out, uint64_t not_before_ns, uint64_t version) {
       PROCAM_OK)
       << err;
   EXPECT_EQ(drawn, 1);
-  return monotonicNow();
+  return monotonicNowNs();
 }
 
 TEST(SimDrivers, OutputPresentsAFrameAtTheTimeAskedFor) {
@@ -366,7 +361,7 @@ TEST(SimDrivers, OutputPresentsAFrameAtTheTimeAskedFor) {
   EXPECT_LT(shown - ready, 1'000'000u);
   // Asked for 250 ms ahead (a 1280x720 frame draws in milliseconds): queued, render
   // returns before it goes on, on the wall at the time asked for.
-  const uint64_t asked = monotonicNow() + 250'000'000;
+  const uint64_t asked = monotonicNowNs() + 250'000'000;
   const uint64_t returned = renderAt(out, asked, 2);
   ASSERT_EQ(out.raw().ops.output->get_timing(out.raw().self, &ready, &shown, &period), PROCAM_OK);
   EXPECT_LT(ready, asked);
